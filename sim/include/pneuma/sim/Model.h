@@ -1,0 +1,157 @@
+#pragma once
+/// @file Model.h
+/// The immutable simulation model: everything that does not change while Pneuma steps.
+///
+/// A Model is what `meshing/` builds and writes as `model.json` (see docs/model-format.md) and what
+/// `sim/` reads back. It follows MuJoCo's mjModel: topology, rest geometry, masses and gains only;
+/// all time-varying quantities live in State.
+///
+/// Conventions (all SI, radians):
+///  - world frame is RAS: +x toward the subject's right, +y anterior, +z superior; gravity is -z.
+///  - each rigid body's frame has its origin at the body's centre of mass and, at rest, axes parallel
+///    to the world axes. Body-frame points are therefore `restWorldPoint - com`.
+///  - structures of arrays: one column (or entry) per item, Eigen::Matrix3X* for 3-vectors.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pneuma::sim {
+
+/// Muscle and spring groups (Zordan et al. 2004, Table 1). Cartilage is not a muscle: it is the
+/// structurally stable set of two-sided linear springs of Section 5 that links ribs to the sternum.
+enum class ElementGroup : int {
+  IntercostalExternal = 0,  ///< outer intercostals: down and forward from rib above to rib below; inhale
+  IntercostalInternal,      ///< inner intercostals: down and backward; exhale
+  Diaphragm,                ///< radial strands, central tendon to costal margin, xiphoid and crura
+  Rectus,                   ///< vertical strands on the anterior abdominal wall
+  TransversusObliques,      ///< horizontal and diagonal strands around the abdominal wall
+  Cartilage,                ///< structural springs: costal cartilage and attachments (two-sided)
+  Count
+};
+constexpr int kElementGroupCount = static_cast<int>(ElementGroup::Count);
+
+/// Stable snake_case name of a group as used in model.json, presets and CSV headers
+/// ("intercostal_external", "intercostal_internal", "diaphragm", "rectus", "transversus_obliques", "cartilage").
+const char* groupName(ElementGroup g);
+/// Inverse of groupName(); returns false when the name is unknown.
+bool groupFromName(const std::string& name, ElementGroup& out);
+/// True for the groups that follow the one-sided muscle law (Eq. 2); false for structural springs.
+inline bool isMuscleGroup(ElementGroup g) { return g != ElementGroup::Cartilage; }
+
+/// A set of points, each bound either to a rigid body (a fixed point in that body's frame) or to up to
+/// three gut nodes (barycentric weights). Used for element endpoints, cavity vertices and landmarks.
+struct AnchorSet {
+  std::vector<int> body;      ///< rigid-body index, or -1 when the point is bound to nodes   (#P)
+  Eigen::Matrix3Xd local;     ///< [m] point in the body frame, used when body >= 0            (3 x #P)
+  Eigen::Matrix3Xi nodes;     ///< gut node indices, -1 marks an unused slot; used when body < 0 (3 x #P)
+  Eigen::Matrix3Xd weights;   ///< [-] barycentric weights of `nodes`, summing to 1             (3 x #P)
+
+  int size() const { return static_cast<int>(body.size()); }
+  /// Appends a point fixed in body `b` at body-frame position `p` [m].
+  void addBodyPoint(int b, const Eigen::Vector3d& p);
+  /// Appends a point bound to nodes `n` with weights `w` (unused slots: node -1, weight 0).
+  void addNodePoint(const Eigen::Vector3i& n, const Eigen::Vector3d& w);
+};
+
+/// Rigid bodies: bones. Fixed bodies (lumbar spine, pelvis) never move.
+struct Bodies {
+  std::vector<std::string> name;           ///< unique names, e.g. "rib3_left", "sternum", "thoracic_1" (#B)
+  std::vector<std::uint8_t> isFixed;       ///< 1 when the body never moves                            (#B)
+  Eigen::VectorXd mass;                    ///< [kg]                                                    (#B)
+  Eigen::Matrix3Xd com;                    ///< [m] rest-pose centre of mass in world = frame origin    (3 x #B)
+  std::vector<Eigen::Matrix3d> inertia;    ///< [kg m^2] inertia tensor about the com, body frame       (#B)
+  std::vector<std::string> mesh;           ///< render mesh (.vtp, body-frame coordinates [m]) relative to the model dir; may be empty (#B)
+
+  int size() const { return static_cast<int>(name.size()); }
+};
+
+/// Ball joints (Zordan et al. 2004, Section 5): rib-spine costovertebral joints and the joints
+/// between thoracic segments. Joint friction follows Eq. 3, tau = -mu * relative angular velocity;
+/// a passive rotational spring tau = -k * (rotation vector of the relative rotation) holds the spine.
+struct Joints {
+  std::vector<std::string> name;   ///< e.g. "costovertebral_rib3_left"        (#J)
+  std::vector<int> parent;         ///< body index of the parent (may be fixed) (#J)
+  std::vector<int> child;          ///< body index of the child                 (#J)
+  Eigen::Matrix3Xd anchor;         ///< [m] rest-pose joint centre, world       (3 x #J)
+  Eigen::VectorXd friction;        ///< [N m s/rad] mu of Eq. 3                 (#J)
+  Eigen::VectorXd stiffness;       ///< [N m/rad] passive rotational stiffness  (#J)
+
+  int size() const { return static_cast<int>(parent.size()); }
+};
+
+/// Role of a gut node on the sealed gut surface (Section 6).
+enum class NodeRegion : std::uint8_t {
+  Wall = 0,       ///< anterior and lateral abdominal wall (moving)
+  Diaphragm = 1,  ///< the diaphragm dome (moving)
+  Fixed = 2       ///< the fixed back and bottom
+};
+
+/// Point masses of the deformable gut surface (Section 6.1).
+struct Nodes {
+  Eigen::Matrix3Xd rest;                  ///< [m] rest positions, world   (3 x #N)
+  Eigen::VectorXd mass;                   ///< [kg] point masses; moving wall masses add up to 8 kg (#N)
+  std::vector<NodeRegion> region;         ///< role of each node           (#N)
+
+  int size() const { return static_cast<int>(rest.cols()); }
+  bool isFixed(int i) const { return region[static_cast<std::size_t>(i)] == NodeRegion::Fixed; }
+};
+
+/// The sealed, volume-preserving gut (Section 6.2): P = kappa (V0/V - 1) (Eq. 4), with V0 the volume
+/// enclosed by `triangles` at the nodes' rest positions.
+struct Gut {
+  Eigen::Matrix3Xi triangles;   ///< node indices, counter-clockwise seen from outside (outward normals) (3 x #F)
+  double kappa = 0.0;           ///< [Pa] bulk "volumetric" modulus of Eq. 4
+};
+
+/// Spring elements: muscles (Eq. 2) and structural springs (cartilage).
+///   muscle:     F = min[-alpha kac (l - r l0) - kpe (l - l0) - b dl/dt, 0]   (tension only)
+///   structural: F = -kpe (l - l0) - b dl/dt                                    (two-sided)
+/// F is the signed scalar force along the element (negative = pulling the endpoints together).
+struct Elements {
+  std::vector<ElementGroup> group;  ///< (#E)
+  AnchorSet endA;                   ///< first endpoint  (#E points)
+  AnchorSet endB;                   ///< second endpoint (#E points)
+  Eigen::VectorXd restLength;       ///< [m] l0 > 0            (#E)
+  Eigen::VectorXd kac;              ///< [N/m] active gain      (#E)
+  Eigen::VectorXd kpe;              ///< [N/m] passive gain     (#E)
+  Eigen::VectorXd damping;          ///< [N s/m] b              (#E)
+
+  int size() const { return static_cast<int>(group.size()); }
+};
+
+/// Closed lung-cavity surface (Figure 6): its vertices are anchors, so its volume can be recomputed
+/// from the current bone poses and diaphragm nodes at every step.
+struct Cavity {
+  AnchorSet vertices;            ///< (#C points)
+  Eigen::Matrix3Xi triangles;    ///< vertex indices, outward normals (3 x #T)
+};
+
+/// Named points for measurement, bound like cavity vertices.
+/// Required names: "xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right".
+struct Landmarks {
+  std::vector<std::string> name;  ///< (#L)
+  AnchorSet points;               ///< (#L points)
+
+  /// Index of a landmark by name, or -1.
+  int find(const std::string& n) const;
+};
+
+/// The whole immutable model.
+struct Model {
+  std::string name;                         ///< e.g. "adult_male"
+  std::string anatomy;                      ///< anatomy preset it was built from
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81}; ///< [m/s^2]
+  Bodies bodies;
+  Joints joints;
+  Nodes nodes;
+  Gut gut;
+  Elements elements;
+  Cavity cavity;
+  Landmarks landmarks;
+};
+
+}  // namespace pneuma::sim
