@@ -1,0 +1,538 @@
+#include "pneuma/sim/ModelIO.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace pneuma::sim {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kFormatName = "pneuma-model";
+constexpr const char* kRequiredLandmarks[] = {"xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left",
+                                              "rib8_lateral_right"};
+
+const char* regionName(NodeRegion r) {
+  switch (r) {
+    case NodeRegion::Wall: return "wall";
+    case NodeRegion::Diaphragm: return "diaphragm";
+    case NodeRegion::Fixed: return "fixed";
+  }
+  return "wall";
+}
+
+// ---------------------------------------------------------------------------------------------
+// reading: every accessor carries the JSON path so that errors name the field
+
+class Reader {
+ public:
+  Reader(const json& j, std::string path, const std::string& source)
+      : m_j(j), m_path(std::move(path)), m_source(source) {}
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw Error(m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
+  }
+  const std::string& path() const { return m_path; }
+
+  Reader at(const std::string& key) const {
+    if (!m_j.is_object()) fail("must be an object");
+    auto it = m_j.find(key);
+    if (it == m_j.end()) Reader(m_j, join(key), m_source).fail("missing");
+    return Reader(*it, join(key), m_source);
+  }
+  bool has(const std::string& key) const { return m_j.is_object() && m_j.contains(key); }
+
+  std::size_t size() const {
+    if (!m_j.is_array()) fail("must be an array");
+    return m_j.size();
+  }
+  Reader operator[](std::size_t i) const {
+    return Reader(m_j.at(i), m_path + "[" + std::to_string(i) + "]", m_source);
+  }
+
+  double number() const {
+    if (!m_j.is_number()) fail("must be a number");
+    const double v = m_j.get<double>();
+    if (!std::isfinite(v)) fail("must be finite");
+    return v;
+  }
+  int integer() const {
+    if (!m_j.is_number_integer()) fail("must be an integer");
+    return m_j.get<int>();
+  }
+  bool boolean() const {
+    if (!m_j.is_boolean()) fail("must be true or false");
+    return m_j.get<bool>();
+  }
+  std::string string() const {
+    if (!m_j.is_string()) fail("must be a string");
+    return m_j.get<std::string>();
+  }
+  Eigen::Vector3d vec3() const {
+    if (!m_j.is_array() || m_j.size() != 3) fail("must be an array of 3 numbers");
+    return {(*this)[0].number(), (*this)[1].number(), (*this)[2].number()};
+  }
+  Eigen::Vector3i index3() const {
+    if (!m_j.is_array() || m_j.size() != 3) fail("must be an array of 3 integers");
+    return {(*this)[0].integer(), (*this)[1].integer(), (*this)[2].integer()};
+  }
+
+ private:
+  std::string join(const std::string& key) const { return m_path.empty() ? key : m_path + "." + key; }
+  const json& m_j;
+  std::string m_path;
+  const std::string& m_source;
+};
+
+// anchor: {"body": i, "local": [x,y,z]} or {"nodes": [a(,b,c)], "weights": [wa(,wb,wc)]}
+void readAnchor(const Reader& r, AnchorSet& out) {
+  if (r.has("body")) {
+    out.addBodyPoint(r.at("body").integer(), r.at("local").vec3());
+    return;
+  }
+  const Reader nodes = r.at("nodes");
+  const Reader weights = r.at("weights");
+  const std::size_t n = nodes.size();
+  if (n < 1 || n > 3) nodes.fail("must list 1 to 3 node indices");
+  if (weights.size() != n) weights.fail("must have as many entries as nodes (" + std::to_string(n) + ")");
+  Eigen::Vector3i idx(-1, -1, -1);
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < n; ++k) {
+    idx[static_cast<int>(k)] = nodes[k].integer();
+    w[static_cast<int>(k)] = weights[k].number();
+  }
+  out.addNodePoint(idx, w);
+}
+
+json writeAnchor(const AnchorSet& a, int i) {
+  json j;
+  if (a.body[static_cast<std::size_t>(i)] >= 0) {
+    j["body"] = a.body[static_cast<std::size_t>(i)];
+    j["local"] = {a.local(0, i), a.local(1, i), a.local(2, i)};
+    return j;
+  }
+  json nodes = json::array(), weights = json::array();
+  for (int k = 0; k < 3; ++k) {
+    if (a.nodes(k, i) < 0) continue;
+    nodes.push_back(a.nodes(k, i));
+    weights.push_back(a.weights(k, i));
+  }
+  j["nodes"] = nodes;
+  j["weights"] = weights;
+  return j;
+}
+
+json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// ---------------------------------------------------------------------------------------------
+// validation helpers
+
+[[noreturn]] void invalid(const std::string& field, const std::string& why) { throw Error(field + ": " + why); }
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void requirePositive(double v, const std::string& field) {
+  if (!std::isfinite(v) || v <= 0.0) invalid(field, "must be > 0, got " + num(v));
+}
+void requireNonNegative(double v, const std::string& field) {
+  if (!std::isfinite(v) || v < 0.0) invalid(field, "must be >= 0, got " + num(v));
+}
+void requireFinite(const Eigen::Vector3d& v, const std::string& field) {
+  if (!v.allFinite()) invalid(field, "must be finite");
+}
+
+void validateAnchors(const AnchorSet& a, const std::string& field, int nBodies, int nNodes) {
+  const int n = a.size();
+  if (a.local.cols() != n || a.nodes.cols() != n || a.weights.cols() != n)
+    invalid(field, "inconsistent anchor array sizes");
+  for (int i = 0; i < n; ++i) {
+    const std::string f = field + "[" + std::to_string(i) + "]";
+    const int b = a.body[static_cast<std::size_t>(i)];
+    if (b >= 0) {
+      if (b >= nBodies) invalid(f + ".body", "index " + std::to_string(b) + " out of range [0, " + std::to_string(nBodies) + ")");
+      requireFinite(a.local.col(i), f + ".local");
+      continue;
+    }
+    if (b != -1) invalid(f + ".body", "index " + std::to_string(b) + " out of range [0, " + std::to_string(nBodies) + ")");
+    double sum = 0.0;
+    int used = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int node = a.nodes(k, i);
+      if (node < 0) continue;
+      if (node >= nNodes) invalid(f + ".nodes", "index " + std::to_string(node) + " out of range [0, " + std::to_string(nNodes) + ")");
+      if (!std::isfinite(a.weights(k, i))) invalid(f + ".weights", "must be finite");
+      sum += a.weights(k, i);
+      ++used;
+    }
+    if (used == 0) invalid(f + ".nodes", "must list at least one node");
+    if (std::abs(sum - 1.0) > 1e-6) invalid(f + ".weights", "must sum to 1, got " + num(sum));
+  }
+}
+
+void validateTriangles(const Eigen::Matrix3Xi& t, const std::string& field, int nVertices) {
+  for (int i = 0; i < t.cols(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (t(k, i) < 0 || t(k, i) >= nVertices)
+        invalid(field + "[" + std::to_string(i) + "]",
+                "vertex index " + std::to_string(t(k, i)) + " out of range [0, " + std::to_string(nVertices) + ")");
+    }
+    if (t(0, i) == t(1, i) || t(1, i) == t(2, i) || t(0, i) == t(2, i))
+      invalid(field + "[" + std::to_string(i) + "]", "degenerate triangle (repeated vertex)");
+  }
+}
+
+// signed volume enclosed by a triangle mesh (divergence theorem) [m^3]
+double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& t) {
+  double v = 0.0;
+  for (int i = 0; i < t.cols(); ++i) v += x.col(t(0, i)).dot(x.col(t(1, i)).cross(x.col(t(2, i))));
+  return v / 6.0;
+}
+
+}  // namespace
+
+// =============================================================================================
+
+void validateModel(const Model& m) {
+  const int nB = m.bodies.size();
+  const int nN = m.nodes.size();
+
+  // bodies
+  if (nB == 0) invalid("bodies", "must not be empty");
+  if (static_cast<int>(m.bodies.isFixed.size()) != nB || m.bodies.mass.size() != nB || m.bodies.com.cols() != nB ||
+      static_cast<int>(m.bodies.inertia.size()) != nB || static_cast<int>(m.bodies.mesh.size()) != nB)
+    invalid("bodies", "inconsistent array sizes");
+  std::set<std::string> names;
+  for (int i = 0; i < nB; ++i) {
+    const std::string f = "bodies[" + std::to_string(i) + "]";
+    const std::string& name = m.bodies.name[static_cast<std::size_t>(i)];
+    if (name.empty()) invalid(f + ".name", "must not be empty");
+    if (!names.insert(name).second) invalid(f + ".name", "duplicate body name '" + name + "'");
+    requirePositive(m.bodies.mass[i], f + ".mass");
+    requireFinite(m.bodies.com.col(i), f + ".com");
+    const Eigen::Matrix3d& I = m.bodies.inertia[static_cast<std::size_t>(i)];
+    if (!I.allFinite() || (I - I.transpose()).norm() > 1e-9 * (1.0 + I.norm()))
+      invalid(f + ".inertia", "must be a finite symmetric 3x3 matrix");
+    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I).eigenvalues();
+    if (ev.minCoeff() <= 0.0) invalid(f + ".inertia", "must be positive definite, smallest eigenvalue " + num(ev.minCoeff()));
+  }
+  if (m.bodies.mesh.size() != m.bodies.name.size()) invalid("bodies", "inconsistent mesh list");
+
+  // joints
+  const int nJ = m.joints.size();
+  if (static_cast<int>(m.joints.name.size()) != nJ || static_cast<int>(m.joints.child.size()) != nJ ||
+      m.joints.anchor.cols() != nJ || m.joints.friction.size() != nJ || m.joints.stiffness.size() != nJ)
+    invalid("joints", "inconsistent array sizes");
+  for (int i = 0; i < nJ; ++i) {
+    const std::string f = "joints[" + std::to_string(i) + "]";
+    const int p = m.joints.parent[static_cast<std::size_t>(i)];
+    const int c = m.joints.child[static_cast<std::size_t>(i)];
+    if (p < 0 || p >= nB) invalid(f + ".parent", "body index " + std::to_string(p) + " out of range");
+    if (c < 0 || c >= nB) invalid(f + ".child", "body index " + std::to_string(c) + " out of range");
+    if (p == c) invalid(f + ".child", "must differ from parent");
+    if (m.bodies.isFixed[static_cast<std::size_t>(c)]) invalid(f + ".child", "must be a moving body");
+    requireFinite(m.joints.anchor.col(i), f + ".anchor");
+    requireNonNegative(m.joints.friction[i], f + ".friction");
+    requireNonNegative(m.joints.stiffness[i], f + ".stiffness");
+  }
+
+  // nodes and gut
+  if (m.nodes.mass.size() != nN || static_cast<int>(m.nodes.region.size()) != nN)
+    invalid("nodes", "inconsistent array sizes");
+  for (int i = 0; i < nN; ++i) {
+    const std::string f = "nodes[" + std::to_string(i) + "]";
+    requireFinite(m.nodes.rest.col(i), f + ".x");
+    if (m.nodes.isFixed(i)) requireNonNegative(m.nodes.mass[i], f + ".mass");
+    else requirePositive(m.nodes.mass[i], f + ".mass");
+  }
+  validateTriangles(m.gut.triangles, "gut.triangles", nN);
+  if (m.gut.triangles.cols() > 0) {
+    requirePositive(m.gut.kappa, "gut.kappa");
+    const double v0 = enclosedVolume(m.nodes.rest, m.gut.triangles);
+    if (v0 <= 0.0) invalid("gut.triangles", "enclosed rest volume must be > 0 (outward orientation), got " + num(v0) + " m^3");
+  }
+
+  // elements
+  const int nE = m.elements.size();
+  if (m.elements.endA.size() != nE || m.elements.endB.size() != nE || m.elements.restLength.size() != nE ||
+      m.elements.kac.size() != nE || m.elements.kpe.size() != nE || m.elements.damping.size() != nE)
+    invalid("elements", "inconsistent array sizes");
+  validateAnchors(m.elements.endA, "elements.a", nB, nN);
+  validateAnchors(m.elements.endB, "elements.b", nB, nN);
+  for (int i = 0; i < nE; ++i) {
+    const std::string f = "elements[" + std::to_string(i) + "]";
+    const int g = static_cast<int>(m.elements.group[static_cast<std::size_t>(i)]);
+    if (g < 0 || g >= kElementGroupCount) invalid(f + ".group", "unknown group " + std::to_string(g));
+    requirePositive(m.elements.restLength[i], f + ".rest_length");
+    requireNonNegative(m.elements.kac[i], f + ".kac");
+    requireNonNegative(m.elements.kpe[i], f + ".kpe");
+    requireNonNegative(m.elements.damping[i], f + ".damping");
+  }
+
+  // cavity
+  validateAnchors(m.cavity.vertices, "cavity.vertices", nB, nN);
+  validateTriangles(m.cavity.triangles, "cavity.triangles", m.cavity.vertices.size());
+
+  // landmarks
+  if (static_cast<int>(m.landmarks.name.size()) != m.landmarks.points.size())
+    invalid("landmarks", "inconsistent array sizes");
+  validateAnchors(m.landmarks.points, "landmarks", nB, nN);
+  for (const char* required : kRequiredLandmarks) {
+    if (m.landmarks.find(required) < 0) invalid("landmarks", std::string("missing required landmark '") + required + "'");
+  }
+
+  if (!m.gravity.allFinite()) invalid("gravity", "must be finite");
+}
+
+// =============================================================================================
+
+Model parseModel(const std::string& jsonText, const std::string& sourceName) {
+  json doc;
+  try {
+    doc = json::parse(jsonText);
+  } catch (const json::parse_error& e) {
+    throw Error(sourceName + ": not valid JSON (byte " + std::to_string(e.byte) + ")");
+  }
+  const Reader root(doc, "", sourceName);
+
+  // header
+  if (root.at("format").string() != kFormatName)
+    root.at("format").fail(std::string("must be \"") + kFormatName + "\"");
+  const int version = root.at("version").integer();
+  if (version != kModelFormatVersion)
+    root.at("version").fail("unsupported version " + std::to_string(version) + " (this build reads " +
+                            std::to_string(kModelFormatVersion) + ")");
+
+  Model m;
+  m.name = root.at("name").string();
+  m.anatomy = root.has("anatomy") ? root.at("anatomy").string() : std::string();
+  m.gravity = root.at("gravity").vec3();
+
+  // bodies
+  const Reader bodies = root.at("bodies");
+  const std::size_t nB = bodies.size();
+  m.bodies.mass.resize(static_cast<Eigen::Index>(nB));
+  m.bodies.com.resize(3, static_cast<Eigen::Index>(nB));
+  for (std::size_t i = 0; i < nB; ++i) {
+    const Reader b = bodies[i];
+    m.bodies.name.push_back(b.at("name").string());
+    m.bodies.isFixed.push_back(b.at("fixed").boolean() ? 1 : 0);
+    m.bodies.mass[static_cast<Eigen::Index>(i)] = b.at("mass").number();
+    m.bodies.com.col(static_cast<Eigen::Index>(i)) = b.at("com").vec3();
+    const Reader inertia = b.at("inertia");
+    if (inertia.size() != 3) inertia.fail("must be a 3x3 array");
+    Eigen::Matrix3d I;
+    for (std::size_t r = 0; r < 3; ++r) I.row(static_cast<Eigen::Index>(r)) = inertia[r].vec3().transpose();
+    m.bodies.inertia.push_back(I);
+    m.bodies.mesh.push_back(b.has("mesh") ? b.at("mesh").string() : std::string());
+  }
+
+  // joints
+  const Reader joints = root.at("joints");
+  const std::size_t nJ = joints.size();
+  m.joints.anchor.resize(3, static_cast<Eigen::Index>(nJ));
+  m.joints.friction.resize(static_cast<Eigen::Index>(nJ));
+  m.joints.stiffness.resize(static_cast<Eigen::Index>(nJ));
+  for (std::size_t i = 0; i < nJ; ++i) {
+    const Reader j = joints[i];
+    const auto k = static_cast<Eigen::Index>(i);
+    m.joints.name.push_back(j.at("name").string());
+    m.joints.parent.push_back(j.at("parent").integer());
+    m.joints.child.push_back(j.at("child").integer());
+    m.joints.anchor.col(k) = j.at("anchor").vec3();
+    m.joints.friction[k] = j.at("friction").number();
+    m.joints.stiffness[k] = j.at("stiffness").number();
+  }
+
+  // nodes
+  const Reader nodes = root.at("nodes");
+  const std::size_t nN = nodes.size();
+  m.nodes.rest.resize(3, static_cast<Eigen::Index>(nN));
+  m.nodes.mass.resize(static_cast<Eigen::Index>(nN));
+  for (std::size_t i = 0; i < nN; ++i) {
+    const Reader n = nodes[i];
+    m.nodes.rest.col(static_cast<Eigen::Index>(i)) = n.at("x").vec3();
+    m.nodes.mass[static_cast<Eigen::Index>(i)] = n.at("mass").number();
+    const std::string region = n.at("region").string();
+    if (region == "wall") m.nodes.region.push_back(NodeRegion::Wall);
+    else if (region == "diaphragm") m.nodes.region.push_back(NodeRegion::Diaphragm);
+    else if (region == "fixed") m.nodes.region.push_back(NodeRegion::Fixed);
+    else n.at("region").fail("unknown region '" + region + "' (expected wall, diaphragm or fixed)");
+  }
+
+  // gut
+  const Reader gut = root.at("gut");
+  m.gut.kappa = gut.at("kappa").number();
+  const Reader gutTris = gut.at("triangles");
+  m.gut.triangles.resize(3, static_cast<Eigen::Index>(gutTris.size()));
+  for (std::size_t i = 0; i < gutTris.size(); ++i) m.gut.triangles.col(static_cast<Eigen::Index>(i)) = gutTris[i].index3();
+
+  // elements
+  const Reader elements = root.at("elements");
+  const std::size_t nE = elements.size();
+  for (auto* v : {&m.elements.restLength, &m.elements.kac, &m.elements.kpe, &m.elements.damping})
+    v->resize(static_cast<Eigen::Index>(nE));
+  for (std::size_t i = 0; i < nE; ++i) {
+    const Reader e = elements[i];
+    const auto k = static_cast<Eigen::Index>(i);
+    ElementGroup g;
+    const std::string group = e.at("group").string();
+    if (!groupFromName(group, g)) e.at("group").fail("unknown group '" + group + "'");
+    m.elements.group.push_back(g);
+    readAnchor(e.at("a"), m.elements.endA);
+    readAnchor(e.at("b"), m.elements.endB);
+    m.elements.restLength[k] = e.at("rest_length").number();
+    m.elements.kac[k] = e.at("kac").number();
+    m.elements.kpe[k] = e.at("kpe").number();
+    m.elements.damping[k] = e.at("damping").number();
+  }
+
+  // cavity
+  const Reader cavity = root.at("cavity");
+  const Reader cavVerts = cavity.at("vertices");
+  for (std::size_t i = 0; i < cavVerts.size(); ++i) readAnchor(cavVerts[i], m.cavity.vertices);
+  const Reader cavTris = cavity.at("triangles");
+  m.cavity.triangles.resize(3, static_cast<Eigen::Index>(cavTris.size()));
+  for (std::size_t i = 0; i < cavTris.size(); ++i) m.cavity.triangles.col(static_cast<Eigen::Index>(i)) = cavTris[i].index3();
+
+  // landmarks
+  const Reader landmarks = root.at("landmarks");
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+    m.landmarks.name.push_back(landmarks[i].at("name").string());
+    readAnchor(landmarks[i], m.landmarks.points);
+  }
+
+  // semantic checks; their messages name the model field
+  try {
+    validateModel(m);
+  } catch (const Error& e) {
+    throw Error(sourceName + ": " + e.what());
+  }
+  return m;
+}
+
+Model loadModel(const std::string& dir) {
+  const std::string path = dir + "/model.json";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open (is '" + dir + "' a model directory?)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseModel(text.str(), path);
+}
+
+std::string serializeModel(const Model& m) {
+  validateModel(m);
+  json doc;
+  doc["format"] = kFormatName;
+  doc["version"] = kModelFormatVersion;
+  doc["name"] = m.name;
+  doc["anatomy"] = m.anatomy;
+  doc["units"] = {{"length", "m"},          {"mass", "kg"},        {"time", "s"},
+                  {"force", "N"},           {"pressure", "Pa"},    {"inertia", "kg m^2"},
+                  {"stiffness", "N/m"},     {"damping", "N s/m"},  {"joint_friction", "N m s/rad"},
+                  {"joint_stiffness", "N m/rad"}, {"angle", "rad"}};
+  doc["frame"] = "RAS: +x subject's right, +y anterior, +z superior; body frames at the centre of mass, "
+                 "axes parallel to the world at rest";
+  doc["gravity"] = vec(m.gravity);
+
+  json bodies = json::array();
+  for (int i = 0; i < m.bodies.size(); ++i) {
+    const Eigen::Matrix3d& I = m.bodies.inertia[static_cast<std::size_t>(i)];
+    json b;
+    b["name"] = m.bodies.name[static_cast<std::size_t>(i)];
+    b["fixed"] = m.bodies.isFixed[static_cast<std::size_t>(i)] != 0;
+    b["mass"] = m.bodies.mass[i];
+    b["com"] = vec(m.bodies.com.col(i));
+    b["inertia"] = {vec(I.row(0).transpose()), vec(I.row(1).transpose()), vec(I.row(2).transpose())};
+    b["mesh"] = m.bodies.mesh[static_cast<std::size_t>(i)];
+    bodies.push_back(std::move(b));
+  }
+  doc["bodies"] = std::move(bodies);
+
+  json joints = json::array();
+  for (int i = 0; i < m.joints.size(); ++i) {
+    joints.push_back({{"name", m.joints.name[static_cast<std::size_t>(i)]},
+                      {"parent", m.joints.parent[static_cast<std::size_t>(i)]},
+                      {"child", m.joints.child[static_cast<std::size_t>(i)]},
+                      {"anchor", vec(m.joints.anchor.col(i))},
+                      {"friction", m.joints.friction[i]},
+                      {"stiffness", m.joints.stiffness[i]}});
+  }
+  doc["joints"] = std::move(joints);
+
+  json nodes = json::array();
+  for (int i = 0; i < m.nodes.size(); ++i) {
+    nodes.push_back({{"x", vec(m.nodes.rest.col(i))},
+                     {"mass", m.nodes.mass[i]},
+                     {"region", regionName(m.nodes.region[static_cast<std::size_t>(i)])}});
+  }
+  doc["nodes"] = std::move(nodes);
+
+  auto triangles = [](const Eigen::Matrix3Xi& t) {
+    json a = json::array();
+    for (int i = 0; i < t.cols(); ++i) a.push_back({t(0, i), t(1, i), t(2, i)});
+    return a;
+  };
+  doc["gut"] = {{"kappa", m.gut.kappa}, {"triangles", triangles(m.gut.triangles)}};
+
+  json elements = json::array();
+  for (int i = 0; i < m.elements.size(); ++i) {
+    elements.push_back({{"group", groupName(m.elements.group[static_cast<std::size_t>(i)])},
+                        {"a", writeAnchor(m.elements.endA, i)},
+                        {"b", writeAnchor(m.elements.endB, i)},
+                        {"rest_length", m.elements.restLength[i]},
+                        {"kac", m.elements.kac[i]},
+                        {"kpe", m.elements.kpe[i]},
+                        {"damping", m.elements.damping[i]}});
+  }
+  doc["elements"] = std::move(elements);
+
+  json cavVerts = json::array();
+  for (int i = 0; i < m.cavity.vertices.size(); ++i) cavVerts.push_back(writeAnchor(m.cavity.vertices, i));
+  doc["cavity"] = {{"vertices", std::move(cavVerts)}, {"triangles", triangles(m.cavity.triangles)}};
+
+  json landmarks = json::array();
+  for (int i = 0; i < m.landmarks.points.size(); ++i) {
+    json l = writeAnchor(m.landmarks.points, i);
+    l["name"] = m.landmarks.name[static_cast<std::size_t>(i)];
+    landmarks.push_back(std::move(l));
+  }
+  doc["landmarks"] = std::move(landmarks);
+
+  return doc.dump(1) + "\n";
+}
+
+void saveModel(const Model& m, const std::string& dir) {
+  const std::string text = serializeModel(m);
+  const std::string path = dir + "/model.json";
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(path + ": cannot write (is '" + dir + "' a writable directory?)");
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw Error(path + ": write failed (disk full?)");
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw Error(path + ": cannot rename temporary file into place");
+  }
+}
+
+}  // namespace pneuma::sim
