@@ -21,5 +21,6 @@ function(pneuma_add_gtest name)
     PNEUMA_DEFAULT_MODEL_DIR="${PNEUMA_DEFAULT_MODEL_DIR}"
     PNEUMA_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
   pneuma_target_defaults(${name})
-  gtest_discover_tests(${name} PROPERTIES LABELS ${T_LABEL} DISCOVERY_TIMEOUT 60)
+  # discover at test time, so GUI suites are listed under the same xvfb-run as they run
+  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST PROPERTIES LABELS ${T_LABEL} DISCOVERY_TIMEOUT 60)
 endfunction()
