@@ -1,0 +1,30 @@
+#pragma once
+/// @file Controller.h
+/// Muscle activation control (Zordan et al. 2004, Section 7): every muscle group gets a contraction
+/// ratio r(t) and an activation alpha(t) that enter the muscle law, Eq. 2:
+///   F = min[-alpha kac (l - r l0) - kpe (l - l0) - b dl/dt, 0].
+
+#include "pneuma/sim/Activation.h"
+#include "pneuma/sim/Metrics.h"
+
+#include <memory>
+#include <string>
+
+namespace pneuma::sim {
+
+/// A source of muscle activations. Simulation calls activations() once per step with the control
+/// time and the most recent output-frame metrics (feedback controllers read `latest.lungVolume`).
+/// Implementations must be deterministic: the same call sequence gives the same outputs.
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  /// Activations at control time `t` [s] (0 = first instant after the settling phase).
+  /// @param latest metrics of the latest output frame (lungVolume [m^3] etc.); zeros before the first frame.
+  virtual Activations activations(double t, const Metrics& latest) = 0;
+  /// One-line human-readable description, e.g. "breath style 'calm' (15 b/m)".
+  virtual std::string describe() const = 0;
+  /// A deep copy with the same parameters and internal state.
+  virtual std::unique_ptr<Controller> clone() const = 0;
+};
+
+}  // namespace pneuma::sim

@@ -1,0 +1,60 @@
+#pragma once
+/// @file Elements.h
+/// Element kernels: small pure functions of one spring element or of the gut surface, testable alone
+/// (in the manner of PositionBasedDynamics' XPBD.h). Sign convention: a scalar element force F < 0
+/// pulls the endpoints together (tension); the force on endpoint A is -F d and on B is +F d, with
+/// d = (xB - xA) / l the unit direction from A to B.
+
+#include <Eigen/Core>
+
+namespace pneuma::sim {
+
+/// Parameters of one muscle element under a given activation (Eq. 2).
+struct MuscleParams {
+  double restLength = 0.0;  ///< [m] l0 > 0
+  double kac = 0.0;         ///< [N/m] active gain
+  double kpe = 0.0;         ///< [N/m] passive gain
+  double damping = 0.0;     ///< [N s/m] b
+  double alpha = 0.0;       ///< [-] activation in [0, 1]
+  double r = 1.0;           ///< [-] contraction ratio
+};
+
+/// Muscle force, Zordan et al. 2004 Eq. 2:
+///   F = min[-alpha kac (l - r l0) - kpe (l - l0) - b ldot, 0]            [N]
+/// Tension only; the damping term may be "virtually positive" (resist shortening) as long as the
+/// total stays <= 0. @param l length [m], @param ldot lengthening rate [m/s].
+double muscleForce(double l, double ldot, const MuscleParams& p);
+
+/// Slack length [m] of a muscle: the length at which its elastic part, -alpha kac (l - r l0) - kpe (l - l0),
+/// is zero: l_s = (alpha kac r + kpe) l0 / (alpha kac + kpe); l0 when alpha kac + kpe = 0.
+double muscleSlackLength(const MuscleParams& p);
+
+/// Elastic energy [J] of a muscle (the potential of Eq. 2 without damping): 1/2 (alpha kac + kpe) (l - l_s)^2
+/// for l > l_s, else 0.
+double muscleEnergy(double l, const MuscleParams& p);
+
+/// Structural (cartilage) spring force, two-sided and damped: F = -k (l - l0) - b ldot   [N].
+double springForce(double l, double ldot, double restLength, double k, double damping);
+
+/// Elastic energy [J] of a structural spring: 1/2 k (l - l0)^2.
+double springEnergy(double l, double restLength, double k);
+
+/// Volume [m^3] enclosed by a closed triangle surface with outward normals: the sum over faces of the
+/// signed tetrahedra from the vertex centroid c to each face (Section 6.2),
+///   V = sum_f (a - c) . ((b - c) x (e - c)) / 6.
+/// @param x  3 x #V vertex positions [m];  @param triangles 3 x #F vertex indices.
+double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles);
+
+/// Gut pressure, Eq. 4: P = kappa (V0 / V - 1) [Pa], with kappa [Pa], V0 and V [m^3].
+double gutPressure(double kappa, double restVolume, double volume);
+
+/// Elastic energy [J] stored by the gut pressure: the potential whose negative gradient is the
+/// max(0, P) face force of Eq. 5,  E = kappa (V - V0 - V0 ln(V / V0)) for V < V0, else 0.
+double gutEnergy(double kappa, double restVolume, double volume);
+
+/// Adds the pressure forces of Eq. 5 to `force` (3 x #V, not cleared): every face i adds
+/// max(0, P) A_i n_i / 3 [N] to each of its three vertices. This equals max(0, P) dV/dx.
+void addPressureForces(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, double pressure,
+                       Eigen::Matrix3Xd& force);
+
+}  // namespace pneuma::sim

@@ -1,0 +1,77 @@
+#pragma once
+/// @file Metrics.h
+/// Per-frame measurements of a running simulation and the Summary over a run.
+/// Everything is SI ([m^3], [N], [J], [m], [Pa]); convert to mL, mm or cmH2O only at the edges.
+
+#include "pneuma/sim/Activation.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pneuma::sim {
+
+/// Measurements at one output frame.
+struct Metrics {
+  double time = 0.0;              ///< [s] simulated time of the frame
+  double lungVolume = 0.0;        ///< [m^3] volume enclosed by the bound lung-cavity surface (Figure 6)
+  double gutVolume = 0.0;         ///< [m^3] gut volume V (sum of centroid -> face tetrahedra, Section 6.2)
+  double gutVolumeError = 0.0;    ///< [-] signed relative error (V - V0) / V0
+  double gutPressure = 0.0;       ///< [Pa] P = kappa (V0/V - 1), Eq. 4 (before clamping at 0)
+  Eigen::VectorXd elementForce;   ///< [N] signed scalar force per element, <= 0 is tension (#E)
+  std::vector<std::uint8_t> isSlack;  ///< 1 when a muscle element carries no force (#E)
+  std::array<double, kElementGroupCount> groupTension{};  ///< [N] sum of max(0, -F) over each group
+  Activations activations{};      ///< control input in effect at this frame
+  double kineticEnergy = 0.0;     ///< [J] sum of 1/2 m v^2 + 1/2 w^T I w over bodies and nodes
+  double elasticEnergy = 0.0;     ///< [J] springs (one-sided muscles, two-sided cartilage), gut pressure, spine joints
+  double gravityEnergy = 0.0;     ///< [J] m g . x summed, relative to the rest pose (0 when gravity is off)
+  double maxJointError = 0.0;     ///< [m] largest ball-joint separation after the step
+  Eigen::Matrix3Xd landmarks;     ///< [m] landmark positions, world, in Model::landmarks order (3 x #L)
+};
+
+/// Light per-frame series kept over a whole run for the Summary and the plots.
+struct Trace {
+  std::vector<double> time;            ///< [s]
+  std::vector<double> lungVolume;      ///< [m^3]
+  std::vector<double> gutVolumeError;  ///< [-] signed
+  std::vector<Eigen::Matrix3Xd> landmarks;  ///< [m] (3 x #L) per frame
+
+  /// Appends the scalar parts of one frame.
+  void append(const Metrics& m);
+  std::size_t size() const { return time.size(); }
+  void clear();
+};
+
+/// Figures over a run, measured after the settling phase.
+struct Summary {
+  double tidalVolume = 0.0;            ///< [m^3] peak-to-peak lung volume, averaged over full cycles
+  double breathsPerMinute = 0.0;       ///< [1/min] from the period of the volume signal (0 if < 2 cycles)
+  double endExpiratoryVolume = 0.0;    ///< [m^3] mean of the per-cycle minima (the run's minimum if < 1 cycle)
+  double endInspiratoryVolume = 0.0;   ///< [m^3] mean of the per-cycle maxima (the run's maximum if < 1 cycle)
+  int cycles = 0;                      ///< [-] number of full cycles found
+  double maxGutVolumeError = 0.0;      ///< [-] max |(V - V0)/V0|
+  double meanGutVolumeError = 0.0;     ///< [-] mean |(V - V0)/V0|
+  double diaphragmApexExcursion = 0.0; ///< [m] largest displacement range of the landmark (see landmarkExcursion)
+  double xiphoidExcursion = 0.0;       ///< [m]
+  double umbilicusExcursion = 0.0;     ///< [m]
+  double realTimeFactor = 0.0;         ///< [-] simulated seconds per wall-clock second (stepping only)
+  long long steps = 0;                 ///< [-] steps taken in the whole run, settling included
+  double dt = 0.0;                     ///< [s] time step
+  double measuredFrom = 0.0;           ///< [s] start of the analysed window (end of settling)
+};
+
+/// Analyses `trace` from time `from` [s] on: cycles are delimited by successive upward crossings of
+/// the mean lung volume (with a hysteresis of 10 % of the range); tidal volume is the mean
+/// per-cycle peak-to-peak, the rate is 60 / mean period. Excursions are
+/// landmarkExcursion() of "diaphragm_apex", "xiphoid" and "umbilicus" (0 when a name is missing).
+/// Fills the volume, rate, gut-error and excursion fields; the caller sets rtf, steps and dt.
+Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from);
+
+/// Excursion [m] of landmark `index` over frames with time >= `from`: the length of the range
+/// (max - min) along the axis of largest range, i.e. max over x, y, z of (max - min) of that coordinate.
+double landmarkExcursion(const Trace& trace, int index, double from);
+
+}  // namespace pneuma::sim

@@ -1,0 +1,51 @@
+#pragma once
+/// @file Recorder.h
+/// Compact in-memory recording of states at the output rate, with random access, for timeline
+/// scrubbing. Poses and forces are stored as float (half the memory of double, ample for display);
+/// a bounded capacity keeps the most recent frames.
+
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/State.h"
+
+#include <cstddef>
+#include <deque>
+#include <vector>
+
+namespace pneuma::sim {
+
+/// One recorded output frame.
+struct RecordedFrame {
+  double time = 0.0;                 ///< [s]
+  std::vector<float> bodyPose;       ///< per body: x, y, z [m], then qw, qx, qy, qz [-]   (7 #B)
+  std::vector<float> nodePosition;   ///< [m] per node x, y, z                             (3 #N)
+  std::vector<float> elementForce;   ///< [N] signed scalar force per element              (#E)
+  double lungVolume = 0.0;           ///< [m^3]
+  double gutVolumeError = 0.0;       ///< [-]
+};
+
+class Recorder {
+ public:
+  /// @param capacity maximum number of frames kept (oldest dropped first); 0 = unlimited.
+  explicit Recorder(std::size_t capacity = 0) : m_capacity(capacity) {}
+
+  /// Appends a frame made from `state` and `metrics`.
+  void record(const State& state, const Metrics& metrics);
+  /// Number of frames held.
+  std::size_t size() const { return m_frames.size(); }
+  bool empty() const { return m_frames.empty(); }
+  /// Frame `i`, 0 = oldest held.
+  const RecordedFrame& frame(std::size_t i) const { return m_frames.at(i); }
+  /// Index of the frame nearest to `time` [s]; 0 when empty.
+  std::size_t indexAt(double time) const;
+  /// Writes frame `i`'s positions and orientations into `state` (resized to match), with zero
+  /// velocities and state.time = frame time. For display only: resuming from it is not bit-exact.
+  void restore(std::size_t i, State& state) const;
+  void clear() { m_frames.clear(); }
+  std::size_t capacity() const { return m_capacity; }
+
+ private:
+  std::size_t m_capacity;
+  std::deque<RecordedFrame> m_frames;
+};
+
+}  // namespace pneuma::sim

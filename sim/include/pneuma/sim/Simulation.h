@@ -1,0 +1,94 @@
+#pragma once
+/// @file Simulation.h
+/// The Qt-free "logic layer" that both pneuma-cli and the desktop app drive (3D Slicer's Logic,
+/// MuJoCo's simulate without the window): owns the model, the state, the controller and the options,
+/// steps, measures at the output rate, records, and stops with an Error on a blow-up.
+///
+/// Time line: t in [0, settleTime) is the settling phase (gravity and passive forces find their
+/// equilibrium; the controller is asked for activations(0, ...), the start-of-cycle posture). From
+/// t = settleTime on, the controller runs with control time t - settleTime. Summary figures are
+/// measured from settleTime on.
+
+#include "pneuma/sim/Controller.h"
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Model.h"
+#include "pneuma/sim/Recorder.h"
+#include "pneuma/sim/State.h"
+#include "pneuma/sim/Step.h"
+
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace pneuma::sim {
+
+/// Run settings (validated by validateSimulationOptions()).
+struct SimulationOptions {
+  StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
+  double dt = 0.0;              ///< [s] time step; 0 = defaultTimeStep(step.integrator)
+  double settleTime = 2.0;      ///< [s] settling phase before the controller starts, >= 0
+  double outputRate = 60.0;     ///< [Hz] metrics and recording rate, > 0
+  double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
+};
+
+/// @throws Error naming the field: dt < 0 or not finite, settleTime < 0, outputRate <= 0, bad step options.
+void validateSimulationOptions(const SimulationOptions& o);
+
+class Simulation {
+ public:
+  /// Validates the model (masses, gains >= 0), the controller's first activations and the options.
+  /// @throws Error naming the field and value before anything runs.
+  Simulation(std::shared_ptr<const Model> model, std::unique_ptr<Controller> controller,
+             SimulationOptions options = {});
+
+  /// Back to the rest pose at t = 0; clears the trace and the recorder; keeps model, controller and options.
+  void reset();
+  /// Replaces the controller (takes effect at the next step; the controller keeps the run's clock).
+  void setController(std::unique_ptr<Controller> controller);
+  /// Replaces the options (validated). Changing dt or the integrator mid-run is allowed.
+  void setOptions(const SimulationOptions& options);
+
+  /// Steps until `duration` [s] more has been simulated, computing metrics and recording at the
+  /// output rate. `onFrame` (optional) is called after every output frame; return false to stop early.
+  /// @throws Error on NaN/Inf or blow-up, naming the time, the element/body/node and a likely cause.
+  void advance(double duration, const std::function<bool(const Simulation&)>& onFrame = {});
+  /// One step of dt (metrics are computed if an output frame falls due).
+  void stepOnce();
+
+  const Model& model() const { return *m_model; }
+  const State& state() const { return m_state; }
+  const SimulationOptions& options() const { return m_options; }
+  const Controller& controller() const { return *m_controller; }
+  /// Time step in use [s].
+  double dt() const { return m_dt; }
+  /// Metrics of the latest output frame.
+  const Metrics& latestMetrics() const { return m_latest; }
+  /// Activations applied in the latest step.
+  const Activations& currentActivations() const { return m_activations; }
+  const Trace& trace() const { return m_trace; }
+  const Recorder& recorder() const { return m_recorder; }
+  /// Summary over the run so far (see summarize()), with real-time factor, steps and dt.
+  Summary summary() const;
+  /// [-] simulated seconds per wall-clock second spent inside advance()/stepOnce().
+  double realTimeFactor() const;
+
+ private:
+  void stepInternal();
+  void emitFrame();
+
+  std::shared_ptr<const Model> m_model;
+  std::unique_ptr<Controller> m_controller;
+  SimulationOptions m_options;
+  double m_dt = 0.0;            // [s]
+  State m_state;
+  StepWork m_work;
+  Activations m_activations{};
+  Metrics m_latest;
+  Trace m_trace;
+  Recorder m_recorder;
+  double m_nextFrameTime = 0.0; // [s]
+  double m_wallSeconds = 0.0;   // [s] wall-clock time spent stepping
+  double m_simulatedSeconds = 0.0;  // [s] simulated while timed
+};
+
+}  // namespace pneuma::sim

@@ -1,0 +1,107 @@
+#pragma once
+/// @file Step.h
+/// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step):
+///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3),
+///                  passive spine stiffness, gravity
+///   2. integrate   velocities and positions with the chosen integrator
+///   3. joints      ball-joint constraints: velocity impulses, then position projection (error < 0.1 mm)
+/// Metrics are computed separately, at the output rate (computeMetrics()).
+///
+/// Integrators
+/// - SymplecticEuler: the paper's reference scheme (Section 6.1), v += F/m dt, then x += v dt, for
+///   nodes and bodies (quaternions integrated with the new angular velocity). Explicit, so dt is
+///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max).
+/// - ImplicitEuler: linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH 1998) over all
+///   node and body velocities, solving (M + dt D + dt^2 K) dv = dt (f - dt K v) with a matrix-free,
+///   Jacobi-preconditioned conjugate gradient. K holds the element stiffness along and across each
+///   taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
+///   joint springs; D holds element damping and joint friction. Why this one: the stiff parts of the
+///   model (cartilage, the gut's near-incompressibility kappa, joint friction on light ribs) are
+///   linear or nearly so, so backward Euler removes their step limit at the cost of a few CG passes
+///   that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so its numerical
+///   damping of high frequencies is harmless, while a position-based (XPBD) scheme would not follow
+///   the paper's force laws (Eq. 2, 4, 5) as directly.
+
+#include "pneuma/sim/Activation.h"
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Model.h"
+#include "pneuma/sim/State.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace pneuma::sim {
+
+/// Time integration scheme.
+enum class IntegratorKind { SymplecticEuler, ImplicitEuler };
+
+/// "symplectic-euler" or "implicit-euler".
+const char* integratorName(IntegratorKind k);
+/// Inverse of integratorName(); returns false when unknown.
+bool integratorFromName(const std::string& name, IntegratorKind& out);
+/// Default time step [s] of each integrator: stable on the default model (see the validation tests).
+double defaultTimeStep(IntegratorKind k);
+
+/// Per-run physical switches and solver settings.
+struct StepOptions {
+  IntegratorKind integrator = IntegratorKind::ImplicitEuler;
+  bool gravity = true;                ///< apply Model::gravity to bodies and nodes
+  double jointFrictionScale = 1.0;    ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
+  double kappa = -1.0;                ///< [Pa] gut bulk modulus of Eq. 4; < 0 uses Model::gut.kappa
+  std::array<double, kElementGroupCount> activeGainScale{1, 1, 1, 1, 1, 1};   ///< [-] multiplies kac per group
+  std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kpe and b per group
+  int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
+  double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
+  int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
+  double cgTolerance = 1e-7;          ///< [-] implicit Euler: relative residual of the CG solve
+};
+
+/// Checks the options (finite, non-negative scales, kappa, iteration counts).
+/// @throws Error naming the field and value.
+void validateStepOptions(const StepOptions& o);
+
+/// Preallocated scratch memory of step() (no allocation per step) and the by-products of the last
+/// step that metrics need. Make one per (Model, State) pair with makeStepWork().
+struct StepWork {
+  double restGutVolume = 0.0;          ///< [m^3] V0, gut volume at the rest pose
+  double gutVolume = 0.0;              ///< [m^3] V at the start of the last step
+  double gutPressure = 0.0;            ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
+  Eigen::VectorXd elementForce;        ///< [N] scalar force per element of the last step (#E)
+  Eigen::VectorXd elementLength;       ///< [m] (#E)
+  Eigen::Matrix3Xd elementDirection;   ///< [-] unit A->B direction (3 x #E)
+  Eigen::Matrix3Xd pointA, pointB;     ///< [m] endpoint positions (3 x #E)
+  Eigen::VectorXd elementStiffness;    ///< [N/m] dF/dl magnitude used by the implicit solve (#E)
+  Eigen::VectorXd elementDamping;      ///< [N s/m] b of taut elements, 0 when slack (#E)
+  std::vector<Eigen::Matrix3d> rotation;  ///< [-] body rotation matrices (#B)
+  std::vector<Eigen::Matrix3d> inverseInertiaWorld;  ///< [1/(kg m^2)] R I^-1 R^T, zero for fixed bodies (#B)
+  Eigen::Matrix3Xd bodyForce, bodyTorque;  ///< [N], [N m] world (3 x #B)
+  Eigen::Matrix3Xd nodeForce;          ///< [N] (3 x #N)
+  Eigen::Matrix3Xd gutGradient;        ///< [m^2] dV/dx per node (3 x #N)
+  Eigen::Matrix3Xd gutPositions;       ///< [m] scratch copy of node positions for the volume (3 x #N)
+  double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
+  int cgIterations = 0;                ///< [-] CG iterations of the last implicit step
+  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB;  ///< implicit solver vectors (6 #B + 3 #N)
+};
+
+/// Allocates the scratch memory for `model` and computes its rest gut volume.
+StepWork makeStepWork(const Model& model);
+
+/// Advances `state` by `dt` [s] under activations `act` (forces -> integrate -> joints).
+/// Does not check for blow-ups (Simulation does) and does not compute metrics.
+void step(const Model& model, State& state, double dt, const Activations& act, const StepOptions& options,
+          StepWork& work);
+
+/// Metrics of `state` (lung and gut volume, element forces of the last step, energies, landmarks).
+/// Element forces come from `work` (the last step); call after step().
+void computeMetrics(const Model& model, const State& state, const Activations& act, const StepOptions& options,
+                    const StepWork& work, Metrics& out);
+
+/// Checks `state` for NaN/Inf and blow-up (speeds above 100 m/s, joint error above 1 cm).
+/// @throws Error naming the time, the body / node / element and a likely cause, e.g.
+///   "simulation blew up at t = 1.234 s: node 17 speed 3.2e4 m/s (likely cause: dt too large for stiffness)".
+void checkState(const Model& model, const State& state, const StepWork& work, double dt);
+
+}  // namespace pneuma::sim
