@@ -52,9 +52,11 @@ double gutPressure(double kappa, double restVolume, double volume);
 /// max(0, P) face force of Eq. 5,  E = kappa (V - V0 - V0 ln(V / V0)) for V < V0, else 0.
 double gutEnergy(double kappa, double restVolume, double volume);
 
-/// Adds the pressure forces of Eq. 5 to `force` (3 x #V, not cleared): every face i adds
-/// max(0, P) A_i n_i / 3 [N] to each of its three vertices. This equals max(0, P) dV/dx.
-void addPressureForces(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, double pressure,
-                       Eigen::Matrix3Xd& force);
+/// Adds `scale` times the volume gradient dV/dx to `out` (3 x #V, not cleared): every face i adds
+/// scale A_i n_i / 3 to each of its three vertices (A_i n_i = (b - a) x (e - a) / 2). On a closed
+/// surface this is the exact gradient of enclosedVolume(). With scale = max(0, P) it is the gut
+/// pressure force of Eq. 5 [N]; with scale = 1 it is dV/dx [m^2].
+void addVolumeGradient(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, double scale,
+                       Eigen::Matrix3Xd& out);
 
 }  // namespace pneuma::sim

@@ -42,6 +42,8 @@ class Recorder {
   void restore(std::size_t i, State& state) const;
   void clear() { m_frames.clear(); }
   std::size_t capacity() const { return m_capacity; }
+  /// Changes the capacity (0 = unlimited), dropping the oldest frames beyond it.
+  void setCapacity(std::size_t capacity);
 
  private:
   std::size_t m_capacity;

@@ -73,7 +73,9 @@ class Simulation {
   double realTimeFactor() const;
 
  private:
-  void stepInternal();
+  // one timed step (control, physics, blow-up check); true when an output frame was emitted
+  bool timedStep();
+  // metrics, trace and recorder for the current state
   void emitFrame();
 
   std::shared_ptr<const Model> m_model;

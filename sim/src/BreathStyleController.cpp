@@ -1,0 +1,160 @@
+#include "pneuma/sim/BreathStyleController.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace pneuma::sim {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void requireRange(const std::string& field, double v, double lo, double hi, bool openLow) {
+  const bool ok = std::isfinite(v) && (openLow ? v > lo : v >= lo) && v <= hi;
+  if (!ok) {
+    std::ostringstream os;
+    os << field << ": must be in " << (openLow ? "(" : "[") << lo << ", " << hi << "], got " << v;
+    throw Error(os.str());
+  }
+}
+
+GroupActivation& slot(Activations& a, ElementGroup g) { return a[static_cast<std::size_t>(g)]; }
+
+}  // namespace
+
+void validateBreathStyle(const BreathStyle& s) {
+  const std::string p = "breath style '" + s.name + "': ";
+  if (!std::isfinite(s.breathsPerMinute) || s.breathsPerMinute <= 0.0 || s.breathsPerMinute > 600.0)
+    requireRange(p + "breaths_per_minute", s.breathsPerMinute, 0.0, 600.0, true);
+  requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
+  requireRange(p + "diaphragm_r", s.diaphragmR, 0.0, 1.5, true);
+  requireRange(p + "intercostal_amplitude", s.intercostalAmplitude, 0.0, 1.5, false);
+  requireRange(p + "intercostal_mean - intercostal_amplitude", s.intercostalMean - s.intercostalAmplitude, 0.0, 1.5,
+               true);
+  requireRange(p + "intercostal_mean + intercostal_amplitude", s.intercostalMean + s.intercostalAmplitude, 0.0, 1.5,
+               true);
+  requireRange(p + "rectus_r", s.rectusR, 0.0, 1.5, true);
+  if (s.cycles < 0) throw Error(p + "cycles: must be >= 0, got " + std::to_string(s.cycles));
+}
+
+BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& source) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(jsonText);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(source + ": not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw Error(source + ": expected a JSON object");
+  BreathStyle s;
+  auto number = [&](const char* key, double& out, bool required) {
+    if (!j.contains(key)) {
+      if (required) throw Error(source + ": " + key + ": missing");
+      return;
+    }
+    if (!j[key].is_number()) throw Error(source + ": " + key + ": must be a number");
+    out = j[key].get<double>();
+  };
+  try {
+    if (!j.contains("name") || !j["name"].is_string()) throw Error(source + ": name: missing or not a string");
+    s.name = j["name"].get<std::string>();
+    if (j.contains("note")) s.note = j["note"].get<std::string>();
+    number("breaths_per_minute", s.breathsPerMinute, true);
+    number("inhale_fraction", s.inhaleFraction, false);
+    number("diaphragm_r", s.diaphragmR, true);
+    number("intercostal_mean", s.intercostalMean, true);
+    number("intercostal_amplitude", s.intercostalAmplitude, true);
+    number("rectus_r", s.rectusR, false);
+    if (j.contains("rectus_active")) {
+      if (!j["rectus_active"].is_boolean()) throw Error(source + ": rectus_active: must be true or false");
+      s.rectusActive = j["rectus_active"].get<bool>();
+    }
+    if (j.contains("cycles")) {
+      if (!j["cycles"].is_number_integer()) throw Error(source + ": cycles: must be an integer");
+      s.cycles = j["cycles"].get<int>();
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(source + ": " + e.what());
+  }
+  try {
+    validateBreathStyle(s);
+  } catch (const Error& e) {
+    throw Error(source + ": " + e.what());
+  }
+  return s;
+}
+
+std::string defaultPresetDir() {
+  if (const char* env = std::getenv("PNEUMA_RESOURCE_DIR"); env != nullptr && *env != '\0')
+    return std::string(env) + "/presets";
+  return PNEUMA_SIM_PRESET_DIR;
+}
+
+std::vector<std::string> breathStyleNames(const std::string& presetDir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(presetDir, ec)) {
+    if (entry.is_regular_file() && entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+BreathStyle loadBreathStyle(const std::string& nameOrPath, const std::string& presetDir) {
+  const bool isPath = nameOrPath.size() > 5 && nameOrPath.substr(nameOrPath.size() - 5) == ".json";
+  const std::string path = isPath ? nameOrPath : presetDir + "/" + nameOrPath + ".json";
+  std::ifstream in(path);
+  if (!in) {
+    if (isPath) throw Error("breath style file '" + path + "': cannot be read");
+    std::string valid;
+    for (const std::string& n : breathStyleNames(presetDir)) valid += (valid.empty() ? "" : ", ") + n;
+    throw Error("unknown breath style '" + nameOrPath + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseBreathStyle(text.str(), path);
+}
+
+BreathStyleController::BreathStyleController(BreathStyle style) : m_style(std::move(style)) {
+  validateBreathStyle(m_style);
+}
+
+Activations BreathStyleController::activations(double t, const Metrics& /*latest*/) {
+  const BreathStyle& s = m_style;
+  const double period = 60.0 / s.breathsPerMinute;  // [s]
+  // after a finite number of cycles, hold the cycle-start posture
+  const double tc = (s.cycles > 0 && t >= s.cycles * period) ? 0.0 : std::max(t, 0.0);
+  const double phase = std::fmod(tc, period) / period;  // [-] 0 = start of inhale
+  const bool inhale = phase < s.inhaleFraction;
+  const double c = std::cos(2.0 * kPi * phase);
+
+  Activations a = relaxedActivations();
+  // diaphragm: step function, on during inhale
+  slot(a, ElementGroup::Diaphragm) = inhale ? GroupActivation{s.diaphragmR, 1.0} : GroupActivation{1.0, 0.0};
+  // intercostals: out-of-phase sinusoids, outer contract (r drops) on inhale, inner on exhale
+  slot(a, ElementGroup::IntercostalExternal) = {s.intercostalMean + s.intercostalAmplitude * c, 1.0};
+  slot(a, ElementGroup::IntercostalInternal) = {s.intercostalMean - s.intercostalAmplitude * c, 1.0};
+  // rectus: forced exhale only, during the exhale part
+  if (s.rectusActive && !inhale) slot(a, ElementGroup::Rectus) = {s.rectusR, 1.0};
+  return a;
+}
+
+std::string BreathStyleController::describe() const {
+  std::ostringstream os;
+  os << "breath style '" << m_style.name << "' (" << m_style.breathsPerMinute << " b/m"
+     << (m_style.cycles > 0 ? ", " + std::to_string(m_style.cycles) + " cycle(s)" : std::string()) << ")";
+  return os.str();
+}
+
+std::unique_ptr<Controller> BreathStyleController::clone() const {
+  return std::make_unique<BreathStyleController>(*this);
+}
+
+}  // namespace pneuma::sim

@@ -1,0 +1,70 @@
+#include "pneuma/sim/Elements.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pneuma::sim {
+
+double muscleForce(double l, double ldot, const MuscleParams& p) {
+  const double elastic = -p.alpha * p.kac * (l - p.r * p.restLength) - p.kpe * (l - p.restLength);
+  return std::min(elastic - p.damping * ldot, 0.0);
+}
+
+double muscleSlackLength(const MuscleParams& p) {
+  const double k = p.alpha * p.kac + p.kpe;
+  if (k <= 0.0) return p.restLength;
+  return (p.alpha * p.kac * p.r + p.kpe) * p.restLength / k;
+}
+
+double muscleEnergy(double l, const MuscleParams& p) {
+  const double stretch = l - muscleSlackLength(p);
+  return stretch > 0.0 ? 0.5 * (p.alpha * p.kac + p.kpe) * stretch * stretch : 0.0;
+}
+
+double springForce(double l, double ldot, double restLength, double k, double damping) {
+  return -k * (l - restLength) - damping * ldot;
+}
+
+double springEnergy(double l, double restLength, double k) {
+  const double stretch = l - restLength;
+  return 0.5 * k * stretch * stretch;
+}
+
+double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles) {
+  // tetrahedra from the vertex centroid to each face (exact for a closed surface; the centroid only
+  // reduces round-off)
+  const Eigen::Vector3d c = x.rowwise().mean();
+  double sixV = 0.0;
+  for (Eigen::Index f = 0; f < triangles.cols(); ++f) {
+    const Eigen::Vector3d a = x.col(triangles(0, f)) - c;
+    const Eigen::Vector3d b = x.col(triangles(1, f)) - c;
+    const Eigen::Vector3d e = x.col(triangles(2, f)) - c;
+    sixV += a.dot(b.cross(e));
+  }
+  return sixV / 6.0;
+}
+
+double gutPressure(double kappa, double restVolume, double volume) {
+  return kappa * (restVolume / volume - 1.0);
+}
+
+double gutEnergy(double kappa, double restVolume, double volume) {
+  if (volume >= restVolume) return 0.0;
+  return kappa * (volume - restVolume - restVolume * std::log(volume / restVolume));
+}
+
+void addVolumeGradient(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, double scale,
+                       Eigen::Matrix3Xd& out) {
+  if (scale == 0.0) return;
+  // A n / 3 = (b - a) x (e - a) / 6 for each of the face's three vertices
+  for (Eigen::Index f = 0; f < triangles.cols(); ++f) {
+    const int ia = triangles(0, f), ib = triangles(1, f), ie = triangles(2, f);
+    const Eigen::Vector3d an = (x.col(ib) - x.col(ia)).cross(x.col(ie) - x.col(ia));
+    const Eigen::Vector3d share = (scale / 6.0) * an;
+    out.col(ia) += share;
+    out.col(ib) += share;
+    out.col(ie) += share;
+  }
+}
+
+}  // namespace pneuma::sim

@@ -1,0 +1,154 @@
+#include "pneuma/sim/Simulation.h"
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace pneuma::sim {
+
+namespace {
+
+// mass and gain checks on top of validateModel(): negative gains or masses are rejected by name
+void validateDynamics(const Model& m) {
+  auto fail = [](const std::string& field, int i, double v) {
+    std::ostringstream os;
+    os << field << "[" << i << "]: must be finite and >= 0, got " << v;
+    throw Error(os.str());
+  };
+  for (int b = 0; b < m.bodies.size(); ++b) {
+    if (!m.bodies.isFixed[static_cast<std::size_t>(b)] && !(m.bodies.mass(b) > 0.0))
+      throw Error("bodies.mass[" + std::to_string(b) + "] ('" + m.bodies.name[static_cast<std::size_t>(b)] +
+                  "'): must be > 0, got " + std::to_string(m.bodies.mass(b)));
+  }
+  for (int n = 0; n < m.nodes.size(); ++n) {
+    if (!m.nodes.isFixed(n) && !(m.nodes.mass(n) > 0.0))
+      throw Error("nodes.mass[" + std::to_string(n) + "]: must be > 0, got " + std::to_string(m.nodes.mass(n)));
+  }
+  for (int e = 0; e < m.elements.size(); ++e) {
+    if (!(m.elements.kac(e) >= 0.0)) fail("elements.kac", e, m.elements.kac(e));
+    if (!(m.elements.kpe(e) >= 0.0)) fail("elements.kpe", e, m.elements.kpe(e));
+    if (!(m.elements.damping(e) >= 0.0)) fail("elements.damping", e, m.elements.damping(e));
+  }
+  for (int j = 0; j < m.joints.size(); ++j) {
+    if (!(m.joints.friction(j) >= 0.0)) fail("joints.friction", j, m.joints.friction(j));
+    if (!(m.joints.stiffness(j) >= 0.0)) fail("joints.stiffness", j, m.joints.stiffness(j));
+  }
+  if (!(m.gut.kappa >= 0.0)) throw Error("gut.kappa: must be finite and >= 0, got " + std::to_string(m.gut.kappa));
+}
+
+}  // namespace
+
+void validateSimulationOptions(const SimulationOptions& o) {
+  validateStepOptions(o.step);
+  auto fail = [](const char* field, double v, const char* rule) {
+    std::ostringstream os;
+    os << field << ": " << rule << ", got " << v;
+    throw Error(os.str());
+  };
+  if (!std::isfinite(o.dt) || o.dt < 0.0) fail("dt", o.dt, "must be > 0 s (or 0 for the integrator's default)");
+  if (o.dt > 0.05) fail("dt", o.dt, "must be <= 0.05 s");
+  if (!std::isfinite(o.settleTime) || o.settleTime < 0.0) fail("settleTime", o.settleTime, "must be >= 0 s");
+  if (!std::isfinite(o.outputRate) || o.outputRate <= 0.0) fail("outputRate", o.outputRate, "must be > 0 Hz");
+  if (!std::isfinite(o.recordSeconds) || o.recordSeconds < 0.0)
+    fail("recordSeconds", o.recordSeconds, "must be >= 0 s");
+}
+
+Simulation::Simulation(std::shared_ptr<const Model> model, std::unique_ptr<Controller> controller,
+                       SimulationOptions options)
+    : m_model(std::move(model)), m_controller(std::move(controller)) {
+  if (!m_model) throw Error("Simulation: no model");
+  if (!m_controller) throw Error("Simulation: no controller");
+  validateModel(*m_model);
+  validateDynamics(*m_model);
+  setOptions(options);
+  validateActivations(m_controller->activations(0.0, Metrics{}));
+  reset();
+}
+
+void Simulation::setOptions(const SimulationOptions& options) {
+  validateSimulationOptions(options);
+  m_options = options;
+  m_dt = options.dt > 0.0 ? options.dt : defaultTimeStep(options.step.integrator);
+  m_recorder.setCapacity(
+      options.recordSeconds > 0.0 ? static_cast<std::size_t>(std::ceil(options.recordSeconds * options.outputRate)) + 1
+                                  : 0);
+}
+
+void Simulation::setController(std::unique_ptr<Controller> controller) {
+  if (!controller) throw Error("Simulation::setController: no controller");
+  validateActivations(controller->activations(0.0, m_latest));
+  m_controller = std::move(controller);
+}
+
+void Simulation::reset() {
+  m_state = makeInitialState(*m_model);
+  m_work = makeStepWork(*m_model);
+  m_activations = m_controller->activations(0.0, Metrics{});
+  m_trace.clear();
+  m_recorder.clear();
+  m_latest = Metrics{};
+  m_nextFrameTime = 0.0;
+  m_wallSeconds = 0.0;
+  m_simulatedSeconds = 0.0;
+  emitFrame();
+}
+
+void Simulation::emitFrame() {
+  computeMetrics(*m_model, m_state, m_activations, m_options.step, m_work, m_latest);
+  m_trace.append(m_latest);
+  m_recorder.record(m_state, m_latest);
+  m_nextFrameTime += 1.0 / m_options.outputRate;
+}
+
+bool Simulation::timedStep() {
+  const auto start = std::chrono::steady_clock::now();
+
+  // control: hold the cycle-start posture while settling
+  const double controlTime = m_state.time - m_options.settleTime;
+  m_activations = m_controller->activations(controlTime < 0.0 ? 0.0 : controlTime, m_latest);
+  validateActivations(m_activations);
+
+  // physics: forces -> integrate -> joints, then the blow-up check
+  step(*m_model, m_state, m_dt, m_activations, m_options.step, m_work);
+  checkState(*m_model, m_state, m_work, m_dt);
+
+  m_wallSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  m_simulatedSeconds += m_dt;
+
+  // metrics and recording at the output rate
+  if (m_state.time < m_nextFrameTime - 1e-9 * m_dt) return false;
+  emitFrame();
+  return true;
+}
+
+void Simulation::stepOnce() { timedStep(); }
+
+void Simulation::advance(double duration, const std::function<bool(const Simulation&)>& onFrame) {
+  if (!std::isfinite(duration) || duration < 0.0) {
+    std::ostringstream os;
+    os << "duration: must be >= 0 s, got " << duration;
+    throw Error(os.str());
+  }
+  const double end = m_state.time + duration;
+  while (m_state.time < end - 0.5 * m_dt) {
+    if (timedStep() && onFrame && !onFrame(*this)) return;
+  }
+}
+
+Summary Simulation::summary() const {
+  std::vector<std::string> names = m_model->landmarks.name;
+  Summary s = summarize(m_trace, names, m_options.settleTime);
+  s.realTimeFactor = realTimeFactor();
+  s.steps = m_state.steps;
+  s.dt = m_dt;
+  return s;
+}
+
+double Simulation::realTimeFactor() const {
+  return m_wallSeconds > 0.0 ? m_simulatedSeconds / m_wallSeconds : 0.0;
+}
+
+}  // namespace pneuma::sim

@@ -1,0 +1,670 @@
+#include "pneuma/sim/Step.h"
+
+#include "pneuma/sim/Elements.h"
+#include "pneuma/sim/Error.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace pneuma::sim {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+std::size_t at(int i) { return static_cast<std::size_t>(i); }
+
+Matrix3d skew(const Vector3d& v) {
+  Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+double effectiveKappa(const Model& model, const StepOptions& o) { return o.kappa >= 0.0 ? o.kappa : model.gut.kappa; }
+
+// muscle parameters of element e under the group's activation and gain scales
+MuscleParams muscleParams(const Model& model, int e, const Activations& act, const StepOptions& o) {
+  const int g = static_cast<int>(model.elements.group[at(e)]);
+  const GroupActivation& ga = act[at(g)];
+  MuscleParams p;
+  p.restLength = model.elements.restLength(e);
+  p.kac = model.elements.kac(e) * o.activeGainScale[at(g)];
+  p.kpe = model.elements.kpe(e) * o.passiveGainScale[at(g)];
+  p.damping = model.elements.damping(e) * o.passiveGainScale[at(g)];
+  p.alpha = ga.alpha;
+  p.r = ga.r;
+  return p;
+}
+
+// world position, velocity and lever arm (point - com, bodies only) of anchor i
+void anchorKinematics(const AnchorSet& a, int i, const State& s, const StepWork& w, Vector3d& p, Vector3d& v,
+                      Vector3d& lever) {
+  const int b = a.body[at(i)];
+  if (b >= 0) {
+    lever = w.rotation[at(b)] * a.local.col(i);
+    p = s.bodyPosition.col(b) + lever;
+    v = s.bodyVelocity.col(b) + s.bodyAngularVelocity.col(b).cross(lever);
+    return;
+  }
+  p.setZero();
+  v.setZero();
+  lever.setZero();
+  for (int k = 0; k < 3; ++k) {
+    const int n = a.nodes(k, i);
+    if (n < 0) continue;
+    p += a.weights(k, i) * s.nodePosition.col(n);
+    v += a.weights(k, i) * s.nodeVelocity.col(n);
+  }
+}
+
+// adds force f [N] acting at anchor i to the body (force and torque about the com) or to its nodes
+void applyAnchorForce(const AnchorSet& a, int i, const Vector3d& lever, const Vector3d& f, StepWork& w) {
+  const int b = a.body[at(i)];
+  if (b >= 0) {
+    w.bodyForce.col(b) += f;
+    w.bodyTorque.col(b) += lever.cross(f);
+    return;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const int n = a.nodes(k, i);
+    if (n >= 0) w.nodeForce.col(n) += a.weights(k, i) * f;
+  }
+}
+
+// ---- generalized-velocity helpers for the implicit solve: u = [v_b, w_b]_b ++ [v_n]_n ----
+
+Eigen::Index nodeOffset(const Model& m, int n) { return 6 * static_cast<Eigen::Index>(m.bodies.size()) + 3 * n; }
+
+Vector3d anchorVelocity(const AnchorSet& a, int i, const Vector3d& lever, const Model& m, const Eigen::VectorXd& u) {
+  const int b = a.body[at(i)];
+  if (b >= 0) return u.segment<3>(6 * b) + u.segment<3>(6 * b + 3).cross(lever);
+  Vector3d v = Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const int n = a.nodes(k, i);
+    if (n >= 0) v += a.weights(k, i) * u.segment<3>(nodeOffset(m, n));
+  }
+  return v;
+}
+
+void addAnchorGeneralized(const AnchorSet& a, int i, const Vector3d& lever, const Vector3d& f, const Model& m,
+                          Eigen::VectorXd& out) {
+  const int b = a.body[at(i)];
+  if (b >= 0) {
+    out.segment<3>(6 * b) += f;
+    out.segment<3>(6 * b + 3) += lever.cross(f);
+    return;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const int n = a.nodes(k, i);
+    if (n >= 0) out.segment<3>(nodeOffset(m, n)) += a.weights(k, i) * f;
+  }
+}
+
+// zero the entries of fixed bodies and nodes
+void maskFixed(const Model& m, Eigen::VectorXd& x) {
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies.isFixed[at(b)]) x.segment<6>(6 * b).setZero();
+  for (int n = 0; n < m.nodes.size(); ++n)
+    if (m.nodes.isFixed(n)) x.segment<3>(nodeOffset(m, n)).setZero();
+}
+
+// ---------------------------------------------------------------------------------------------
+// stage 1: forces
+
+// rotation matrices and world inverse inertias of all bodies
+void updateBodyFrames(const Model& model, const State& s, StepWork& w) {
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    w.rotation[at(b)] = s.bodyOrientation[at(b)].toRotationMatrix();
+    const Matrix3d& r = w.rotation[at(b)];
+    w.inverseInertiaWorld[at(b)] = r * w.inverseInertiaBody[at(b)] * r.transpose();
+  }
+}
+
+// muscles (Eq. 2) and structural springs, with their linearisation for the implicit solve
+void accumulateElementForces(const Model& model, const State& s, const Activations& act, const StepOptions& o,
+                             StepWork& w) {
+  const Elements& el = model.elements;
+  for (int e = 0; e < el.size(); ++e) {
+    Vector3d pa, va, ra, pb, vb, rb;
+    anchorKinematics(el.endA, e, s, w, pa, va, ra);
+    anchorKinematics(el.endB, e, s, w, pb, vb, rb);
+    const Vector3d delta = pb - pa;
+    const double l = std::max(delta.norm(), 1e-12);
+    const Vector3d d = delta / l;
+    const double ldot = d.dot(vb - va);
+    const MuscleParams p = muscleParams(model, e, act, o);
+
+    double f = 0.0, k = 0.0, b = 0.0;
+    if (isMuscleGroup(el.group[at(e)])) {
+      f = muscleForce(l, ldot, p);
+      if (f < 0.0) {
+        k = p.alpha * p.kac + p.kpe;
+        b = p.damping;
+      }
+    } else {
+      f = springForce(l, ldot, p.restLength, p.kpe, p.damping);
+      k = p.kpe;
+      b = p.damping;
+    }
+    w.elementForce(e) = f;
+    w.elementLength(e) = l;
+    w.elementDirection.col(e) = d;
+    w.leverA.col(e) = ra;
+    w.leverB.col(e) = rb;
+    w.elementStiffness(e) = k;
+    w.elementDamping(e) = b;
+    w.elementGeometric(e) = std::max(-f, 0.0) / l;
+    applyAnchorForce(el.endA, e, ra, -f * d, w);
+    applyAnchorForce(el.endB, e, rb, f * d, w);
+  }
+}
+
+// gut pressure: P = kappa (V0/V - 1) (Eq. 4), force max(0, P) A n / 3 per face and vertex (Eq. 5)
+void accumulateGutPressure(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
+  if (model.gut.triangles.cols() == 0) return;
+  w.gutVolume = enclosedVolume(s.nodePosition, model.gut.triangles);
+  w.gutPressure = gutPressure(effectiveKappa(model, o), w.restGutVolume, w.gutVolume);
+  w.gutGradient.setZero();
+  addVolumeGradient(s.nodePosition, model.gut.triangles, 1.0, w.gutGradient);
+  if (w.gutPressure > 0.0) w.nodeForce += w.gutPressure * w.gutGradient;
+}
+
+// rotation vector [rad] of the child relative to the parent, world frame (zero at rest)
+Vector3d jointRotation(const State& s, int parent, int child) {
+  const Eigen::Quaterniond rel = s.bodyOrientation[at(parent)].conjugate() * s.bodyOrientation[at(child)];
+  const Eigen::AngleAxisd aa(rel.w() < 0.0 ? Eigen::Quaterniond(-rel.coeffs()) : rel);
+  return s.bodyOrientation[at(parent)] * (aa.angle() * aa.axis());
+}
+
+// joint friction tau = -mu (w_child - w_parent) (Eq. 3) and passive rotational stiffness tau = -k theta
+void accumulateJointTorques(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
+  const Joints& j = model.joints;
+  for (int i = 0; i < j.size(); ++i) {
+    const int p = j.parent[at(i)], c = j.child[at(i)];
+    const double mu = j.friction(i) * o.jointFrictionScale;
+    Vector3d tau = -mu * (s.bodyAngularVelocity.col(c) - s.bodyAngularVelocity.col(p));
+    if (j.stiffness(i) > 0.0) tau -= j.stiffness(i) * jointRotation(s, p, c);
+    w.bodyTorque.col(c) += tau;
+    w.bodyTorque.col(p) -= tau;
+  }
+}
+
+// gravity on moving bodies and nodes; gyroscopic torque -w x (I w)
+void accumulateGravityAndGyroscopic(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    if (o.gravity) w.bodyForce.col(b) += model.bodies.mass(b) * model.gravity;
+    const Matrix3d& r = w.rotation[at(b)];
+    const Vector3d om = s.bodyAngularVelocity.col(b);
+    w.bodyTorque.col(b) -= om.cross(r * (model.bodies.inertia[at(b)] * (r.transpose() * om)));
+  }
+  if (o.gravity) {
+    for (int n = 0; n < model.nodes.size(); ++n) w.nodeForce.col(n) += model.nodes.mass(n) * model.gravity;
+  }
+}
+
+void computeForces(const Model& model, const State& s, const Activations& act, const StepOptions& o, StepWork& w) {
+  w.bodyForce.setZero();
+  w.bodyTorque.setZero();
+  w.nodeForce.setZero();
+  updateBodyFrames(model, s, w);
+  accumulateElementForces(model, s, act, o, w);
+  accumulateGutPressure(model, s, o, w);
+  accumulateJointTorques(model, s, o, w);
+  accumulateGravityAndGyroscopic(model, s, o, w);
+}
+
+// ---------------------------------------------------------------------------------------------
+// stage 2: integrate velocities
+
+// paper's scheme (Section 6.1): v += F/m dt for nodes, and the Newton-Euler analogue for bodies
+void explicitVelocityUpdate(const Model& model, State& s, double dt, StepWork& w) {
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    s.bodyVelocity.col(b) += (dt / model.bodies.mass(b)) * w.bodyForce.col(b);
+    s.bodyAngularVelocity.col(b) += dt * (w.inverseInertiaWorld[at(b)] * w.bodyTorque.col(b));
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) {
+    if (model.nodes.isFixed(n)) continue;
+    s.nodeVelocity.col(n) += (dt / model.nodes.mass(n)) * w.nodeForce.col(n);
+  }
+}
+
+// out = kScale K u + dScale D u: the linearised stiffness and damping of elements, gut pressure and joints
+void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w,
+                           const Eigen::VectorXd& u, double kScale, double dScale, Eigen::VectorXd& out) {
+  out.setZero();
+  const Elements& el = model.elements;
+  for (int e = 0; e < el.size(); ++e) {
+    const double ka = kScale * w.elementStiffness(e) + dScale * w.elementDamping(e);
+    const double kg = kScale * w.elementGeometric(e);
+    if (ka == 0.0 && kg == 0.0) continue;
+    const Vector3d ra = w.leverA.col(e), rb = w.leverB.col(e);
+    const Vector3d du = anchorVelocity(el.endB, e, rb, model, u) - anchorVelocity(el.endA, e, ra, model, u);
+    const Vector3d d = w.elementDirection.col(e);
+    const double along = d.dot(du);
+    const Vector3d y = ka * along * d + kg * (du - along * d);
+    addAnchorGeneralized(el.endA, e, ra, -y, model, out);
+    addAnchorGeneralized(el.endB, e, rb, y, model, out);
+  }
+  // rank-one gut pressure stiffness kappa V0 / V^2 g g^T while the pressure pushes (V < V0)
+  if (w.gutPressure > 0.0 && kScale != 0.0) {
+    const double kp = kScale * effectiveKappa(model, o) * w.restGutVolume / (w.gutVolume * w.gutVolume);
+    double gu = 0.0;
+    for (int n = 0; n < model.nodes.size(); ++n) gu += w.gutGradient.col(n).dot(u.segment<3>(nodeOffset(model, n)));
+    for (int n = 0; n < model.nodes.size(); ++n) out.segment<3>(nodeOffset(model, n)) += (kp * gu) * w.gutGradient.col(n);
+  }
+  // joint springs and friction act on the relative angular velocity
+  const Joints& j = model.joints;
+  for (int i = 0; i < j.size(); ++i) {
+    const double kj = kScale * j.stiffness(i) + dScale * j.friction(i) * o.jointFrictionScale;
+    if (kj == 0.0) continue;
+    const int p = j.parent[at(i)], c = j.child[at(i)];
+    const Vector3d y = kj * (u.segment<3>(6 * c + 3) - u.segment<3>(6 * p + 3));
+    out.segment<3>(6 * c + 3) += y;
+    out.segment<3>(6 * p + 3) -= y;
+  }
+  maskFixed(model, out);
+}
+
+// out = M u (block diagonal: m I for translations, world inertia for rotations)
+void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, Eigen::VectorXd& out) {
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    const Matrix3d& r = w.rotation[at(b)];
+    out.segment<3>(6 * b) = model.bodies.mass(b) * u.segment<3>(6 * b);
+    out.segment<3>(6 * b + 3) = r * (model.bodies.inertia[at(b)] * (r.transpose() * u.segment<3>(6 * b + 3)));
+  }
+  for (int n = 0; n < model.nodes.size(); ++n)
+    out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
+}
+
+// Jacobi preconditioner: diagonal of M plus the element terms on translational entries
+void buildPreconditioner(const Model& model, const StepWork& w, double dt, Eigen::VectorXd& diag) {
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    const Matrix3d& r = w.rotation[at(b)];
+    const Matrix3d iw = r * model.bodies.inertia[at(b)] * r.transpose();
+    diag.segment<3>(6 * b).setConstant(model.bodies.mass(b));
+    diag.segment<3>(6 * b + 3) = iw.diagonal();
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) diag.segment<3>(nodeOffset(model, n)).setConstant(model.nodes.mass(n));
+  const Elements& el = model.elements;
+  for (int e = 0; e < el.size(); ++e) {
+    const double k = dt * dt * (w.elementStiffness(e) + w.elementGeometric(e)) + dt * w.elementDamping(e);
+    if (k == 0.0) continue;
+    const Vector3d d2 = w.elementDirection.col(e).cwiseAbs2();
+    for (const AnchorSet* a : {&el.endA, &el.endB}) {
+      const int b = a->body[at(e)];
+      if (b >= 0) {
+        diag.segment<3>(6 * b) += k * d2;
+        continue;
+      }
+      for (int i = 0; i < 3; ++i) {
+        const int n = a->nodes(i, e);
+        if (n >= 0) diag.segment<3>(nodeOffset(model, n)) += (k * a->weights(i, e) * a->weights(i, e)) * d2;
+      }
+    }
+  }
+  for (Eigen::Index i = 0; i < diag.size(); ++i) diag(i) = diag(i) > 0.0 ? 1.0 / diag(i) : 0.0;
+}
+
+// linearly implicit Euler (Baraff & Witkin 1998): (M + dt D + dt^2 K) dv = dt (f - dt K v), by PCG
+void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepOptions& o, StepWork& w) {
+  const int nb = model.bodies.size(), nn = model.nodes.size();
+  Eigen::VectorXd &x = w.cgX, &r = w.cgR, &z = w.cgZ, &p = w.cgP, &q = w.cgQ, &rhs = w.cgB;
+
+  // current generalized velocity and forces
+  for (int b = 0; b < nb; ++b) {
+    p.segment<3>(6 * b) = s.bodyVelocity.col(b);
+    p.segment<3>(6 * b + 3) = s.bodyAngularVelocity.col(b);
+    rhs.segment<3>(6 * b) = w.bodyForce.col(b);
+    rhs.segment<3>(6 * b + 3) = w.bodyTorque.col(b);
+  }
+  for (int n = 0; n < nn; ++n) {
+    p.segment<3>(nodeOffset(model, n)) = s.nodeVelocity.col(n);
+    rhs.segment<3>(nodeOffset(model, n)) = w.nodeForce.col(n);
+  }
+  applyStiffnessDamping(model, o, w, p, dt * dt, 0.0, q);
+  rhs = dt * rhs - q;
+  maskFixed(model, rhs);
+
+  // preconditioned conjugate gradient from dv = 0
+  buildPreconditioner(model, w, dt, w.cgDiag);
+  x.setZero();
+  r = rhs;
+  z = w.cgDiag.cwiseProduct(r);
+  p = z;
+  double rz = r.dot(z);
+  const double stop = o.cgTolerance * o.cgTolerance * std::max(rhs.dot(w.cgDiag.cwiseProduct(rhs)), 1e-300);
+  int it = 0;
+  for (; it < o.cgMaxIterations && rz > stop; ++it) {
+    applyStiffnessDamping(model, o, w, p, dt * dt, dt, q);
+    applyMass(model, w, p, z);
+    q += z;
+    maskFixed(model, q);
+    const double alpha = rz / p.dot(q);
+    x += alpha * p;
+    r -= alpha * q;
+    z = w.cgDiag.cwiseProduct(r);
+    const double rzNew = r.dot(z);
+    p = z + (rzNew / rz) * p;
+    rz = rzNew;
+  }
+  w.cgIterations = it;
+
+  // v += dv
+  for (int b = 0; b < nb; ++b) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    s.bodyVelocity.col(b) += x.segment<3>(6 * b);
+    s.bodyAngularVelocity.col(b) += x.segment<3>(6 * b + 3);
+  }
+  for (int n = 0; n < nn; ++n) {
+    if (!model.nodes.isFixed(n)) s.nodeVelocity.col(n) += x.segment<3>(nodeOffset(model, n));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// stage 3: ball joints
+
+// inverse of the 3x3 effective mass of a point constraint between bodies p and c at levers rp, rc
+Matrix3d jointEffectiveMassInverse(const Model& model, const StepWork& w, int p, int c, const Vector3d& rp,
+                                   const Vector3d& rc) {
+  Matrix3d k = Matrix3d::Zero();
+  for (const auto& [b, r] : {std::pair<int, Vector3d>{p, rp}, std::pair<int, Vector3d>{c, rc}}) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    const Matrix3d rx = skew(r);
+    k += Matrix3d::Identity() / model.bodies.mass(b) - rx * w.inverseInertiaWorld[at(b)] * rx;
+  }
+  return k.inverse();
+}
+
+// sequential impulses: the relative velocity of the two anchor points of every joint goes to zero
+void solveJointVelocities(const Model& model, State& s, const StepOptions& o, StepWork& w) {
+  const Joints& j = model.joints;
+  const int iterations = std::max(1, o.jointIterations / 3);
+  for (int it = 0; it < iterations; ++it) {
+    for (int i = 0; i < j.size(); ++i) {
+      const int p = j.parent[at(i)], c = j.child[at(i)];
+      const Vector3d rp = w.rotation[at(p)] * w.jointLocalParent.col(i);
+      const Vector3d rc = w.rotation[at(c)] * w.jointLocalChild.col(i);
+      const Vector3d vrel = (s.bodyVelocity.col(c) + s.bodyAngularVelocity.col(c).cross(rc)) -
+                            (s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(rp));
+      const Vector3d impulse = -jointEffectiveMassInverse(model, w, p, c, rp, rc) * vrel;
+      if (!model.bodies.isFixed[at(c)]) {
+        s.bodyVelocity.col(c) += impulse / model.bodies.mass(c);
+        s.bodyAngularVelocity.col(c) += w.inverseInertiaWorld[at(c)] * rc.cross(impulse);
+      }
+      if (!model.bodies.isFixed[at(p)]) {
+        s.bodyVelocity.col(p) -= impulse / model.bodies.mass(p);
+        s.bodyAngularVelocity.col(p) -= w.inverseInertiaWorld[at(p)] * rp.cross(impulse);
+      }
+    }
+  }
+}
+
+// rotates body b by the small rotation vector dtheta [rad] (world frame)
+void rotateBody(State& s, int b, const Vector3d& dtheta) {
+  Eigen::Quaterniond& q = s.bodyOrientation[at(b)];
+  const Eigen::Quaterniond dq(0.0, dtheta.x(), dtheta.y(), dtheta.z());
+  q.coeffs() += 0.5 * (dq * q).coeffs();
+  q.normalize();
+}
+
+// mass-weighted position projection until every joint error is below the tolerance (velocities kept)
+void projectJointPositions(const Model& model, State& s, const StepOptions& o, StepWork& w) {
+  const Joints& j = model.joints;
+  w.maxJointError = 0.0;
+  for (int it = 0; it < o.jointIterations; ++it) {
+    double worst = 0.0;
+    for (int i = 0; i < j.size(); ++i) {
+      const int p = j.parent[at(i)], c = j.child[at(i)];
+      const Vector3d rp = w.rotation[at(p)] * w.jointLocalParent.col(i);
+      const Vector3d rc = w.rotation[at(c)] * w.jointLocalChild.col(i);
+      const Vector3d err = (s.bodyPosition.col(c) + rc) - (s.bodyPosition.col(p) + rp);
+      worst = std::max(worst, err.norm());
+      if (err.squaredNorm() == 0.0) continue;
+      const Vector3d impulse = -jointEffectiveMassInverse(model, w, p, c, rp, rc) * err;
+      for (const auto& [b, r, sign] : {std::tuple<int, Vector3d, double>{c, rc, 1.0}, {p, rp, -1.0}}) {
+        if (model.bodies.isFixed[at(b)]) continue;
+        s.bodyPosition.col(b) += (sign / model.bodies.mass(b)) * impulse;
+        rotateBody(s, b, sign * (w.inverseInertiaWorld[at(b)] * r.cross(impulse)));
+        w.rotation[at(b)] = s.bodyOrientation[at(b)].toRotationMatrix();
+      }
+    }
+    w.maxJointError = worst;
+    if (worst < o.jointTolerance) break;
+  }
+  // refresh the world inertias for the next stage
+  updateBodyFrames(model, s, w);
+}
+
+// x += v dt for bodies (quaternion update with the new angular velocity) and moving nodes
+void integratePositions(const Model& model, State& s, double dt, StepWork& w) {
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    s.bodyPosition.col(b) += dt * s.bodyVelocity.col(b);
+    rotateBody(s, b, dt * s.bodyAngularVelocity.col(b));
+    w.rotation[at(b)] = s.bodyOrientation[at(b)].toRotationMatrix();
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) {
+    if (!model.nodes.isFixed(n)) s.nodePosition.col(n) += dt * s.nodeVelocity.col(n);
+  }
+  updateBodyFrames(model, s, w);
+}
+
+std::string describeBlowUpCause(double dt) {
+  std::ostringstream os;
+  os << "likely cause: dt = " << dt << " s too large for the stiffness (lower dt or use implicit-euler)";
+  return os.str();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+const char* integratorName(IntegratorKind k) {
+  return k == IntegratorKind::SymplecticEuler ? "symplectic-euler" : "implicit-euler";
+}
+
+bool integratorFromName(const std::string& name, IntegratorKind& out) {
+  if (name == "symplectic-euler") {
+    out = IntegratorKind::SymplecticEuler;
+    return true;
+  }
+  if (name == "implicit-euler") {
+    out = IntegratorKind::ImplicitEuler;
+    return true;
+  }
+  return false;
+}
+
+double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : 2e-3; }
+
+void validateStepOptions(const StepOptions& o) {
+  auto fail = [](const std::string& field, double v, const char* rule) {
+    std::ostringstream os;
+    os << field << ": " << rule << ", got " << v;
+    throw Error(os.str());
+  };
+  if (!std::isfinite(o.jointFrictionScale) || o.jointFrictionScale < 0.0)
+    fail("jointFrictionScale", o.jointFrictionScale, "must be finite and >= 0");
+  if (!std::isfinite(o.kappa)) fail("kappa", o.kappa, "must be finite (< 0 selects the model's value)");
+  for (int g = 0; g < kElementGroupCount; ++g) {
+    const std::string name = groupName(static_cast<ElementGroup>(g));
+    if (!std::isfinite(o.activeGainScale[at(g)]) || o.activeGainScale[at(g)] < 0.0)
+      fail("activeGainScale." + name, o.activeGainScale[at(g)], "must be finite and >= 0");
+    if (!std::isfinite(o.passiveGainScale[at(g)]) || o.passiveGainScale[at(g)] < 0.0)
+      fail("passiveGainScale." + name, o.passiveGainScale[at(g)], "must be finite and >= 0");
+  }
+  if (o.jointIterations < 1) fail("jointIterations", o.jointIterations, "must be >= 1");
+  if (!(o.jointTolerance > 0.0)) fail("jointTolerance", o.jointTolerance, "must be > 0");
+  if (o.cgMaxIterations < 1) fail("cgMaxIterations", o.cgMaxIterations, "must be >= 1");
+  if (!(o.cgTolerance > 0.0)) fail("cgTolerance", o.cgTolerance, "must be > 0");
+}
+
+StepWork makeStepWork(const Model& model) {
+  StepWork w;
+  const int nb = model.bodies.size(), nn = model.nodes.size(), ne = model.elements.size(), nj = model.joints.size();
+  w.restGutVolume = model.gut.triangles.cols() > 0 ? enclosedVolume(model.nodes.rest, model.gut.triangles) : 0.0;
+  w.gutVolume = w.restGutVolume;
+  w.elementForce = Eigen::VectorXd::Zero(ne);
+  w.elementLength = Eigen::VectorXd::Zero(ne);
+  w.elementDirection = Eigen::Matrix3Xd::Zero(3, ne);
+  w.leverA = Eigen::Matrix3Xd::Zero(3, ne);
+  w.leverB = Eigen::Matrix3Xd::Zero(3, ne);
+  w.elementStiffness = Eigen::VectorXd::Zero(ne);
+  w.elementGeometric = Eigen::VectorXd::Zero(ne);
+  w.elementDamping = Eigen::VectorXd::Zero(ne);
+  w.inverseInertiaBody.resize(at(nb));
+  for (int b = 0; b < nb; ++b)
+    w.inverseInertiaBody[at(b)] = model.bodies.isFixed[at(b)] ? Matrix3d::Zero() : Matrix3d(model.bodies.inertia[at(b)].inverse());
+  w.jointLocalParent.resize(3, nj);
+  w.jointLocalChild.resize(3, nj);
+  for (int i = 0; i < nj; ++i) {
+    w.jointLocalParent.col(i) = model.joints.anchor.col(i) - model.bodies.com.col(model.joints.parent[at(i)]);
+    w.jointLocalChild.col(i) = model.joints.anchor.col(i) - model.bodies.com.col(model.joints.child[at(i)]);
+  }
+  w.rotation.assign(at(nb), Matrix3d::Identity());
+  w.inverseInertiaWorld = w.inverseInertiaBody;
+  w.bodyForce = Eigen::Matrix3Xd::Zero(3, nb);
+  w.bodyTorque = Eigen::Matrix3Xd::Zero(3, nb);
+  w.nodeForce = Eigen::Matrix3Xd::Zero(3, nn);
+  w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
+  const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
+  for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgDiag, &w.cgB}) *v = Eigen::VectorXd::Zero(n);
+  return w;
+}
+
+void step(const Model& model, State& state, double dt, const Activations& act, const StepOptions& options,
+          StepWork& work) {
+  // forces: muscles, cartilage, gut pressure, joint friction and stiffness, gravity
+  computeForces(model, state, act, options, work);
+
+  // integrate velocities
+  if (options.integrator == IntegratorKind::SymplecticEuler)
+    explicitVelocityUpdate(model, state, dt, work);
+  else
+    implicitVelocityUpdate(model, state, dt, options, work);
+
+  // joints: remove relative velocity at every ball joint
+  solveJointVelocities(model, state, options, work);
+
+  // integrate positions with the new velocities
+  integratePositions(model, state, dt, work);
+
+  // joints: project positions back onto the constraints
+  projectJointPositions(model, state, options, work);
+
+  state.time += dt;
+  ++state.steps;
+}
+
+void computeMetrics(const Model& model, const State& state, const Activations& act, const StepOptions& options,
+                    const StepWork& work, Metrics& out) {
+  out.time = state.time;
+  out.activations = act;
+
+  // volumes: lung cavity from its bound surface, gut from the node surface
+  Eigen::Matrix3Xd cavity;
+  anchorPositions(model.cavity.vertices, state, cavity);
+  out.lungVolume = model.cavity.triangles.cols() > 0 ? enclosedVolume(cavity, model.cavity.triangles) : 0.0;
+  out.gutVolume = model.gut.triangles.cols() > 0 ? enclosedVolume(state.nodePosition, model.gut.triangles) : 0.0;
+  out.gutVolumeError = work.restGutVolume > 0.0 ? (out.gutVolume - work.restGutVolume) / work.restGutVolume : 0.0;
+  const double kappa = effectiveKappa(model, options);
+  out.gutPressure = work.restGutVolume > 0.0 ? gutPressure(kappa, work.restGutVolume, out.gutVolume) : 0.0;
+
+  // element forces of the last step, slack state and group tensions
+  const Elements& el = model.elements;
+  out.elementForce = work.elementForce;
+  out.isSlack.assign(at(el.size()), 0);
+  out.groupTension.fill(0.0);
+  for (int e = 0; e < el.size(); ++e) {
+    const double f = work.elementForce(e);
+    if (isMuscleGroup(el.group[at(e)]) && f >= 0.0) out.isSlack[at(e)] = 1;
+    out.groupTension[at(static_cast<int>(el.group[at(e)]))] += std::max(-f, 0.0);
+  }
+
+  // energies: kinetic, elastic (elements at the current pose, gut, joint springs), gravity
+  double kinetic = 0.0, gravity = 0.0;
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    const Matrix3d r = state.bodyOrientation[at(b)].toRotationMatrix();
+    const Vector3d om = r.transpose() * state.bodyAngularVelocity.col(b);
+    kinetic += 0.5 * model.bodies.mass(b) * state.bodyVelocity.col(b).squaredNorm() +
+               0.5 * om.dot(model.bodies.inertia[at(b)] * om);
+    if (options.gravity)
+      gravity -= model.bodies.mass(b) * model.gravity.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) {
+    if (model.nodes.isFixed(n)) continue;
+    kinetic += 0.5 * model.nodes.mass(n) * state.nodeVelocity.col(n).squaredNorm();
+    if (options.gravity)
+      gravity -= model.nodes.mass(n) * model.gravity.dot(state.nodePosition.col(n) - model.nodes.rest.col(n));
+  }
+  Eigen::Matrix3Xd pa, pb;
+  anchorPositions(el.endA, state, pa);
+  anchorPositions(el.endB, state, pb);
+  double elastic = 0.0;
+  for (int e = 0; e < el.size(); ++e) {
+    const double l = (pb.col(e) - pa.col(e)).norm();
+    const MuscleParams p = muscleParams(model, e, act, options);
+    elastic += isMuscleGroup(el.group[at(e)]) ? muscleEnergy(l, p) : springEnergy(l, p.restLength, p.kpe);
+  }
+  if (work.restGutVolume > 0.0) elastic += gutEnergy(kappa, work.restGutVolume, out.gutVolume);
+  for (int i = 0; i < model.joints.size(); ++i) {
+    const double th = jointRotation(state, model.joints.parent[at(i)], model.joints.child[at(i)]).norm();
+    elastic += 0.5 * model.joints.stiffness(i) * th * th;
+  }
+  out.kineticEnergy = kinetic;
+  out.elasticEnergy = elastic;
+  out.gravityEnergy = gravity;
+  out.maxJointError = work.maxJointError;
+
+  // landmarks
+  anchorPositions(model.landmarks.points, state, out.landmarks);
+}
+
+void checkState(const Model& model, const State& state, const StepWork& work, double dt) {
+  constexpr double kMaxSpeed = 100.0;      // [m/s] nothing in a breathing torso moves this fast
+  constexpr double kMaxJointError = 0.01;  // [m]
+  auto fail = [&](const std::string& what) {
+    std::ostringstream os;
+    os << "simulation blew up at t = " << state.time << " s: " << what << " (" << describeBlowUpCause(dt) << ")";
+    throw Error(os.str());
+  };
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    const double v = state.bodyVelocity.col(b).norm() + state.bodyAngularVelocity.col(b).norm();
+    if (!std::isfinite(v) || !state.bodyPosition.col(b).allFinite())
+      fail("body '" + model.bodies.name[at(b)] + "' has a non-finite position or velocity");
+    if (state.bodyVelocity.col(b).norm() > kMaxSpeed) {
+      std::ostringstream os;
+      os << "body '" << model.bodies.name[at(b)] << "' speed " << state.bodyVelocity.col(b).norm() << " m/s";
+      fail(os.str());
+    }
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) {
+    const double v = state.nodeVelocity.col(n).norm();
+    if (!std::isfinite(v) || !state.nodePosition.col(n).allFinite())
+      fail("gut node " + std::to_string(n) + " has a non-finite position or velocity");
+    if (v > kMaxSpeed) {
+      std::ostringstream os;
+      os << "gut node " << n << " speed " << v << " m/s";
+      fail(os.str());
+    }
+  }
+  for (int e = 0; e < model.elements.size(); ++e) {
+    if (!std::isfinite(work.elementForce(e)))
+      fail("element " + std::to_string(e) + " (" + groupName(model.elements.group[at(e)]) + ") has a non-finite force");
+  }
+  if (work.maxJointError > kMaxJointError) {
+    std::ostringstream os;
+    os << "joint error " << work.maxJointError * 1e3 << " mm exceeds 10 mm";
+    fail(os.str());
+  }
+}
+
+}  // namespace pneuma::sim
