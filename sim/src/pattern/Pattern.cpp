@@ -1,0 +1,283 @@
+#include "pneuma/sim/pattern/Pattern.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace pneuma::sim::pattern {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kFormatName = "pneuma-pattern";
+
+// a JSON node with its path, so every error names the field
+class Node {
+ public:
+  Node(const json& j, std::string path, const std::string& source) : m_j(j), m_path(std::move(path)), m_source(source) {}
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw Error(m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
+  }
+  const std::string& path() const { return m_path; }
+  const json& raw() const { return m_j; }
+
+  // object access; `allowed` lists every accepted key so that typos are rejected
+  void requireKeys(std::initializer_list<const char*> allowed) const {
+    if (!m_j.is_object()) fail("must be an object");
+    for (auto it = m_j.begin(); it != m_j.end(); ++it) {
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; }))
+        child(it.key(), *it).fail("unknown field");
+    }
+  }
+  bool has(const char* key) const { return m_j.is_object() && m_j.contains(key); }
+  Node at(const char* key) const {
+    if (!has(key)) child(key, m_j).fail("missing");
+    return child(key, m_j.at(key));
+  }
+  Node operator[](std::size_t i) const { return Node(m_j.at(i), m_path + "[" + std::to_string(i) + "]", m_source); }
+  std::size_t size() const {
+    if (!m_j.is_array()) fail("must be an array");
+    return m_j.size();
+  }
+
+  double number() const {
+    if (!m_j.is_number()) fail("must be a number");
+    const double x = m_j.get<double>();
+    if (!std::isfinite(x)) fail("must be finite");
+    return x;
+  }
+  std::string string() const {
+    if (!m_j.is_string()) fail("must be a string");
+    return m_j.get<std::string>();
+  }
+  // rethrows a validation message "field: reason" of a child of this node with its full path
+  [[noreturn]] void failBelow(const std::string& fieldAndReason) const {
+    throw Error(m_source + ": " + (m_path.empty() ? "" : m_path + ".") + fieldAndReason);
+  }
+  double numberOr(const char* key, double fallback) const { return has(key) ? at(key).number() : fallback; }
+  std::string stringOr(const char* key, const std::string& fallback) const {
+    return has(key) ? at(key).string() : fallback;
+  }
+
+ private:
+  Node child(const std::string& key, const json& j) const {
+    return Node(j, m_path.empty() ? key : m_path + "." + key, m_source);
+  }
+  const json& m_j;
+  std::string m_path;
+  const std::string& m_source;
+};
+
+CycleKind parseKind(const Node& n) {
+  const std::string k = n.string();
+  for (CycleKind kind : {CycleKind::Linear, CycleKind::Keyframe, CycleKind::Spline})
+    if (k == cycleKindName(kind)) return kind;
+  n.fail("unknown cycle kind '" + k + "' (valid: linear, keyframe, spline)");
+}
+
+CycleSpec parseCycle(const Node& n) {
+  n.requireKeys({"kind", "time", "rate_bpm", "depth", "ie_ratio", "post_inspiratory_pause_s",
+                 "post_expiratory_pause_s", "irregularity", "balance", "keyframes"});
+  CycleSpec c;
+  c.kind = parseKind(n.at("kind"));
+
+  // time base: relative cycles need a rate, absolute ones take it from the keyframes
+  const std::string time = n.stringOr("time", "relative");
+  if (time != "relative" && time != "absolute") n.at("time").fail("must be 'relative' or 'absolute', got '" + time + "'");
+  c.isRelative = time == "relative";
+  if (c.isRelative) c.rate = n.at("rate_bpm").number();
+  else if (n.has("rate_bpm")) n.at("rate_bpm").fail("not allowed with absolute time (the keyframes set the rate)");
+
+  // depth [min, max]
+  const Node depth = n.at("depth");
+  if (depth.size() != 2) depth.fail("must be [min, max]");
+  c.depthMin = depth[0].number();
+  c.depthMax = depth[1].number();
+
+  // timing extras
+  if (n.has("ie_ratio") && n.has("keyframes")) n.at("ie_ratio").fail("not allowed with keyframes (they set the shape)");
+  c.ieRatio = n.numberOr("ie_ratio", c.ieRatio);
+  c.postInspiratoryPause = n.numberOr("post_inspiratory_pause_s", 0.0);
+  c.postExpiratoryPause = n.numberOr("post_expiratory_pause_s", 0.0);
+  if (n.has("irregularity")) {
+    const Node irr = n.at("irregularity");
+    irr.requireKeys({"rate", "depth"});
+    c.rateIrregularity = irr.numberOr("rate", 0.0);
+    c.depthIrregularity = irr.numberOr("depth", 0.0);
+  }
+  c.balance = n.numberOr("balance", c.balance);
+
+  // keyframes as [time, volume] pairs
+  if (n.has("keyframes")) {
+    const Node k = n.at("keyframes");
+    for (std::size_t i = 0; i < k.size(); ++i) {
+      const Node pair = k[i];
+      if (pair.size() != 2) pair.fail("must be [time, volume]");
+      c.keyframes.push_back({pair[0].number(), pair[1].number()});
+    }
+  }
+
+  // semantic checks, reported under this cycle's path
+  try {
+    validateCycle(c);
+  } catch (const Error& e) {
+    n.failBelow(e.what());
+  }
+  return c;
+}
+
+Layer parseLayer(const Node& n) {
+  n.requireKeys({"name", "repeat", "cycle"});
+  Layer l;
+  l.name = n.at("name").string();
+  const Node repeat = n.at("repeat");
+  if (repeat.raw().is_string()) {
+    if (repeat.string() != "infinite") repeat.fail("must be a count >= 1 or \"infinite\"");
+    l.repetitions = kInfinite;
+  } else {
+    const double r = repeat.number();
+    if (r < 1.0 || r != std::floor(r) || r > 1e6) repeat.fail("must be a count >= 1 or \"infinite\"");
+    l.repetitions = static_cast<int>(r);
+  }
+  l.cycle = parseCycle(n.at("cycle"));
+  return l;
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot read file");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+std::string affectPath(const std::string& resourceDir, const std::string& name) {
+  return (std::filesystem::path(resourceDir) / "presets" / "affect" / (name + ".json")).string();
+}
+
+constexpr int kMaxAffectNesting = 4;  // "affect" references may nest this deep (guards against cycles)
+
+Pattern parseAt(const std::string& jsonText, const std::string& sourceName, const std::string& resourceDir,
+                int nesting);
+Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, int nesting);
+
+// a layer source: inline "layers" or a reference "affect": NAME (exactly one of them)
+std::vector<Layer> parseLayerSource(const Node& n, const std::string& resourceDir, int nesting, std::string* label) {
+  if (n.has("layers") == n.has("affect")) n.fail("needs exactly one of \"layers\" or \"affect\"");
+  if (n.has("affect")) {
+    const Node a = n.at("affect");
+    const std::string name = a.string();
+    if (label) *label = name;
+    try {
+      if (nesting >= kMaxAffectNesting) throw Error("affect references nest too deep (a cycle?)");
+      return loadAffectAt(name, resourceDir, nesting + 1).layers;
+    } catch (const Error& e) {
+      a.fail(e.what());
+    }
+  }
+  const Node arr = n.at("layers");
+  if (arr.size() == 0) arr.fail("must not be empty");
+  std::vector<Layer> layers;
+  for (std::size_t i = 0; i < arr.size(); ++i) layers.push_back(parseLayer(arr[i]));
+  if (label && !layers.empty()) *label = layers.front().name;
+  return layers;
+}
+
+Pattern parseAt(const std::string& jsonText, const std::string& sourceName, const std::string& resourceDir,
+                int nesting) {
+  json j;
+  try {
+    j = json::parse(jsonText);
+  } catch (const json::parse_error& e) {
+    throw Error(sourceName + ": invalid JSON: " + e.what());
+  }
+  const Node root(j, "", sourceName);
+  root.requireKeys({"format", "version", "name", "description", "layers", "affect", "timeline"});
+
+  // header
+  const Node format = root.at("format");
+  if (format.string() != kFormatName) format.fail(std::string("must be \"") + kFormatName + "\"");
+  const Node version = root.at("version");
+  if (version.number() != kPatternFormatVersion)
+    version.fail("unsupported version " + version.raw().dump() + " (this build reads " +
+                 std::to_string(kPatternFormatVersion) + ")");
+  Pattern p;
+  p.name = root.at("name").string();
+  p.description = root.stringOr("description", "");
+  p.layers = parseLayerSource(root, resourceDir, nesting, nullptr);
+
+  // timeline of scheduled pushes, in time order
+  if (root.has("timeline")) {
+    const Node events = root.at("timeline");
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      const Node e = events[i];
+      e.requireKeys({"time_s", "switch", "label", "layers", "affect"});
+      TimelineEvent ev;
+      const Node time = e.at("time_s");
+      ev.time = time.number();
+      if (ev.time < 0.0) time.fail("must be >= 0");
+      if (!p.timeline.empty() && ev.time < p.timeline.back().time)
+        time.fail("events must be in time order (previous at " + std::to_string(p.timeline.back().time) + " s)");
+      const std::string mode = e.stringOr("switch", "immediate");
+      if (!switchModeFromName(mode, ev.mode))
+        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + mode + "\"");
+      ev.layers = parseLayerSource(e, resourceDir, nesting, &ev.label);
+      ev.label = e.stringOr("label", ev.label);
+      p.timeline.push_back(std::move(ev));
+    }
+  }
+  return p;
+}
+
+Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, int nesting) {
+  const std::vector<std::string> valid = listAffects(resourceDir);
+  if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
+    std::string list;
+    for (const std::string& v : valid) list += (list.empty() ? "" : ", ") + v;
+    throw Error("unknown affect '" + name + "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) +
+                ")");
+  }
+  const std::string path = affectPath(resourceDir, name);
+  return parseAt(readText(path), std::filesystem::path(path).filename().string(), resourceDir, nesting);
+}
+
+}  // namespace
+
+Pattern parsePattern(const std::string& jsonText, const std::string& sourceName, const std::string& resourceDir) {
+  return parseAt(jsonText, sourceName, resourceDir, 0);
+}
+
+Pattern loadPatternFile(const std::string& path, const std::string& resourceDir) {
+  return parseAt(readText(path), path, resourceDir, 0);
+}
+
+std::vector<std::string> listAffects(const std::string& resourceDir) {
+  std::vector<std::string> names;
+  const std::filesystem::path dir = std::filesystem::path(resourceDir) / "presets" / "affect";
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+    if (entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+Pattern loadAffect(const std::string& name, const std::string& resourceDir) {
+  return loadAffectAt(name, resourceDir, 0);
+}
+
+LayerStack makeLayerStack(const Pattern& pattern, std::uint64_t seed) {
+  LayerStack stack(seed);
+  stack.push(pattern.layers, SwitchMode::EndOfCycle, 0.0);
+  for (const TimelineEvent& e : pattern.timeline) stack.push(e.layers, e.mode, e.time);
+  return stack;
+}
+
+}  // namespace pneuma::sim::pattern
