@@ -1,0 +1,128 @@
+// The pattern controller's feedback law on a first-order lung plant (no physics model needed).
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/pattern/PatternController.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+using namespace pneuma::sim;
+using namespace pneuma::sim::pattern;
+
+namespace {
+
+const std::string kResources = PNEUMA_RESOURCE_DIR;
+std::size_t idx(ElementGroup g) { return static_cast<std::size_t>(g); }
+
+DriveCalibration plantCalibration() {
+  DriveCalibration c;
+  c.restVolume = 2.4e-3;  // [m^3]
+  c.gain[idx(ElementGroup::IntercostalExternal)] = 0.3;
+  c.gain[idx(ElementGroup::Diaphragm)] = 0.6;
+  c.gain[idx(ElementGroup::IntercostalInternal)] = 0.1;
+  c.gain[idx(ElementGroup::Rectus)] = 0.05;
+  c.gain[idx(ElementGroup::TransversusObliques)] = 0.05;
+  return c;
+}
+
+// a lung whose volume relaxes with time constant tau [s] towards the static response of the activations,
+// whose true gains are `gainError` times the calibrated ones; frames at 60 Hz as in Simulation
+struct Plant {
+  double tau = 0.12, gainError = 0.8, volume = 2.4e-3, time = 0.0, nextFrame = 0.0;
+  Metrics latest;
+  Activations last{};
+
+  double staticVolume(const Activations& a, const DriveCalibration& c) const {
+    double f = 0.0;
+    for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::Diaphragm})
+      f += c.gain[idx(g)] * a[idx(g)].alpha;
+    for (ElementGroup g : {ElementGroup::IntercostalInternal, ElementGroup::Rectus, ElementGroup::TransversusObliques})
+      f -= c.gain[idx(g)] * a[idx(g)].alpha;
+    return c.restVolume + gainError * f * c.volumePerFraction;
+  }
+  // runs `seconds` of control (after a 1 s settle) and returns the controller's tracking
+  void run(PatternController& ctl, double seconds, const DriveCalibration& c) {
+    const double dt = 1e-3, settle = 1.0;
+    while (time < settle + seconds) {
+      last = ctl.activations(std::max(time - settle, 0.0), latest);
+      validateActivations(last);
+      volume += dt / tau * (staticVolume(last, c) - volume);
+      time += dt;
+      if (time >= nextFrame) {
+        latest.time = time;
+        latest.lungVolume = volume;
+        nextFrame += 1.0 / 60.0;
+      }
+    }
+  }
+};
+
+}  // namespace
+
+TEST(PatternController, TracksSustainedPresetsOnALaggingMiscalibratedPlant) {
+  for (const char* affect : {"neutral", "excitement", "relaxation", "focus", "panic", "sadness"}) {
+    SCOPED_TRACE(affect);
+    const DriveCalibration c = plantCalibration();
+    auto ctl = makeAffectController(affect, kResources, 1, c);
+    Plant plant;
+    plant.run(*ctl, 30.0, c);
+    EXPECT_GT(ctl->tracking().frames, 1700);
+    EXPECT_LT(ctl->tracking().rmsPercentOfPeakToPeak(), 10.0);
+    RecordProperty(std::string("rms_pct_") + affect, std::to_string(ctl->tracking().rmsPercentOfPeakToPeak()));
+    EXPECT_NEAR(ctl->measuredFraction(), ctl->targetFraction(), 0.05);
+  }
+}
+
+TEST(PatternController, BalanceSplitsTheDriveBetweenChestAndBelly) {
+  // mean alpha of intercostals vs diaphragm over the run: focus/panic chest, relaxation belly
+  auto chestShare = [](const char* affect) {
+    const DriveCalibration c = plantCalibration();
+    auto ctl = makeAffectController(affect, kResources, 1, c);
+    Plant plant;
+    double chest = 0.0, belly = 0.0;
+    for (int k = 0; k < 20; ++k) {
+      plant.run(*ctl, 0.5 * (k + 1), c);
+      chest += plant.last[idx(ElementGroup::IntercostalExternal)].alpha * c.gain[idx(ElementGroup::IntercostalExternal)];
+      belly += plant.last[idx(ElementGroup::Diaphragm)].alpha * c.gain[idx(ElementGroup::Diaphragm)];
+    }
+    return chest / (chest + belly);
+  };
+  EXPECT_GT(chestShare("panic"), 0.7);
+  EXPECT_GT(chestShare("focus"), 0.6);
+  EXPECT_LT(chestShare("relaxation"), 0.3);
+}
+
+TEST(PatternController, ExpiratoryMusclesWorkOnlyBelowRest) {
+  const DriveCalibration c = plantCalibration();
+  auto ctl = makeAffectController("neutral", kResources, 1, c);
+  Plant plant;
+  plant.run(*ctl, 10.0, c);
+  // quiet breathing stays above rest: the abdominal wall stays idle (at most small corrections)
+  EXPECT_LT(plant.last[idx(ElementGroup::Rectus)].alpha, 0.2);
+  // a target below rest recruits rectus and obliques (forced expiration)
+  Layer forced;
+  forced.name = "forced";
+  forced.cycle.rate = 10.0;
+  forced.cycle.depthMin = 0.0;
+  forced.cycle.depthMax = 0.05;
+  forced.cycle.balance = 0.2;
+  ctl->push({forced}, SwitchMode::Immediate);
+  double maxRectus = 0.0;
+  for (int k = 1; k <= 60; ++k) {
+    plant.run(*ctl, 10.0 + 0.1 * k, c);
+    maxRectus = std::max(maxRectus, plant.last[idx(ElementGroup::Rectus)].alpha);
+  }
+  EXPECT_GT(maxRectus, 0.3);
+}
+
+TEST(PatternController, RejectsAnUncalibratedGroup) {
+  DriveCalibration c = plantCalibration();
+  c.gain[idx(ElementGroup::Rectus)] = 0.0;
+  try {
+    makeAffectController("neutral", kResources, 1, c);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("calibration.gain.rectus"), std::string::npos) << e.what();
+  }
+}
