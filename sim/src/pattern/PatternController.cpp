@@ -82,8 +82,10 @@ double TrackingStats::rmsPercentOfPeakToPeak() const {
 
 PatternController::PatternController(LayerStack stack, DriveCalibration calibration,
                                      PatternControllerOptions options, std::string description)
-    : m_stack(std::move(stack)),
+    : m_stack(stack),
+      m_initialStack(std::move(stack)),
       m_calibration(calibration),
+      m_givenCalibration(calibration),
       m_options(options),
       m_description(std::move(description)) {
   const DriveCalibration& c = m_calibration;
@@ -110,7 +112,21 @@ double PatternController::fractionToVolume(double fraction) const {
 
 void PatternController::push(const std::vector<Layer>& playOrder, SwitchMode mode) { m_stack.push(playOrder, mode); }
 
+void PatternController::restart() {
+  m_stack = m_initialStack;
+  m_calibration = m_givenCalibration;
+  m_isControlling = false;
+  m_restVolumeSeen = 0.0;
+  m_lastTime = m_lastFrameControlTime = 0.0;
+  m_lastFrameTime = -1.0;
+  m_target = m_measured = m_error = m_integral = 0.0;
+  m_balance = m_stack.balance();
+  m_tracking = TrackingStats();
+}
+
 Activations PatternController::activations(double t, const Metrics& latest) {
+  // control time going backwards means the simulation was reset: start the pattern over
+  if (t < m_lastTime) restart();
   // settling (t = 0): hold the rest posture and learn the rest volume unless it was given
   if (!m_isControlling && t <= 0.0) {
     if (latest.lungVolume > 0.0 && m_calibration.restVolume == 0.0) m_restVolumeSeen = latest.lungVolume;

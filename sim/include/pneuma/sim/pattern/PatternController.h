@@ -78,6 +78,7 @@ class PatternController : public Controller {
   PatternController(LayerStack stack, DriveCalibration calibration, PatternControllerOptions options = {},
                     std::string description = "pattern");
 
+  /// Control time going backwards (Simulation::reset()) restarts the pattern from its initial stack.
   Activations activations(double t, const Metrics& latest) override;
   std::string describe() const override;
   std::unique_ptr<Controller> clone() const override;
@@ -99,9 +100,12 @@ class PatternController : public Controller {
 
  private:
   Activations distribute(double drive, double balance) const;  // drive u and balance b -> alphas
+  void restart();                                               // back to the state at construction
 
   LayerStack m_stack;
+  LayerStack m_initialStack;       // for restart()
   DriveCalibration m_calibration;
+  DriveCalibration m_givenCalibration;  // as passed in (restVolume may be learned later)
   PatternControllerOptions m_options;
   std::string m_description;
   bool m_isControlling = false;   // false during settling (t = 0 calls)
