@@ -4,6 +4,9 @@
 /// Exit codes: 0 success, 1 a check or run failed (e.g. `validate` with a failing check),
 /// 2 bad usage or bad input (unknown option, missing model, unwritable output, invalid scenario).
 
+#include "Commands.h"
+#include "ModelCommand.h"
+
 #include <CLI/CLI.hpp>
 
 #include <iostream>
@@ -36,6 +39,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Pneuma headless: simulate breathing, export data and plots, validate against the papers.",
                "pneuma-cli"};
   app.set_version_flag("--version", std::string("pneuma-cli ") + PNEUMA_VERSION, "Print the version and exit");
+  pneuma::app::addSimulateCommand(app);
+  pneuma::app::addModelCommand(app);
   app.footer("Run 'pneuma-cli SUBCOMMAND --help' for the options of a subcommand. Docs: docs/cli.md");
 
   try {

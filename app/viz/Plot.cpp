@@ -327,9 +327,21 @@ std::vector<Plot::Primitive> Plot::layout() const {
   double yTickWidth = 0.0;
   for (double t : yticks) yTickWidth = std::max(yTickWidth, textWidth(tickLabel(t, ystep), tickSize));
 
+  // legend entries; more than five go outside, to the right of the plot box
+  std::vector<const Series*> entries;
+  for (const Series& s : m_series)
+    if (!s.label.empty()) entries.push_back(&s);
+  for (const Series& s : m_references)
+    if (!s.label.empty()) entries.push_back(&s);
+  const bool hasLegend = entries.size() > 1 || !m_references.empty();
+  double legendTextWidth = 0.0;
+  for (const Series* s : entries) legendTextWidth = std::max(legendTextWidth, textWidth(s->label, legendSize));
+  const double legendW = legendTextWidth + 52.0;
+  const bool isLegendOutside = hasLegend && entries.size() > 5;
+
   // plot box from the margins the labels need
   const double left = 14.0 + labelSize + 10.0 + yTickWidth + 8.0;
-  const double right = m_width - 24.0;
+  const double right = m_width - 24.0 - (isLegendOutside ? legendW + 4.0 : 0.0);
   const double top = 16.0 + titleSize + 12.0;
   const double bottom = m_height - (14.0 + labelSize + 10.0 + tickSize + 8.0);
   auto mapX = [&](double x) { return left + (x - xlo) / (xhi - xlo) * (right - left); };
@@ -401,17 +413,11 @@ std::vector<Plot::Primitive> Plot::layout() const {
   text((left + right) / 2.0, m_height - 14.0, m_xLabel, labelSize, P::Anchor::Middle, false);
   text(14.0 + labelSize, (top + bottom) / 2.0, m_yLabel, labelSize, P::Anchor::Middle, true);
 
-  // legend in the top-right corner of the plot box
-  std::vector<const Series*> entries;
-  for (const Series& s : m_series)
-    if (!s.label.empty()) entries.push_back(&s);
-  for (const Series& s : m_references)
-    if (!s.label.empty()) entries.push_back(&s);
-  if (entries.size() > 1 || !m_references.empty()) {
-    double w = 0.0;
-    for (const Series* s : entries) w = std::max(w, textWidth(s->label, legendSize));
-    const double rowH = legendSize + 6.0, boxW = w + 52.0, boxH = rowH * entries.size() + 10.0;
-    const double bx = std::round(right - boxW - 10.0) + 0.5, by = std::round(top + 10.0) + 0.5;
+  // legend in the top-right corner of the plot box, or right of it
+  if (hasLegend) {
+    const double rowH = legendSize + 6.0, boxW = legendW, boxH = rowH * entries.size() + 10.0;
+    const double bx = std::round(isLegendOutside ? right + 12.0 : right - boxW - 10.0) + 0.5;
+    const double by = std::round(isLegendOutside ? top : top + 10.0) + 0.5;
     P box;
     box.kind = P::Kind::Rect;
     box.xy = {bx, by, boxW, boxH};

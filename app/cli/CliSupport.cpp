@@ -1,0 +1,67 @@
+#include "CliSupport.h"
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace fs = std::filesystem;
+
+namespace pneuma::app {
+
+void fail(int code, const std::string& message) {
+  std::cerr << "pneuma-cli: error: " << message << "\n";
+  throw CLI::RuntimeError(code);
+}
+
+std::string resolveModelDir(const std::string& requested) {
+  std::string dir = requested;
+  if (dir.empty()) {
+    if (const char* env = std::getenv("PNEUMA_MODEL_DIR"); env != nullptr && *env != '\0') {
+      dir = env;
+    } else {
+      std::error_code ec;
+      const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+      dir = ((ec ? fs::path(".") : exe.parent_path()) / ".." / "models" / "default").lexically_normal().string();
+    }
+  }
+  if (!fs::is_directory(dir))
+    fail(kExitBadInput, "model directory '" + dir + "' does not exist (build the default model or pass --model DIR)");
+  if (!fs::is_regular_file(fs::path(dir) / "model.json"))
+    fail(kExitBadInput, "model directory '" + dir + "' has no model.json");
+  return dir;
+}
+
+std::string resourceDir() {
+  if (const char* env = std::getenv("PNEUMA_RESOURCE_DIR"); env != nullptr && *env != '\0') return env;
+  return PNEUMA_RESOURCE_DIR;
+}
+
+void prepareOutputDir(const std::string& dir) {
+  if (dir.empty()) fail(kExitBadInput, "--out: must not be empty");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) fail(kExitBadInput, "--out: cannot create directory '" + dir + "'" + (ec ? ": " + ec.message() : ""));
+  // probe: can we create a file there?
+  const fs::path probe = fs::path(dir) / (".pneuma-write-test-" + std::to_string(static_cast<long>(getpid())));
+  {
+    std::ofstream out(probe);
+    if (!out) fail(kExitBadInput, "--out: directory '" + dir + "' is not writable");
+  }
+  fs::remove(probe, ec);
+}
+
+std::string formatNumber(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+}  // namespace pneuma::app

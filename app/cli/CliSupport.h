@@ -1,0 +1,35 @@
+#pragma once
+/// @file CliSupport.h
+/// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
+/// resources, preparing output directories, number formatting for JSON/CSV.
+
+#include <string>
+
+namespace pneuma::app {
+
+/// Exit codes of pneuma-cli (docs/cli.md).
+enum ExitCode : int {
+  kExitOk = 0,        ///< success
+  kExitFailed = 1,    ///< the run or a check failed (validate with a failing check, simulation blow-up)
+  kExitBadInput = 2,  ///< bad usage or input: unknown option/name, missing model, unwritable --out, bad value
+  kExitInterrupted = 130  ///< stopped by SIGINT (outputs written, summary marked partial)
+};
+
+/// Prints "pneuma-cli: error: <message>" on stderr and ends the subcommand with `code`
+/// (throws CLI::RuntimeError, which main() turns into the exit code).
+[[noreturn]] void fail(int code, const std::string& message);
+
+/// The model directory to use: `requested` when given, else $PNEUMA_MODEL_DIR, else
+/// <directory of pneuma-cli>/../models/default. Fails with kExitBadInput when it has no model.json.
+std::string resolveModelDir(const std::string& requested);
+
+/// The resource directory (presets, scenarios): $PNEUMA_RESOURCE_DIR when set, else the source tree's resources/.
+std::string resourceDir();
+
+/// Creates `dir` (and parents) and checks that a file can be written in it; fails with kExitBadInput otherwise.
+void prepareOutputDir(const std::string& dir);
+
+/// Shortest round-trip text of a double for CSV/JSON ("%.9g"); "nan" never appears: non-finite gives "".
+std::string formatNumber(double v);
+
+}  // namespace pneuma::app

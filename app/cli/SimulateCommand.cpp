@@ -1,0 +1,232 @@
+/// @file SimulateCommand.cpp
+/// `pneuma-cli simulate`: one run of a breath style, an affect, a pattern file or a scenario file.
+
+#include "CliSupport.h"
+#include "Commands.h"
+#include "Progress.h"
+#include "RunRecord.h"
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/pattern/PatternController.h"
+#include "viz/AtomicFile.h"
+#include "viz/VtkSeriesWriter.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <functional>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace pneuma::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Command-line settings; `isGiven` tells which numeric ones were on the command line (the others keep
+/// the scenario's or the default value).
+struct SimulateArgs {
+  std::string model;
+  std::string style, affect, scenario, pattern;
+  double duration = 0.0;    // [s]
+  std::string out;
+  double outputRate = 0.0;  // [Hz]
+  bool vtk = false;
+  std::uint64_t seed = 0;
+  std::string integrator;
+  double dt = 0.0;          // [s]
+  double settle = 0.0;      // [s]
+  std::function<bool(const char*)> isGiven;
+};
+
+/// The scenario to run: the --scenario file (if any) with the command-line settings applied on top.
+sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
+  sim::Scenario s;
+  if (!a.scenario.empty()) {
+    try {
+      s = sim::loadScenario(a.scenario);
+    } catch (const sim::Error& e) {
+      fail(kExitBadInput, e.what());
+    }
+  }
+  const int given = !a.style.empty() + !a.affect.empty() + !a.pattern.empty() + !a.scenario.empty();
+  if (given != 1) fail(kExitBadInput, "give exactly one of --style, --affect, --pattern or --scenario");
+  if (!a.style.empty()) s.controller = sim::ControllerKind::Style, s.controllerName = a.style;
+  if (!a.affect.empty()) s.controller = sim::ControllerKind::Affect, s.controllerName = a.affect;
+  if (!a.pattern.empty()) s.controller = sim::ControllerKind::Pattern, s.controllerName = a.pattern;
+  if (s.name.empty()) s.name = s.controllerName.empty() ? "run" : fs::path(s.controllerName).stem().string();
+
+  if (a.isGiven("--duration")) {
+    if (!(a.duration > 0.0) || !std::isfinite(a.duration))
+      fail(kExitBadInput, "--duration: must be > 0 s, got " + formatNumber(a.duration));
+    s.duration = a.duration;
+  }
+  if (a.scenario.empty() && !a.isGiven("--duration")) fail(kExitBadInput, "--duration is required (simulated seconds)");
+  if (a.isGiven("--output-rate")) {
+    if (!(a.outputRate > 0.0)) fail(kExitBadInput, "--output-rate: must be > 0 Hz, got " + formatNumber(a.outputRate));
+    s.outputs.outputRate = a.outputRate;
+    s.options.outputRate = a.outputRate;
+  }
+  if (a.vtk) s.outputs.vtk = true;
+  if (a.isGiven("--seed")) s.seed = a.seed;
+  if (!a.integrator.empty() && !sim::integratorFromName(a.integrator, s.options.step.integrator))
+    fail(kExitBadInput, "--integrator: unknown integrator '" + a.integrator + "' (valid: symplectic-euler, implicit-euler)");
+  if (a.isGiven("--dt")) {
+    if (!(a.dt > 0.0)) fail(kExitBadInput, "--dt: must be > 0 s, got " + formatNumber(a.dt));
+    s.options.dt = a.dt;
+  }
+  if (a.isGiven("--settle")) {
+    if (!(a.settle >= 0.0)) fail(kExitBadInput, "--settle: must be >= 0 s, got " + formatNumber(a.settle));
+    s.options.settleTime = a.settle;
+  }
+  try {
+    sim::validateSimulationOptions(s.options);
+  } catch (const sim::Error& e) {
+    fail(kExitBadInput, e.what());
+  }
+  return s;
+}
+
+/// A JSON number, or null when not finite.
+nlohmann::json jsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+void runSimulate(const SimulateArgs& args) {
+  const sim::Scenario scenario = scenarioFromArgs(args);
+  const std::string modelDir =
+      resolveModelDir(!args.model.empty() ? args.model : scenario.model == "default" ? "" : scenario.model);
+  prepareOutputDir(args.out);
+
+  // model, controller and simulation: any bad input is reported by name before anything runs
+  std::shared_ptr<const sim::Model> model;
+  std::unique_ptr<sim::Controller> controller;
+  std::unique_ptr<sim::Simulation> simulation;
+  try {
+    model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
+    controller = sim::makeController(scenario, model, resourceDir());
+    simulation = std::make_unique<sim::Simulation>(model, std::move(controller), scenario.options);
+  } catch (const sim::Error& e) {
+    // a controller given on the command line is named by its flag, not by its scenario-file path
+    std::string message = e.what();
+    const std::string field = std::string("controller.") + sim::controllerKindName(scenario.controller) + ": ";
+    if (args.scenario.empty() && message.rfind(field, 0) == 0)
+      message = std::string("--") + sim::controllerKindName(scenario.controller) + ": " + message.substr(field.size());
+    fail(kExitBadInput, message);
+  }
+  const bool hasTarget = scenario.controller != sim::ControllerKind::Style;
+  const std::string controllerText = simulation->controller().describe();
+
+  // run, recording every output frame; Ctrl-C stops at the next frame
+  RunRecord record(*model, hasTarget);
+  std::unique_ptr<viz::VtkSeriesWriter> vtk;
+  if (scenario.outputs.vtk) vtk = std::make_unique<viz::VtkSeriesWriter>(*model, modelDir, args.out, "frames");
+  const double total = scenario.options.settleTime + scenario.duration;  // [s]
+  std::string blowUp;
+  bool isInterrupted = false;
+  {
+    InterruptGuard guard;
+    ProgressBar bar(scenario.name, total);
+    try {
+      simulation->advance(total, [&](const sim::Simulation& s) {
+        const auto* pattern = dynamic_cast<const sim::pattern::PatternController*>(&s.controller());
+        if (pattern != nullptr) record.append(s.latestMetrics(), pattern->targetFraction(), pattern->measuredFraction());
+        else record.append(s.latestMetrics());
+        if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());
+        bar.update(s.state().time);
+        return !InterruptGuard::isInterrupted();
+      });
+    } catch (const sim::Error& e) {
+      blowUp = e.what();
+    }
+    bar.finish();
+    isInterrupted = InterruptGuard::isInterrupted();
+  }
+
+  // outputs, each through a temporary file and a rename
+  std::vector<std::string> files;
+  if (scenario.outputs.csv) {
+    record.writeCsv(args.out + "/timeseries.csv");
+    files.push_back("timeseries.csv");
+  }
+  if (scenario.outputs.plots && record.size() > 0) {
+    for (const std::string& f : record.writePlots(args.out, scenario.name)) files.push_back(f);
+  }
+  if (vtk) files.push_back(vtk->finish());
+
+  const sim::Summary sum = simulation->summary();
+  nlohmann::json j;
+  j["pneuma_version"] = PNEUMA_VERSION;
+  j["model"] = modelDir;
+  j["model_name"] = model->name;
+  j["scenario"] = scenario.name;
+  j["controller"] = controllerText;
+  j["controller_kind"] = sim::controllerKindName(scenario.controller);
+  j["integrator"] = sim::integratorName(simulation->options().step.integrator);
+  j["dt_s"] = simulation->dt();
+  j["steps"] = sum.steps;
+  j["seed"] = scenario.seed;
+  j["settle_time_s"] = scenario.options.settleTime;
+  j["duration_s"] = scenario.duration;
+  j["simulated_time_s"] = simulation->state().time;
+  j["partial"] = isInterrupted || !blowUp.empty();
+  j["interrupted"] = isInterrupted;
+  j["error"] = blowUp.empty() ? nlohmann::json(nullptr) : nlohmann::json(blowUp);
+  j["real_time_factor"] = jsonNumber(sum.realTimeFactor);
+  j["tidal_volume_ml"] = jsonNumber(sum.tidalVolume * 1e6);
+  j["breaths_per_minute"] = jsonNumber(sum.breathsPerMinute);
+  j["cycles"] = sum.cycles;
+  j["end_expiratory_volume_ml"] = jsonNumber(sum.endExpiratoryVolume * 1e6);
+  j["end_inspiratory_volume_ml"] = jsonNumber(sum.endInspiratoryVolume * 1e6);
+  j["max_gut_volume_error_pct"] = jsonNumber(sum.maxGutVolumeError * 100.0);
+  j["mean_gut_volume_error_pct"] = jsonNumber(sum.meanGutVolumeError * 100.0);
+  j["diaphragm_apex_excursion_mm"] = jsonNumber(sum.diaphragmApexExcursion * 1e3);
+  j["xiphoid_excursion_mm"] = jsonNumber(sum.xiphoidExcursion * 1e3);
+  j["umbilicus_excursion_mm"] = jsonNumber(sum.umbilicusExcursion * 1e3);
+  const auto* pattern = dynamic_cast<const sim::pattern::PatternController*>(&simulation->controller());
+  j["tracking_rms_pct"] = pattern != nullptr ? jsonNumber(pattern->tracking().rmsPercentOfPeakToPeak()) : nlohmann::json(nullptr);
+  j["measured_from_s"] = sum.measuredFrom;
+  j["frames"] = record.size();
+  j["files"] = files;
+  viz::writeFileAtomically(args.out + "/summary.json", j.dump(2) + "\n");
+
+  // a short human-readable report on stdout
+  std::printf("%s: %s%s\n", scenario.name.c_str(), controllerText.c_str(),
+              isInterrupted ? " (interrupted, partial results)" : "");
+  std::printf("  tidal volume %.0f mL, %.1f breaths/min, max gut volume error %.3f %%, real-time factor %.2f\n",
+              sum.tidalVolume * 1e6, sum.breathsPerMinute, sum.maxGutVolumeError * 100.0, sum.realTimeFactor);
+  std::printf("  wrote %s/summary.json and %zu more files\n", args.out.c_str(), files.size());
+  if (!blowUp.empty()) fail(kExitFailed, blowUp);
+  if (isInterrupted) throw CLI::RuntimeError(kExitInterrupted);
+}
+
+}  // namespace
+
+void addSimulateCommand(CLI::App& app) {
+  auto args = std::make_shared<SimulateArgs>();
+  CLI::App* cmd = app.add_subcommand("simulate", "Simulate breathing; write timeseries.csv, summary.json and plots");
+  cmd->add_option("--model", args->model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+  auto* style = cmd->add_option("--style", args->style, "Breath style preset (calm, deep, panting, forced-exhale)");
+  auto* affect = cmd->add_option("--affect", args->affect, "Affect preset (neutral, startle, ... see docs/cli.md)");
+  auto* scenario = cmd->add_option("--scenario", args->scenario, "Scenario file (JSON); other options override it");
+  auto* pattern = cmd->add_option("--pattern", args->pattern, "Pattern file (JSON, docs/patterns.md)");
+  style->excludes(affect)->excludes(pattern);
+  affect->excludes(pattern);
+  (void)scenario;
+  cmd->add_option("--duration", args->duration, "Simulated seconds after the settling phase (> 0)");
+  cmd->add_option("--out", args->out, "Output directory (created if missing)")->required();
+  cmd->add_option("--output-rate", args->outputRate, "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
+  cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
+  cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams (default 0)");
+  cmd->add_option("--integrator", args->integrator, "symplectic-euler or implicit-euler (default implicit-euler)");
+  cmd->add_option("--dt", args->dt, "Time step [s] (default: the integrator's default)");
+  cmd->add_option("--settle", args->settle, "Settling time before the controller starts [s] (default 2)");
+  args->isGiven = [cmd](const char* flag) { return cmd->count(flag) > 0; };
+  cmd->callback([args] { runSimulate(*args); });
+}
+
+}  // namespace pneuma::app

@@ -1,0 +1,256 @@
+#include "viz/VtkSeriesWriter.h"
+
+#include "viz/AtomicFile.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIdList.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkXMLPolyDataReader.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace pneuma::viz {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity"};
+
+vtkSmartPointer<vtkDoubleArray> scalarArray(const char* name, int components, vtkIdType tuples) {
+  auto a = vtkSmartPointer<vtkDoubleArray>::New();
+  a->SetName(name);
+  a->SetNumberOfComponents(components);
+  a->SetNumberOfTuples(tuples);
+  return a;
+}
+
+vtkSmartPointer<vtkCellArray> triangles(const Eigen::Matrix3Xi& tri) {
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  for (Eigen::Index f = 0; f < tri.cols(); ++f) {
+    const vtkIdType ids[3] = {tri(0, f), tri(1, f), tri(2, f)};
+    cells->InsertNextCell(3, ids);
+  }
+  return cells;
+}
+
+void setPoints(vtkPolyData* pd, const Eigen::Matrix3Xd& x) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(x.cols());
+  for (Eigen::Index i = 0; i < x.cols(); ++i) pts->SetPoint(i, x(0, i), x(1, i), x(2, i));
+  pd->SetPoints(pts);
+}
+
+void fieldValue(vtkPolyData* pd, const char* name, double v) {
+  auto a = scalarArray(name, 1, 1);
+  a->SetValue(0, v);
+  pd->GetFieldData()->AddArray(a);
+}
+
+}  // namespace
+
+struct VtkSeriesWriter::Impl {
+  const sim::Model& model;
+  std::string outDir;
+  std::string baseName;
+  // bones: all body meshes appended, in body-frame coordinates, with the body of every point
+  Eigen::Matrix3Xd boneLocal;         // [m] (3 x #points)
+  std::vector<int> bonePointBody;     // (#points)
+  vtkSmartPointer<vtkCellArray> bonePolys, boneVerts;
+  vtkSmartPointer<vtkIntArray> boneBodyId;  // per cell: vertices first, then polygons (VTK's cell order)
+  std::vector<double> frameTimes;     // [s]
+
+  Impl(const sim::Model& m, const std::string& modelDir, std::string dir, std::string base)
+      : model(m), outDir(std::move(dir)), baseName(std::move(base)) {
+    std::error_code ec;
+    fs::create_directories(fs::path(outDir) / baseName, ec);
+    if (ec) throw std::runtime_error("cannot create " + (fs::path(outDir) / baseName).string() + ": " + ec.message());
+    bonePolys = vtkSmartPointer<vtkCellArray>::New();
+    boneVerts = vtkSmartPointer<vtkCellArray>::New();
+    std::vector<int> vertBody, polyBody;
+    std::vector<Eigen::Vector3d> local;
+    for (int b = 0; b < model.bodies.size(); ++b) {
+      const std::string& file = model.bodies.mesh[static_cast<std::size_t>(b)];
+      const vtkIdType base0 = static_cast<vtkIdType>(local.size());
+      if (file.empty()) {
+        // no mesh: one vertex at the com (body-frame origin)
+        local.emplace_back(Eigen::Vector3d::Zero());
+        bonePointBody.push_back(b);
+        boneVerts->InsertNextCell(1, &base0);
+        vertBody.push_back(b);
+        continue;
+      }
+      const std::string path = (fs::path(modelDir) / file).string();
+      vtkNew<vtkXMLPolyDataReader> reader;
+      reader->SetFileName(path.c_str());
+      if (!fs::is_regular_file(path) || (reader->Update(), reader->GetErrorCode() != 0))
+        throw sim::Error("bodies." + model.bodies.name[static_cast<std::size_t>(b)] + ".mesh: cannot read " + path);
+      vtkPolyData* mesh = reader->GetOutput();
+      for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p) {
+        double q[3];
+        mesh->GetPoint(p, q);
+        local.emplace_back(q[0], q[1], q[2]);
+        bonePointBody.push_back(b);
+      }
+      vtkCellArray* polys = mesh->GetPolys();
+      polys->InitTraversal();
+      vtkNew<vtkIdList> ids;
+      while (polys->GetNextCell(ids)) {
+        std::vector<vtkIdType> shifted(static_cast<std::size_t>(ids->GetNumberOfIds()));
+        for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) shifted[static_cast<std::size_t>(k)] = ids->GetId(k) + base0;
+        bonePolys->InsertNextCell(static_cast<vtkIdType>(shifted.size()), shifted.data());
+        polyBody.push_back(b);
+      }
+    }
+    boneBodyId = vtkSmartPointer<vtkIntArray>::New();
+    boneBodyId->SetName("body_id");
+    for (int b : vertBody) boneBodyId->InsertNextValue(b);
+    for (int b : polyBody) boneBodyId->InsertNextValue(b);
+    boneLocal.resize(3, static_cast<Eigen::Index>(local.size()));
+    for (std::size_t i = 0; i < local.size(); ++i) boneLocal.col(static_cast<Eigen::Index>(i)) = local[i];
+  }
+
+  std::string partPath(int part, int frame) const {
+    char name[64];
+    std::snprintf(name, sizeof name, "%s_%06d.vtp", kPartNames[part], frame);
+    return baseName + "/" + name;
+  }
+
+  void write(vtkPolyData* pd, const std::string& relative) const {
+    const std::string path = (fs::path(outDir) / relative).string();
+    const std::string tmp = temporaryPathFor(path);
+    vtkNew<vtkXMLPolyDataWriter> writer;
+    writer->SetInputData(pd);
+    writer->SetFileName(tmp.c_str());
+    writer->SetDataModeToAppended();
+    if (writer->Write() != 1) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error("cannot write " + path);
+    }
+    commitTemporary(tmp, path);
+  }
+
+  vtkSmartPointer<vtkPolyData> bones(const sim::State& state) const {
+    Eigen::Matrix3Xd x(3, boneLocal.cols());
+    for (Eigen::Index i = 0; i < boneLocal.cols(); ++i) {
+      const std::size_t b = static_cast<std::size_t>(bonePointBody[static_cast<std::size_t>(i)]);
+      x.col(i) = state.bodyOrientation[b] * boneLocal.col(i) + state.bodyPosition.col(static_cast<Eigen::Index>(b));
+    }
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, x);
+    pd->SetVerts(boneVerts);
+    pd->SetPolys(bonePolys);
+    pd->GetCellData()->AddArray(boneBodyId);
+    return pd;
+  }
+
+  vtkSmartPointer<vtkPolyData> muscles(const sim::State& state, const sim::Metrics& metrics) const {
+    const sim::Elements& el = model.elements;
+    Eigen::Matrix3Xd a, b;
+    sim::anchorPositions(el.endA, state, a);
+    sim::anchorPositions(el.endB, state, b);
+    Eigen::Matrix3Xd x(3, 2 * el.size());
+    vtkNew<vtkCellArray> lines;
+    auto force = scalarArray("force_N", 1, el.size());
+    auto tension = scalarArray("tension_N", 1, el.size());
+    vtkNew<vtkIntArray> group;
+    group->SetName("group");
+    vtkNew<vtkUnsignedCharArray> slack;
+    slack->SetName("is_slack");
+    for (int e = 0; e < el.size(); ++e) {
+      x.col(2 * e) = a.col(e);
+      x.col(2 * e + 1) = b.col(e);
+      const vtkIdType ids[2] = {2 * e, 2 * e + 1};
+      lines->InsertNextCell(2, ids);
+      const double f = e < metrics.elementForce.size() ? metrics.elementForce(e) : 0.0;
+      force->SetValue(e, f);
+      tension->SetValue(e, f < 0.0 ? -f : 0.0);
+      group->InsertNextValue(static_cast<int>(el.group[static_cast<std::size_t>(e)]));
+      slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size() ? metrics.isSlack[static_cast<std::size_t>(e)] : 0);
+    }
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, x);
+    pd->SetLines(lines);
+    pd->GetCellData()->AddArray(force);
+    pd->GetCellData()->AddArray(tension);
+    pd->GetCellData()->AddArray(group);
+    pd->GetCellData()->AddArray(slack);
+    return pd;
+  }
+
+  vtkSmartPointer<vtkPolyData> gut(const sim::State& state, const sim::Metrics& metrics) const {
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, state.nodePosition);
+    pd->SetPolys(triangles(model.gut.triangles));
+    auto disp = scalarArray("displacement_m", 3, state.nodePosition.cols());
+    for (Eigen::Index i = 0; i < state.nodePosition.cols(); ++i) {
+      const Eigen::Vector3d d = state.nodePosition.col(i) - model.nodes.rest.col(i);
+      disp->SetTuple3(i, d.x(), d.y(), d.z());
+    }
+    pd->GetPointData()->AddArray(disp);
+    fieldValue(pd, "pressure_Pa", metrics.gutPressure);
+    fieldValue(pd, "volume_error", metrics.gutVolumeError);
+    return pd;
+  }
+
+  vtkSmartPointer<vtkPolyData> cavity(const sim::State& state, const sim::Metrics& metrics) const {
+    Eigen::Matrix3Xd x;
+    sim::anchorPositions(model.cavity.vertices, state, x);
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, x);
+    pd->SetPolys(triangles(model.cavity.triangles));
+    fieldValue(pd, "lung_volume_m3", metrics.lungVolume);
+    return pd;
+  }
+};
+
+VtkSeriesWriter::VtkSeriesWriter(const sim::Model& model, const std::string& modelDir, const std::string& outDir,
+                                 const std::string& baseName)
+    : m_impl(std::make_unique<Impl>(model, modelDir, outDir, baseName)) {}
+
+VtkSeriesWriter::~VtkSeriesWriter() = default;
+
+void VtkSeriesWriter::writeFrame(const sim::State& state, const sim::Metrics& metrics) {
+  const int frame = static_cast<int>(m_impl->frameTimes.size());
+  m_impl->write(m_impl->bones(state), m_impl->partPath(0, frame));
+  m_impl->write(m_impl->muscles(state, metrics), m_impl->partPath(1, frame));
+  m_impl->write(m_impl->gut(state, metrics), m_impl->partPath(2, frame));
+  m_impl->write(m_impl->cavity(state, metrics), m_impl->partPath(3, frame));
+  m_impl->frameTimes.push_back(state.time);
+}
+
+std::string VtkSeriesWriter::finish() {
+  std::ostringstream pvd;
+  pvd.precision(9);
+  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "  <Collection>\n";
+  for (std::size_t f = 0; f < m_impl->frameTimes.size(); ++f)
+    for (int part = 0; part < 4; ++part)
+      pvd << "    <DataSet timestep=\"" << m_impl->frameTimes[f] << "\" group=\"\" part=\"" << part << "\" name=\""
+          << kPartNames[part] << "\" file=\"" << m_impl->partPath(part, static_cast<int>(f)) << "\"/>\n";
+  pvd << "  </Collection>\n</VTKFile>\n";
+  const std::string name = m_impl->baseName + ".pvd";
+  writeFileAtomically((fs::path(m_impl->outDir) / name).string(), pvd.str());
+  return name;
+}
+
+int VtkSeriesWriter::frameCount() const { return static_cast<int>(m_impl->frameTimes.size()); }
+
+}  // namespace pneuma::viz

@@ -1,0 +1,82 @@
+#pragma once
+/// @file Scenario.h
+/// Scenario files: a versioned JSON description of one simulation run (model, duration, controller,
+/// parameter overrides, outputs, seed), shared by pneuma-cli (`simulate --scenario`) and the desktop app
+/// (open/save). Format: docs/cli.md, "Scenario files"; examples in resources/scenarios/.
+///
+///   {
+///     "format": "pneuma-scenario", "version": 1,
+///     "name": "calm-30s", "description": "...",
+///     "model": "default",                         // or a model directory, relative to the scenario file
+///     "duration_s": 30, "seed": 1,
+///     "controller": {"style": "calm"},            // or {"affect": "startle"}, or {"pattern": "file.json"},
+///                                                 // or {"pattern": { ...inline pattern file... }}
+///     "overrides": {"integrator": "implicit-euler", "dt_s": 0.002, "settle_time_s": 2,
+///                   "gravity": true, "joint_friction_scale": 1, "kappa_pa": 2e4,
+///                   "active_gain_scale": {"diaphragm": 1.1}, "passive_gain_scale": {"cartilage": 2}},
+///     "outputs": {"output_rate_hz": 60, "csv": true, "plots": true, "vtk": false}
+///   }
+
+#include "pneuma/sim/Simulation.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace pneuma::sim {
+
+/// Current scenario-file format version written by serializeScenario(); parseScenario() reads it.
+constexpr int kScenarioFormatVersion = 1;
+
+/// What drives the muscles.
+enum class ControllerKind { Style, Affect, Pattern };
+
+/// Stable names "style", "affect", "pattern".
+const char* controllerKindName(ControllerKind k);
+
+/// Which files a run writes.
+struct ScenarioOutputs {
+  double outputRate = 60.0;  ///< [Hz] frames per simulated second in CSV/plots/VTK, > 0
+  bool csv = true;           ///< timeseries.csv
+  bool plots = true;         ///< PNG + SVG plots
+  bool vtk = false;          ///< .pvd series of .vtp frames
+};
+
+/// One run.
+struct Scenario {
+  std::string name;                 ///< short identifier
+  std::string description;          ///< free text
+  std::string model = "default";    ///< "default" (the built default model) or a model directory path
+  double duration = 0.0;            ///< [s] simulated time after the settling phase, > 0
+  std::uint64_t seed = 0;           ///< seed of the pattern irregularity streams
+  ControllerKind controller = ControllerKind::Style;
+  std::string controllerName;       ///< Style: preset name; Affect: affect name; Pattern: pattern file path ("" when inline)
+  std::string patternText;          ///< Pattern given inline: the pattern file's JSON text ("" otherwise)
+  SimulationOptions options;        ///< overrides: step options, dt, settle time (outputRate mirrors outputs.outputRate)
+  ScenarioOutputs outputs;
+};
+
+/// Parses the text of a scenario file. Relative "model" and "pattern" paths are resolved against
+/// `baseDir` (the scenario file's directory). Checks every field's type and range, the integrator and
+/// group names; the style, affect or pattern itself is checked when the controller is made.
+/// @throws Error "<sourceName>: <json path>: <reason>", e.g. "run.json: overrides.dt_s: must be > 0, got -1".
+Scenario parseScenario(const std::string& jsonText, const std::string& sourceName, const std::string& baseDir);
+
+/// Reads and parses a scenario file. @throws Error as parseScenario(), or when the file cannot be read.
+Scenario loadScenario(const std::string& path);
+
+/// The JSON text of a scenario (all fields written). Deterministic.
+std::string serializeScenario(const Scenario& scenario);
+
+/// The controller a scenario asks for: a BreathStyleController for a style (presets in
+/// `resourceDir`/presets), or a pattern::PatternController for an affect (`resourceDir`/presets/affect)
+/// or a pattern, seeded with `scenario.seed` and calibrated on `model` with pattern::calibrateDrive()
+/// (a few simulated seconds per muscle group) under `scenario.options`.
+/// @throws Error "controller.<kind>: <reason>", listing the valid names for an unknown style or affect.
+std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,
+                                           const std::string& resourceDir);
+
+/// Writes serializeScenario() to `path` through a temporary file and a rename. @throws Error on I/O failure.
+void saveScenario(const Scenario& scenario, const std::string& path);
+
+}  // namespace pneuma::sim

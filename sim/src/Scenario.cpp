@@ -1,0 +1,276 @@
+#include "pneuma/sim/Scenario.h"
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/pattern/PatternController.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+namespace pneuma::sim {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kFormatName = "pneuma-scenario";
+
+// a JSON value with its path, so every error names the failing field
+class Field {
+ public:
+  Field(const json& j, std::string path, const std::string& source) : m_j(j), m_path(std::move(path)), m_source(source) {}
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw Error(m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
+  }
+  // rejects keys outside `allowed` (typos must not be silently ignored)
+  void allowKeys(std::initializer_list<const char*> allowed) const {
+    if (!m_j.is_object()) fail("must be an object");
+    for (auto it = m_j.begin(); it != m_j.end(); ++it) {
+      bool isKnown = false;
+      for (const char* k : allowed) isKnown = isKnown || it.key() == k;
+      if (!isKnown) child(it.key()).fail("unknown field");
+    }
+  }
+  bool has(const char* key) const { return m_j.contains(key); }
+  Field child(const std::string& key) const { return Field(m_j.at(key), m_path.empty() ? key : m_path + "." + key, m_source); }
+  Field at(const char* key) const {
+    if (!has(key)) Field(m_j, m_path.empty() ? key : m_path + "." + key, m_source).fail("missing");
+    return child(key);
+  }
+  const json& raw() const { return m_j; }
+
+  double number() const {
+    if (!m_j.is_number()) fail("must be a number, got " + m_j.dump());
+    const double v = m_j.get<double>();
+    if (!std::isfinite(v)) fail("must be finite");
+    return v;
+  }
+  double positive() const {
+    const double v = number();
+    if (v <= 0.0) fail("must be > 0, got " + m_j.dump());
+    return v;
+  }
+  double nonNegative() const {
+    const double v = number();
+    if (v < 0.0) fail("must be >= 0, got " + m_j.dump());
+    return v;
+  }
+  std::string string() const {
+    if (!m_j.is_string()) fail("must be a string, got " + m_j.dump());
+    return m_j.get<std::string>();
+  }
+  bool boolean() const {
+    if (!m_j.is_boolean()) fail("must be true or false, got " + m_j.dump());
+    return m_j.get<bool>();
+  }
+
+ private:
+  const json& m_j;
+  std::string m_path;
+  const std::string& m_source;
+};
+
+std::string resolve(const std::string& path, const std::string& baseDir) {
+  if (path.empty() || fs::path(path).is_absolute() || baseDir.empty()) return path;
+  return (fs::path(baseDir) / path).lexically_normal().string();
+}
+
+// {"diaphragm": 1.2, ...} -> per-group scale factors (>= 0)
+void parseGroupScales(const Field& f, std::array<double, kElementGroupCount>& out) {
+  if (!f.raw().is_object()) f.fail("must be an object of group names to scale factors");
+  for (auto it = f.raw().begin(); it != f.raw().end(); ++it) {
+    ElementGroup g;
+    if (!groupFromName(it.key(), g)) {
+      std::string valid;
+      for (int i = 0; i < kElementGroupCount; ++i) valid += std::string(i ? ", " : "") + groupName(static_cast<ElementGroup>(i));
+      f.child(it.key()).fail("unknown muscle group (valid: " + valid + ")");
+    }
+    out[static_cast<std::size_t>(g)] = f.child(it.key()).nonNegative();
+  }
+}
+
+void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
+  c.allowKeys({"style", "affect", "pattern"});
+  const int count = c.has("style") + c.has("affect") + c.has("pattern");
+  if (count != 1) c.fail("needs exactly one of \"style\", \"affect\" or \"pattern\"");
+  if (c.has("style")) {
+    s.controller = ControllerKind::Style;
+    s.controllerName = c.at("style").string();
+  } else if (c.has("affect")) {
+    s.controller = ControllerKind::Affect;
+    s.controllerName = c.at("affect").string();
+  } else {
+    s.controller = ControllerKind::Pattern;
+    const Field p = c.at("pattern");
+    if (p.raw().is_string()) s.controllerName = resolve(p.string(), baseDir);
+    else if (p.raw().is_object()) s.patternText = p.raw().dump(2);
+    else p.fail("must be a pattern file path or an inline pattern object");
+  }
+  if (s.controller != ControllerKind::Pattern && s.controllerName.empty())
+    c.at(controllerKindName(s.controller)).fail("must not be empty");
+}
+
+void parseOverrides(const Field& o, SimulationOptions& opt) {
+  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "joint_friction_scale", "kappa_pa",
+               "active_gain_scale", "passive_gain_scale"});
+  if (o.has("integrator")) {
+    const std::string name = o.at("integrator").string();
+    if (!integratorFromName(name, opt.step.integrator))
+      o.at("integrator").fail("unknown integrator '" + name + "' (valid: symplectic-euler, implicit-euler)");
+  }
+  if (o.has("dt_s")) opt.dt = o.at("dt_s").positive();
+  if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").nonNegative();
+  if (o.has("gravity")) opt.step.gravity = o.at("gravity").boolean();
+  if (o.has("joint_friction_scale")) opt.step.jointFrictionScale = o.at("joint_friction_scale").nonNegative();
+  if (o.has("kappa_pa")) opt.step.kappa = o.at("kappa_pa").positive();
+  if (o.has("active_gain_scale")) parseGroupScales(o.at("active_gain_scale"), opt.step.activeGainScale);
+  if (o.has("passive_gain_scale")) parseGroupScales(o.at("passive_gain_scale"), opt.step.passiveGainScale);
+}
+
+void parseOutputs(const Field& o, ScenarioOutputs& out) {
+  o.allowKeys({"output_rate_hz", "csv", "plots", "vtk"});
+  if (o.has("output_rate_hz")) out.outputRate = o.at("output_rate_hz").positive();
+  if (o.has("csv")) out.csv = o.at("csv").boolean();
+  if (o.has("plots")) out.plots = o.at("plots").boolean();
+  if (o.has("vtk")) out.vtk = o.at("vtk").boolean();
+}
+
+json groupScalesJson(const std::array<double, kElementGroupCount>& scales) {
+  json j = json::object();
+  for (int i = 0; i < kElementGroupCount; ++i) j[groupName(static_cast<ElementGroup>(i))] = scales[static_cast<std::size_t>(i)];
+  return j;
+}
+
+}  // namespace
+
+const char* controllerKindName(ControllerKind k) {
+  switch (k) {
+    case ControllerKind::Style: return "style";
+    case ControllerKind::Affect: return "affect";
+    case ControllerKind::Pattern: return "pattern";
+  }
+  return "style";
+}
+
+Scenario parseScenario(const std::string& jsonText, const std::string& sourceName, const std::string& baseDir) {
+  json j;
+  try {
+    j = json::parse(jsonText);
+  } catch (const json::parse_error& e) {
+    throw Error(sourceName + ": invalid JSON: " + e.what());
+  }
+  const Field root(j, "", sourceName);
+  root.allowKeys({"format", "version", "name", "description", "model", "duration_s", "seed", "controller", "overrides",
+                  "outputs"});
+
+  // header
+  if (root.at("format").string() != kFormatName) root.at("format").fail(std::string("must be \"") + kFormatName + "\"");
+  const Field version = root.at("version");
+  if (!version.raw().is_number_integer() || version.raw().get<int>() != kScenarioFormatVersion)
+    version.fail("unsupported version " + version.raw().dump() + " (this build reads " +
+                 std::to_string(kScenarioFormatVersion) + ")");
+
+  Scenario s;
+  s.name = root.has("name") ? root.at("name").string() : "";
+  s.description = root.has("description") ? root.at("description").string() : "";
+  if (root.has("model")) {
+    s.model = root.at("model").string();
+    if (s.model.empty()) root.at("model").fail("must not be empty (use \"default\" for the default model)");
+    if (s.model != "default") s.model = resolve(s.model, baseDir);
+  }
+  s.duration = root.at("duration_s").positive();
+  if (root.has("seed")) {
+    const Field seed = root.at("seed");
+    if (!seed.raw().is_number_unsigned()) seed.fail("must be a non-negative integer, got " + seed.raw().dump());
+    s.seed = seed.raw().get<std::uint64_t>();
+  }
+  parseController(root.at("controller"), baseDir, s);
+  if (root.has("overrides")) parseOverrides(root.at("overrides"), s.options);
+  if (root.has("outputs")) parseOutputs(root.at("outputs"), s.outputs);
+  s.options.outputRate = s.outputs.outputRate;
+
+  // cross-field checks the simulation would make later, reported against the file
+  try {
+    validateSimulationOptions(s.options);
+  } catch (const Error& e) {
+    throw Error(sourceName + ": overrides: " + e.what());
+  }
+  return s;
+}
+
+Scenario loadScenario(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("scenario file '" + path + "' cannot be read");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseScenario(ss.str(), path, fs::path(path).parent_path().string());
+}
+
+std::string serializeScenario(const Scenario& s) {
+  json j;
+  j["format"] = kFormatName;
+  j["version"] = kScenarioFormatVersion;
+  j["name"] = s.name;
+  j["description"] = s.description;
+  j["model"] = s.model;
+  j["duration_s"] = s.duration;
+  j["seed"] = s.seed;
+  if (s.controller == ControllerKind::Pattern && !s.patternText.empty())
+    j["controller"]["pattern"] = json::parse(s.patternText);
+  else
+    j["controller"][controllerKindName(s.controller)] = s.controllerName;
+  const StepOptions& st = s.options.step;
+  json& o = j["overrides"];
+  o["integrator"] = integratorName(st.integrator);
+  if (s.options.dt > 0.0) o["dt_s"] = s.options.dt;
+  o["settle_time_s"] = s.options.settleTime;
+  o["gravity"] = st.gravity;
+  o["joint_friction_scale"] = st.jointFrictionScale;
+  if (st.kappa > 0.0) o["kappa_pa"] = st.kappa;
+  o["active_gain_scale"] = groupScalesJson(st.activeGainScale);
+  o["passive_gain_scale"] = groupScalesJson(st.passiveGainScale);
+  j["outputs"] = {{"output_rate_hz", s.outputs.outputRate}, {"csv", s.outputs.csv}, {"plots", s.outputs.plots},
+                  {"vtk", s.outputs.vtk}};
+  return j.dump(2) + "\n";
+}
+
+std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,
+                                           const std::string& resourceDir) {
+  try {
+    if (scenario.controller == ControllerKind::Style)
+      return std::make_unique<BreathStyleController>(
+          loadBreathStyle(scenario.controllerName, (fs::path(resourceDir) / "presets").string()));
+    // parse the pattern first (cheap, reports bad names and fields), then calibrate the drive on the model
+    const pattern::Pattern p =
+        scenario.controller == ControllerKind::Affect ? pattern::loadAffect(scenario.controllerName, resourceDir)
+        : scenario.patternText.empty() ? pattern::loadPatternFile(scenario.controllerName, resourceDir)
+                                       : pattern::parsePattern(scenario.patternText, "inline pattern", resourceDir);
+    const pattern::DriveCalibration calibration = pattern::calibrateDrive(std::move(model), scenario.options);
+    return pattern::makePatternController(p, scenario.seed, calibration);
+  } catch (const Error& e) {
+    throw Error(std::string("controller.") + controllerKindName(scenario.controller) + ": " + e.what());
+  }
+}
+
+void saveScenario(const Scenario& scenario, const std::string& path) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error("scenario file '" + path + "' cannot be written");
+    out << serializeScenario(scenario);
+    if (!out.flush()) throw Error("scenario file '" + path + "' cannot be written");
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw Error("scenario file '" + path + "' cannot be written: " + ec.message());
+}
+
+}  // namespace pneuma::sim
