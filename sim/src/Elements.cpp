@@ -1,5 +1,7 @@
 #include "pneuma/sim/Elements.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 

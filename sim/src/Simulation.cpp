@@ -9,38 +9,6 @@
 
 namespace pneuma::sim {
 
-namespace {
-
-// mass and gain checks on top of validateModel(): negative gains or masses are rejected by name
-void validateDynamics(const Model& m) {
-  auto fail = [](const std::string& field, int i, double v) {
-    std::ostringstream os;
-    os << field << "[" << i << "]: must be finite and >= 0, got " << v;
-    throw Error(os.str());
-  };
-  for (int b = 0; b < m.bodies.size(); ++b) {
-    if (!m.bodies.isFixed[static_cast<std::size_t>(b)] && !(m.bodies.mass(b) > 0.0))
-      throw Error("bodies.mass[" + std::to_string(b) + "] ('" + m.bodies.name[static_cast<std::size_t>(b)] +
-                  "'): must be > 0, got " + std::to_string(m.bodies.mass(b)));
-  }
-  for (int n = 0; n < m.nodes.size(); ++n) {
-    if (!m.nodes.isFixed(n) && !(m.nodes.mass(n) > 0.0))
-      throw Error("nodes.mass[" + std::to_string(n) + "]: must be > 0, got " + std::to_string(m.nodes.mass(n)));
-  }
-  for (int e = 0; e < m.elements.size(); ++e) {
-    if (!(m.elements.kac(e) >= 0.0)) fail("elements.kac", e, m.elements.kac(e));
-    if (!(m.elements.kpe(e) >= 0.0)) fail("elements.kpe", e, m.elements.kpe(e));
-    if (!(m.elements.damping(e) >= 0.0)) fail("elements.damping", e, m.elements.damping(e));
-  }
-  for (int j = 0; j < m.joints.size(); ++j) {
-    if (!(m.joints.friction(j) >= 0.0)) fail("joints.friction", j, m.joints.friction(j));
-    if (!(m.joints.stiffness(j) >= 0.0)) fail("joints.stiffness", j, m.joints.stiffness(j));
-  }
-  if (!(m.gut.kappa >= 0.0)) throw Error("gut.kappa: must be finite and >= 0, got " + std::to_string(m.gut.kappa));
-}
-
-}  // namespace
-
 void validateSimulationOptions(const SimulationOptions& o) {
   validateStepOptions(o.step);
   auto fail = [](const char* field, double v, const char* rule) {
@@ -61,8 +29,7 @@ Simulation::Simulation(std::shared_ptr<const Model> model, std::unique_ptr<Contr
     : m_model(std::move(model)), m_controller(std::move(controller)) {
   if (!m_model) throw Error("Simulation: no model");
   if (!m_controller) throw Error("Simulation: no controller");
-  validateModel(*m_model);
-  validateDynamics(*m_model);
+  validateModel(*m_model);  // sizes, indices, masses > 0, gains >= 0, required landmarks
   setOptions(options);
   validateActivations(m_controller->activations(0.0, Metrics{}));
   reset();

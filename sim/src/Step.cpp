@@ -208,17 +208,6 @@ void accumulateGravityAndGyroscopic(const Model& model, const State& s, const St
   }
 }
 
-void computeForces(const Model& model, const State& s, const Activations& act, const StepOptions& o, StepWork& w) {
-  w.bodyForce.setZero();
-  w.bodyTorque.setZero();
-  w.nodeForce.setZero();
-  updateBodyFrames(model, s, w);
-  accumulateElementForces(model, s, act, o, w);
-  accumulateGutPressure(model, s, o, w);
-  accumulateJointTorques(model, s, o, w);
-  accumulateGravityAndGyroscopic(model, s, o, w);
-}
-
 // ---------------------------------------------------------------------------------------------
 // stage 2: integrate velocities
 
@@ -332,10 +321,13 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   rhs = dt * rhs - q;
   maskFixed(model, rhs);
 
-  // preconditioned conjugate gradient from dv = 0
+  // preconditioned conjugate gradient, warm-started from the previous step's dv
   buildPreconditioner(model, w, dt, w.cgDiag);
-  x.setZero();
-  r = rhs;
+  maskFixed(model, x);
+  applyStiffnessDamping(model, o, w, x, dt * dt, dt, q);
+  applyMass(model, w, x, z);
+  r = rhs - q - z;
+  maskFixed(model, r);
   z = w.cgDiag.cwiseProduct(r);
   p = z;
   double rz = r.dot(z);
@@ -382,9 +374,20 @@ Matrix3d jointEffectiveMassInverse(const Model& model, const StepWork& w, int p,
   return k.inverse();
 }
 
+// inverse effective mass of every joint at the current pose, into w.jointMassInverse
+void updateJointMasses(const Model& model, StepWork& w) {
+  const Joints& j = model.joints;
+  for (int i = 0; i < j.size(); ++i) {
+    const int p = j.parent[at(i)], c = j.child[at(i)];
+    w.jointMassInverse[at(i)] = jointEffectiveMassInverse(model, w, p, c, w.rotation[at(p)] * w.jointLocalParent.col(i),
+                                                          w.rotation[at(c)] * w.jointLocalChild.col(i));
+  }
+}
+
 // sequential impulses: the relative velocity of the two anchor points of every joint goes to zero
 void solveJointVelocities(const Model& model, State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
+  updateJointMasses(model, w);
   const int iterations = std::max(1, o.jointIterations / 3);
   for (int it = 0; it < iterations; ++it) {
     for (int i = 0; i < j.size(); ++i) {
@@ -393,7 +396,7 @@ void solveJointVelocities(const Model& model, State& s, const StepOptions& o, St
       const Vector3d rc = w.rotation[at(c)] * w.jointLocalChild.col(i);
       const Vector3d vrel = (s.bodyVelocity.col(c) + s.bodyAngularVelocity.col(c).cross(rc)) -
                             (s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(rp));
-      const Vector3d impulse = -jointEffectiveMassInverse(model, w, p, c, rp, rc) * vrel;
+      const Vector3d impulse = -w.jointMassInverse[at(i)] * vrel;
       if (!model.bodies.isFixed[at(c)]) {
         s.bodyVelocity.col(c) += impulse / model.bodies.mass(c);
         s.bodyAngularVelocity.col(c) += w.inverseInertiaWorld[at(c)] * rc.cross(impulse);
@@ -414,7 +417,8 @@ void rotateBody(State& s, int b, const Vector3d& dtheta) {
   q.normalize();
 }
 
-// mass-weighted position projection until every joint error is below the tolerance (velocities kept)
+// mass-weighted position projection until every joint error is below the tolerance (velocities kept);
+// the effective masses of the velocity stage are reused (the pose changed by one small step)
 void projectJointPositions(const Model& model, State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
   w.maxJointError = 0.0;
@@ -425,9 +429,10 @@ void projectJointPositions(const Model& model, State& s, const StepOptions& o, S
       const Vector3d rp = w.rotation[at(p)] * w.jointLocalParent.col(i);
       const Vector3d rc = w.rotation[at(c)] * w.jointLocalChild.col(i);
       const Vector3d err = (s.bodyPosition.col(c) + rc) - (s.bodyPosition.col(p) + rp);
-      worst = std::max(worst, err.norm());
-      if (err.squaredNorm() == 0.0) continue;
-      const Vector3d impulse = -jointEffectiveMassInverse(model, w, p, c, rp, rc) * err;
+      const double e = err.norm();
+      worst = std::max(worst, e);
+      if (e < 0.1 * o.jointTolerance) continue;
+      const Vector3d impulse = -w.jointMassInverse[at(i)] * err;
       for (const auto& [b, r, sign] : {std::tuple<int, Vector3d, double>{c, rc, 1.0}, {p, rp, -1.0}}) {
         if (model.bodies.isFixed[at(b)]) continue;
         s.bodyPosition.col(b) += (sign / model.bodies.mass(b)) * impulse;
@@ -465,6 +470,17 @@ std::string describeBlowUpCause(double dt) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
+
+void computeForces(const Model& model, const State& s, const Activations& act, const StepOptions& o, StepWork& w) {
+  w.bodyForce.setZero();
+  w.bodyTorque.setZero();
+  w.nodeForce.setZero();
+  updateBodyFrames(model, s, w);
+  accumulateElementForces(model, s, act, o, w);
+  accumulateGutPressure(model, s, o, w);
+  accumulateJointTorques(model, s, o, w);
+  accumulateGravityAndGyroscopic(model, s, o, w);
+}
 
 const char* integratorName(IntegratorKind k) {
   return k == IntegratorKind::SymplecticEuler ? "symplectic-euler" : "implicit-euler";
@@ -528,6 +544,7 @@ StepWork makeStepWork(const Model& model) {
     w.jointLocalParent.col(i) = model.joints.anchor.col(i) - model.bodies.com.col(model.joints.parent[at(i)]);
     w.jointLocalChild.col(i) = model.joints.anchor.col(i) - model.bodies.com.col(model.joints.child[at(i)]);
   }
+  w.jointMassInverse.assign(at(nj), Matrix3d::Zero());
   w.rotation.assign(at(nb), Matrix3d::Identity());
   w.inverseInertiaWorld = w.inverseInertiaBody;
   w.bodyForce = Eigen::Matrix3Xd::Zero(3, nb);

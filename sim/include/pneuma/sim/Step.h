@@ -56,7 +56,7 @@ struct StepOptions {
   int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
   int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
-  double cgTolerance = 1e-7;          ///< [-] implicit Euler: relative residual of the CG solve
+  double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (M^-1 norm)
 };
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
@@ -79,6 +79,7 @@ struct StepWork {
   std::vector<Eigen::Matrix3d> inverseInertiaBody;  ///< [1/(kg m^2)] I^-1 in the body frame, zero for fixed bodies (#B)
   Eigen::Matrix3Xd jointLocalParent;   ///< [m] joint anchor in the parent's body frame (3 x #J)
   Eigen::Matrix3Xd jointLocalChild;    ///< [m] joint anchor in the child's body frame (3 x #J)
+  std::vector<Eigen::Matrix3d> jointMassInverse;  ///< [kg] inverse effective mass of each joint's point constraint (#J)
   std::vector<Eigen::Matrix3d> rotation;  ///< [-] body rotation matrices (#B)
   std::vector<Eigen::Matrix3d> inverseInertiaWorld;  ///< [1/(kg m^2)] R I^-1 R^T, zero for fixed bodies (#B)
   Eigen::Matrix3Xd bodyForce, bodyTorque;  ///< [N], [N m] world (3 x #B)
@@ -86,11 +87,18 @@ struct StepWork {
   Eigen::Matrix3Xd gutGradient;        ///< [m^2] dV/dx per node (3 x #N)
   double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
   int cgIterations = 0;                ///< [-] CG iterations of the last implicit step
-  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB;  ///< implicit solver vectors (6 #B + 3 #N)
+  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps dv
+                                                          ///< of the last step as the next warm start
 };
 
 /// Allocates the scratch memory for `model` and computes its rest gut volume.
 StepWork makeStepWork(const Model& model);
+
+/// Stage 1 alone: clears and accumulates work.bodyForce [N], bodyTorque [N m] (world, about each com) and
+/// nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3)
+/// and stiffness, gravity and the gyroscopic term; also fills the per-element and gut by-products.
+void computeForces(const Model& model, const State& state, const Activations& act, const StepOptions& options,
+                   StepWork& work);
 
 /// Advances `state` by `dt` [s] under activations `act` (forces -> integrate -> joints).
 /// Does not check for blow-ups (Simulation does) and does not compute metrics.
