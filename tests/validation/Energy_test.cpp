@@ -1,0 +1,53 @@
+// Energy without actuation and gravity (STYLE "Tests": invariants): with relaxed muscles, no gravity
+// and random initial velocities, total energy (kinetic + elastic: springs, gut pressure, joint springs)
+// never increases, for both integrators, and the damped system comes to rest.
+#include "ToyTorso.h"
+
+#include "pneuma/sim/Step.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace pneuma::sim {
+namespace {
+
+class EnergyDecay : public ::testing::TestWithParam<IntegratorKind> {};
+
+TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
+  const Model m = test::makeToyTorso(2);
+  StepOptions o;
+  o.gravity = false;
+  o.integrator = GetParam();
+  State s = makeInitialState(m);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int i = 0; i < m.nodes.size(); ++i)
+    if (!m.nodes.isFixed(i)) s.nodeVelocity.col(i) = 0.1 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) s.bodyAngularVelocity.col(b) = 0.5 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+
+  StepWork w = makeStepWork(m);
+  Metrics met;
+  const Activations relaxed = relaxedActivations();
+  computeMetrics(m, s, relaxed, o, w, met);
+  const double e0 = met.kineticEnergy + met.elasticEnergy;
+  double previous = e0;
+  const double dt = defaultTimeStep(o.integrator);
+  while (s.time < 6.0) {
+    step(m, s, dt, relaxed, o, w);
+    computeMetrics(m, s, relaxed, o, w, met);
+    const double e = met.kineticEnergy + met.elasticEnergy;
+    ASSERT_LE(e, previous * (1.0 + 1e-9)) << "energy increased at t = " << s.time;
+    previous = e;
+  }
+  EXPECT_LT(met.kineticEnergy, 1e-2 * e0) << "not at rest after 6 s";
+  EXPECT_LT(previous, 0.05 * e0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sim, EnergyDecay,
+                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler),
+                         [](const auto& info) { return std::string(info.param == IntegratorKind::SymplecticEuler ? "SymplecticEuler" : "ImplicitEuler"); });
+
+}  // namespace
+}  // namespace pneuma::sim
