@@ -1,33 +1,832 @@
 #include "gui/MainWindow.h"
 
-#include "viz/ModelScene.h"
+#include "gui/LivePlots.h"
+#include "gui/ParameterPanel.h"
+#include "gui/PlotView.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Scenario.h"
+#include "viz/AtomicFile.h"
 
+#include <QAction>
+#include <QApplication>
+#include <QCheckBox>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QDateTime>
+#include <QDir>
+#include <QDockWidget>
+#include <QElapsedTimer>
+#include <QEventLoop>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QLabel>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QPdfWriter>
+#include <QPushButton>
+#include <QSlider>
 #include <QStatusBar>
+#include <QStyle>
+#include <QSvgRenderer>
+#include <QTabWidget>
+#include <QTimer>
+#include <QToolBar>
+#include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 #include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkImageData.h>
+#include <vtkOggTheoraWriter.h>
 #include <vtkRenderer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkPointData.h>
+
+#include <cmath>
+#include <cstdio>
 
 namespace pneuma::app {
+
+namespace {
+
+constexpr int kRefreshMs = 33;           // [ms] display refresh: 30 Hz
+constexpr double kRecordSeconds = 60.0;  // [s] recorded for the timeline
+
+const std::vector<std::pair<QString, double>> kSpeeds{
+    {"0.1\u00d7 real time", 0.1}, {"0.25\u00d7 real time", 0.25}, {"0.5\u00d7 real time", 0.5},
+    {"1\u00d7 real time", 1.0},   {"2\u00d7 real time", 2.0},     {"As fast as possible", 0.0}};
+
+// the QImage's pixels as VTK RGB image data (VTK rows run bottom-up)
+void copyToImageData(const QImage& source, vtkImageData* out) {
+  const QImage rgb = source.convertToFormat(QImage::Format_RGB888);
+  const int w = rgb.width() & ~1, h = rgb.height() & ~1;  // Theora wants even sizes
+  out->SetDimensions(w, h, 1);
+  out->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  auto* dst = static_cast<unsigned char*>(out->GetScalarPointer());
+  for (int y = 0; y < h; ++y)
+    std::copy_n(rgb.constScanLine(h - 1 - y), 3 * w, dst + static_cast<std::size_t>(3 * w * y));
+  out->Modified();
+}
+
+QString suffixOf(const QString& path) { return QFileInfo(path).suffix().toLower(); }
+
+}  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make_unique<viz::ModelScene>()) {
   setWindowTitle("Pneuma");
   resize(1280, 800);
 
-  // 3D view
-  m_view = new QVTKOpenGLNativeWidget(this);
+  // centre: the 3D view over the timeline
+  auto* centre = new QWidget(this);
+  auto* centreLayout = new QVBoxLayout(centre);
+  centreLayout->setContentsMargins(0, 0, 0, 0);
+  centreLayout->setSpacing(0);
+  m_view = new QVTKOpenGLNativeWidget(centre);
   vtkNew<vtkGenericOpenGLRenderWindow> window;
   m_view->setRenderWindow(window);
   window->AddRenderer(m_scene->renderer());
   m_scene->installOrientationMarker(m_view->interactor());
-  setCentralWidget(m_view);
+  m_view->installEventFilter(this);
+  centreLayout->addWidget(m_view, 1);
+  buildTimeline(centre);
+  setCentralWidget(centre);
 
-  // status bar
-  m_statusText = new QLabel("Ready", this);
-  statusBar()->addWidget(m_statusText, 1);
+  buildDocks();
+  buildActions();
+
+  // status bar: model, time, fps and real-time factor
+  m_statusModel = new QLabel("No model", this);
+  m_statusTime = new QLabel(this);
+  m_statusFps = new QLabel(this);
+  m_statusRtf = new QLabel(this);
+  statusBar()->addWidget(m_statusModel, 1);
+  statusBar()->addPermanentWidget(m_statusTime);
+  statusBar()->addPermanentWidget(m_statusFps);
+  statusBar()->addPermanentWidget(m_statusRtf);
+
+  m_messageTimer = new QTimer(this);
+  m_messageTimer->setSingleShot(true);
+  connect(m_messageTimer, &QTimer::timeout, this, [this] { m_statusModel->setText(m_modelText); });
+
+  m_refresh = new QTimer(this);
+  m_refresh->setInterval(kRefreshMs);
+  connect(m_refresh, &QTimer::timeout, this, &MainWindow::refresh);
+  m_refresh->start();
+  m_fpsWindowStart = QDateTime::currentMSecsSinceEpoch();
+
+  // default run settings: the calm style when its preset exists
+  const std::vector<std::string> styles = sim::breathStyleNames();
+  for (const std::string& s : styles) m_styleCombo->addItem(QString::fromStdString(s));
+  m_settings.options.recordSeconds = kRecordSeconds;
+  try {
+    m_settings.style = sim::loadBreathStyle(styles.empty() || std::find(styles.begin(), styles.end(), "calm") != styles.end()
+                                                ? "calm" : styles.front());
+  } catch (const sim::Error& e) {
+    m_settings.style.name = "default";
+    showMessage(QString("Breath-style presets not found (%1); using built-in defaults").arg(e.what()), 10000);
+  }
+  {
+    const QSignalBlocker block(m_styleCombo);
+    m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
+  }
+  m_params->setSettings(m_settings, 0.0);
 }
 
-MainWindow::~MainWindow() = default;
+MainWindow::~MainWindow() {
+  m_thread.quit();
+  m_thread.wait();
+}
+
+QString MainWindow::defaultModelDir() {
+  const QByteArray env = qgetenv("PNEUMA_MODEL_DIR");
+  if (!env.isEmpty()) return QString::fromLocal8Bit(env);
+  return QDir(QApplication::applicationDirPath()).absoluteFilePath("../models/default");
+}
+
+void MainWindow::buildTimeline(QWidget* centre) {
+  auto* bar = new QWidget(centre);
+  auto* layout = new QHBoxLayout(bar);
+  layout->setContentsMargins(8, 4, 8, 4);
+  auto* title = new QLabel("Timeline", bar);
+  m_timeline = new QSlider(Qt::Horizontal, bar);
+  m_timeline->setRange(0, 1000);
+  m_timeline->setToolTip("Drag to scrub back through the recorded states (pauses the run)");
+  m_timeLabel = new QLabel("t = 0.00 s", bar);
+  m_timeLabel->setMinimumWidth(170);
+  auto* live = new QPushButton("Live", bar);
+  live->setToolTip("Return to the running simulation");
+  layout->addWidget(title);
+  layout->addWidget(m_timeline, 1);
+  layout->addWidget(m_timeLabel);
+  layout->addWidget(live);
+  centre->layout()->addWidget(bar);
+
+  connect(m_timeline, &QSlider::sliderMoved, this, [this](int value) {
+    if (!m_shown || !m_worker) return;
+    const double t = m_shown->recordedFrom + (m_shown->recordedTo - m_shown->recordedFrom) * value / 1000.0;
+    m_playAction->setChecked(false);
+    m_worker->requestScrub(t);
+  });
+  connect(live, &QPushButton::clicked, this, &MainWindow::play);
+}
+
+void MainWindow::buildActions() {
+  // file menu
+  QMenu* file = menuBar()->addMenu("&File");
+  file->addAction("&Open model directory\u2026", this, [this] {
+    const QString dir = QFileDialog::getExistingDirectory(this, "Open model directory", m_modelDir);
+    if (!dir.isEmpty()) openModel(dir);
+  }, QKeySequence::Open);
+  file->addAction("Open &scenario\u2026", this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, "Open scenario", QString(), "Scenario (*.json)");
+    if (!path.isEmpty()) openScenario(path);
+  });
+  file->addAction("Sa&ve scenario\u2026", this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, "Save scenario", "scenario.json", "Scenario (*.json)");
+    if (!path.isEmpty()) saveScenario(path);
+  }, QKeySequence::Save);
+  file->addSeparator();
+  QMenu* exportMenu = file->addMenu("&Export");
+  for (PlotView* plot : m_plots->plots())
+    exportMenu->addAction(QString("Plot \u201c%1\u201d\u2026").arg(plot->title()), this,
+                          [this, plot] { exportPlotInteractive(plot); });
+  exportMenu->addSeparator();
+  exportMenu->addAction("3D view as PNG\u2026", this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, "Export 3D view", "view.png", "PNG image (*.png)");
+    if (!path.isEmpty()) exportViewImage(path);
+  });
+  exportMenu->addAction("Animation of the recording\u2026", this, [this] {
+    if (!m_shown) return;
+    const QString path = QFileDialog::getSaveFileName(this, "Export animation", "breathing.ogv",
+                                                      "Ogg Theora movie (*.ogv);;PNG sequence (*.png)");
+    if (!path.isEmpty()) exportAnimation(path, m_shown->recordedFrom, m_shown->recordedTo, 25.0);
+  });
+  file->addSeparator();
+  file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
+
+  // simulation toolbar and menu
+  QToolBar* tools = addToolBar("Simulation");
+  tools->setMovable(false);
+  tools->setToolButtonStyle(Qt::ToolButtonTextBesideIcon);
+  m_playAction = tools->addAction(style()->standardIcon(QStyle::SP_MediaPlay), "Play");
+  m_playAction->setCheckable(true);
+  m_playAction->setShortcut(Qt::Key_Space);
+  connect(m_playAction, &QAction::toggled, this, [this](bool on) {
+    m_playAction->setText(on ? "Pause" : "Play");
+    m_playAction->setIcon(style()->standardIcon(on ? QStyle::SP_MediaPause : QStyle::SP_MediaPlay));
+    if (m_worker) m_worker->setRunning(on);
+  });
+  QAction* step = tools->addAction(style()->standardIcon(QStyle::SP_MediaSkipForward), "Step");
+  step->setToolTip("Advance one time step");
+  connect(step, &QAction::triggered, this, [this] {
+    m_playAction->setChecked(false);
+    if (m_worker) m_worker->requestStep();
+  });
+  QAction* reset = tools->addAction(style()->standardIcon(QStyle::SP_MediaSkipBackward), "Reset");
+  reset->setToolTip("Back to the rest pose at t = 0");
+  connect(reset, &QAction::triggered, this, [this] {
+    if (m_worker) m_worker->requestReset();
+  });
+  tools->addSeparator();
+  tools->addWidget(new QLabel(" Speed ", this));
+  m_speedCombo = new QComboBox(this);
+  for (const auto& [label, speed] : kSpeeds) m_speedCombo->addItem(label, speed);
+  m_speedCombo->setCurrentIndex(3);
+  connect(m_speedCombo, qOverload<int>(&QComboBox::currentIndexChanged), this, [this](int i) {
+    if (m_worker) m_worker->setSpeed(m_speedCombo->itemData(i).toDouble());
+  });
+  tools->addWidget(m_speedCombo);
+  tools->addSeparator();
+  tools->addWidget(new QLabel(" Breath style ", this));
+  m_styleCombo = new QComboBox(this);
+  m_styleCombo->setMinimumWidth(130);
+  connect(m_styleCombo, &QComboBox::textActivated, this, [this](const QString& name) { setBreathStyle(name); });
+  tools->addWidget(m_styleCombo);
+  tools->addSeparator();
+  tools->addWidget(new QLabel(" Camera ", this));
+  const std::vector<std::pair<QString, viz::CameraPreset>> cameras{{"Anterior", viz::CameraPreset::Anterior},
+                                                                   {"Lateral", viz::CameraPreset::Lateral},
+                                                                   {"Superior", viz::CameraPreset::Superior},
+                                                                   {"Oblique", viz::CameraPreset::Oblique}};
+  QMenu* view = menuBar()->addMenu("&View");
+  for (const auto& [name, preset] : cameras) {
+    QAction* a = tools->addAction(name);
+    view->addAction(a);
+    connect(a, &QAction::triggered, this, [this, preset = preset] {
+      m_scene->setCamera(preset);
+      m_view->renderWindow()->Render();
+    });
+  }
+  QMenu* simMenu = menuBar()->addMenu("&Simulation");
+  simMenu->addAction(m_playAction);
+  simMenu->addAction(step);
+  simMenu->addAction(reset);
+}
+
+void MainWindow::buildDocks() {
+  // right: live plots
+  m_plots = new LivePlots(this);
+  for (PlotView* plot : m_plots->plots())
+    connect(plot, &PlotView::contextMenuRequested, this, [this, plot](const QPoint& at) {
+      QMenu menu;
+      menu.addAction("Export plot (PNG, SVG, PDF, CSV)\u2026", this, [this, plot] { exportPlotInteractive(plot); });
+      menu.exec(at);
+    });
+  auto* plotDock = new QDockWidget("Live plots", this);
+  plotDock->setObjectName("plots");
+  plotDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  plotDock->setWidget(m_plots);
+  plotDock->setMinimumWidth(380);
+  addDockWidget(Qt::RightDockWidgetArea, plotDock);
+
+  // left: display options and parameters
+  auto* display = new QWidget(this);
+  auto* displayLayout = new QVBoxLayout(display);
+  auto* colouring = new QGroupBox("Colouring", display);
+  auto* colourForm = new QFormLayout(colouring);
+  m_muscleColour = new QComboBox(colouring);
+  m_muscleColour->addItems({"Contractive force [N]", "Muscle group"});
+  m_gutColour = new QComboBox(colouring);
+  m_gutColour->addItems({"Plain", "Pressure [Pa]", "Displacement [mm]"});
+  colourForm->addRow("Muscles", m_muscleColour);
+  colourForm->addRow("Gut", m_gutColour);
+  displayLayout->addWidget(colouring);
+
+  auto* structures = new QGroupBox("Structures", display);
+  auto* structLayout = new QVBoxLayout(structures);
+  for (const char* name : {"Bones", "Gut", "Translucent gut", "Lung cavity", "Landmarks", "Anatomical labels"}) {
+    auto* check = new QCheckBox(name, structures);
+    structLayout->addWidget(check);
+    m_structureChecks.push_back(check);
+  }
+  displayLayout->addWidget(structures);
+
+  auto* groups = new QGroupBox("Muscle groups", display);
+  auto* groupLayout = new QVBoxLayout(groups);
+  for (int g = 0; g < sim::kElementGroupCount; ++g) {
+    const auto group = static_cast<sim::ElementGroup>(g);
+    auto* check = new QCheckBox(viz::groupLabel(group), groups);
+    const auto c = viz::groupColour(group);
+    QPixmap swatch(12, 12);
+    swatch.fill(QColor::fromRgbF(c[0], c[1], c[2]));
+    check->setIcon(QIcon(swatch));
+    groupLayout->addWidget(check);
+    m_groupChecks.push_back(check);
+  }
+  displayLayout->addWidget(groups);
+
+  auto* selectionBox = new QGroupBox("Selection", display);
+  auto* selectionLayout = new QVBoxLayout(selectionBox);
+  m_selection = new QLabel("Click a muscle element or a bone in the 3D view.", selectionBox);
+  m_selection->setWordWrap(true);
+  selectionLayout->addWidget(m_selection);
+  auto* clearTraces = new QPushButton("Clear force traces", selectionBox);
+  connect(clearTraces, &QPushButton::clicked, this, [this] {
+    m_plots->clearTraces();
+    select({});
+  });
+  selectionLayout->addWidget(clearTraces);
+  displayLayout->addWidget(selectionBox);
+  displayLayout->addStretch(1);
+
+  syncDisplayWidgets();
+  auto readOptions = [this] {
+    viz::DisplayOptions o = m_scene->options();
+    o.muscleColouring = m_muscleColour->currentIndex() == 0 ? viz::MuscleColouring::Force : viz::MuscleColouring::Group;
+    o.gutColouring = static_cast<viz::GutColouring>(m_gutColour->currentIndex());
+    o.showBones = m_structureChecks[0]->isChecked();
+    o.showGut = m_structureChecks[1]->isChecked();
+    o.isGutTranslucent = m_structureChecks[2]->isChecked();
+    o.showCavity = m_structureChecks[3]->isChecked();
+    o.showLandmarks = m_structureChecks[4]->isChecked();
+    o.showLabels = m_structureChecks[5]->isChecked();
+    for (std::size_t g = 0; g < m_groupChecks.size(); ++g) o.showGroup[g] = m_groupChecks[g]->isChecked();
+    setDisplayOptions(o);
+  };
+  connect(m_muscleColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
+  connect(m_gutColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
+  for (QCheckBox* c : m_structureChecks) connect(c, &QCheckBox::toggled, this, readOptions);
+  for (QCheckBox* c : m_groupChecks) connect(c, &QCheckBox::toggled, this, readOptions);
+
+  m_params = new ParameterPanel(this);
+  connect(m_params, &ParameterPanel::settingsEdited, this, [this](const RunSettings& s) {
+    m_settings = s;
+    m_plots->setBreathPeriod(60.0 / s.style.breathsPerMinute);
+    if (m_worker) m_worker->requestSettings(s);
+  });
+
+  auto* tabs = new QTabWidget(this);
+  tabs->addTab(display, "Display");
+  tabs->addTab(m_params, "Parameters");
+  auto* leftDock = new QDockWidget("Controls", this);
+  leftDock->setObjectName("controls");
+  leftDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  leftDock->setWidget(tabs);
+  addDockWidget(Qt::LeftDockWidgetArea, leftDock);
+  resizeDocks({leftDock, plotDock}, {230, 400}, Qt::Horizontal);
+}
+
+void MainWindow::syncDisplayWidgets() {
+  const viz::DisplayOptions& o = m_scene->options();
+  const std::vector<QSignalBlocker> blockers = [&] {
+    std::vector<QSignalBlocker> b;
+    b.emplace_back(m_muscleColour);
+    b.emplace_back(m_gutColour);
+    for (QCheckBox* c : m_structureChecks) b.emplace_back(c);
+    for (QCheckBox* c : m_groupChecks) b.emplace_back(c);
+    return b;
+  }();
+  m_muscleColour->setCurrentIndex(o.muscleColouring == viz::MuscleColouring::Force ? 0 : 1);
+  m_gutColour->setCurrentIndex(static_cast<int>(o.gutColouring));
+  const bool flags[] = {o.showBones, o.showGut, o.isGutTranslucent, o.showCavity, o.showLandmarks, o.showLabels};
+  for (std::size_t i = 0; i < m_structureChecks.size(); ++i) m_structureChecks[i]->setChecked(flags[i]);
+  for (std::size_t g = 0; g < m_groupChecks.size(); ++g) m_groupChecks[g]->setChecked(o.showGroup[g]);
+}
+
+void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
+  m_scene->setOptions(options);
+  syncDisplayWidgets();
+  if (m_shown) m_scene->update(m_shown->state, m_shown->metrics);
+  m_view->renderWindow()->Render();
+}
+
+void MainWindow::showMessage(const QString& text, int milliseconds) {
+  m_statusModel->setText(text);
+  m_messageTimer->start(milliseconds);
+}
+
+void MainWindow::report(const QString& title, const QString& message) {
+  m_lastError = message;
+  showMessage(title + ": " + message, 15000);
+  std::fprintf(stderr, "pneuma: %s: %s\n", qPrintable(title), qPrintable(message));
+  // non-blocking dialog: the run and the tests go on
+  auto* box = new QMessageBox(QMessageBox::Warning, title, message, QMessageBox::Ok, this);
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  box->open();
+}
+
+QString MainWindow::openModel(const QString& dir) {
+  std::shared_ptr<const sim::Model> model;
+  std::unique_ptr<sim::Simulation> simulation;
+  try {
+    // load and validate everything before touching the current run
+    model = std::make_shared<const sim::Model>(sim::loadModel(dir.toStdString()));
+    simulation = std::make_unique<sim::Simulation>(
+        model, std::make_unique<sim::BreathStyleController>(m_settings.style), m_settings.options);
+    m_scene->setModel(*model, dir.toStdString());
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot open model '%1': %2").arg(dir, e.what());
+    report("Model not loaded", message);
+    return message;
+  }
+  m_model = model;
+  m_modelDir = QFileInfo(dir).absoluteFilePath();
+  m_selected = {};
+  m_plots->clearTraces();
+  m_params->setSettings(m_settings, model->gut.kappa);
+  m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
+  m_modelText = QString("Model: %1 (%2 bodies, %3 elements, %4 gut nodes)")
+                    .arg(QString::fromStdString(model->name))
+                    .arg(model->bodies.size())
+                    .arg(model->elements.size())
+                    .arg(model->nodes.size());
+  m_statusModel->setText(m_modelText);
+  setWindowTitle(QString("Pneuma \u2014 %1").arg(QString::fromStdString(model->name)));
+
+  if (!m_worker) {
+    m_worker = new SimWorker(model, std::move(simulation), m_settings);
+    m_worker->setSpeed(m_speedCombo->currentData().toDouble());
+    m_worker->moveToThread(&m_thread);
+    connect(&m_thread, &QThread::started, m_worker, &SimWorker::start);
+    connect(&m_thread, &QThread::finished, m_worker, &SimWorker::stop);
+    connect(&m_thread, &QThread::finished, m_worker, &QObject::deleteLater);
+    connect(m_worker, &SimWorker::failed, this, [this](const QString& message) {
+      m_playAction->setChecked(false);
+      report("Simulation stopped", message);
+    });
+    m_thread.start();
+  } else {
+    m_worker->requestSimulation(model, std::move(simulation), m_settings);
+  }
+  m_view->renderWindow()->Render();
+  return {};
+}
+
+QString MainWindow::modelDirFor(const std::string& scenarioModel) const {
+  return scenarioModel == "default" ? defaultModelDir() : QString::fromStdString(scenarioModel);
+}
+
+QString MainWindow::openScenario(const QString& path) {
+  sim::Scenario scenario;
+  sim::BreathStyle style;
+  try {
+    scenario = sim::loadScenario(path.toStdString());
+    if (scenario.controller != sim::ControllerKind::Style)
+      throw sim::Error(std::string("controller: the app plays breath styles; '") +
+                       sim::controllerKindName(scenario.controller) + "' scenarios run in pneuma-cli");
+    style = sim::loadBreathStyle(scenario.controllerName);
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot open scenario '%1': %2").arg(path, e.what());
+    report("Scenario not loaded", message);
+    return message;
+  }
+  const RunSettings previous = m_settings;
+  m_settings.style = style;
+  m_settings.options = scenario.options;
+  m_settings.options.recordSeconds = kRecordSeconds;
+  const QString error = openModel(modelDirFor(scenario.model));
+  if (!error.isEmpty()) {
+    m_settings = previous;
+    return error;
+  }
+  const QSignalBlocker block(m_styleCombo);
+  m_styleCombo->setCurrentText(QString::fromStdString(style.name));
+  showMessage(QString("Scenario '%1' loaded").arg(QString::fromStdString(scenario.name)), 5000);
+  return {};
+}
+
+QString MainWindow::saveScenario(const QString& path) {
+  sim::Scenario scenario;
+  scenario.name = QFileInfo(path).completeBaseName().toStdString();
+  scenario.description = "Saved from the Pneuma desktop app";
+  scenario.model = m_modelDir.isEmpty() ? "default" : m_modelDir.toStdString();
+  scenario.duration = 60.0;
+  scenario.controller = sim::ControllerKind::Style;
+  scenario.options = m_settings.options;
+  try {
+    // an edited style travels as its own preset file next to the scenario
+    const sim::BreathStyle& s = m_settings.style;
+    scenario.controllerName = s.name;
+    bool isPreset = false;
+    try {
+      const sim::BreathStyle preset = sim::loadBreathStyle(s.name);
+      isPreset = preset.breathsPerMinute == s.breathsPerMinute && preset.diaphragmR == s.diaphragmR &&
+                 preset.intercostalMean == s.intercostalMean && preset.intercostalAmplitude == s.intercostalAmplitude &&
+                 preset.inhaleFraction == s.inhaleFraction && preset.rectusActive == s.rectusActive &&
+                 preset.rectusR == s.rectusR && preset.cycles == s.cycles;
+    } catch (const sim::Error&) {
+    }
+    if (!isPreset) {
+      QJsonObject json{{"name", QString::fromStdString(s.name)},
+                       {"note", "Edited in the Pneuma desktop app"},
+                       {"breaths_per_minute", s.breathsPerMinute},
+                       {"inhale_fraction", s.inhaleFraction},
+                       {"diaphragm_r", s.diaphragmR},
+                       {"intercostal_mean", s.intercostalMean},
+                       {"intercostal_amplitude", s.intercostalAmplitude},
+                       {"rectus_active", s.rectusActive},
+                       {"rectus_r", s.rectusR},
+                       {"cycles", s.cycles}};
+      const QFileInfo info(path);
+      const QString stylePath = info.absoluteDir().absoluteFilePath(info.completeBaseName() + ".style.json");
+      viz::writeFileAtomically(stylePath.toStdString(), QJsonDocument(json).toJson().toStdString());
+      scenario.controllerName = stylePath.toStdString();
+    }
+    sim::saveScenario(scenario, path.toStdString());
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot save scenario '%1': %2").arg(path, e.what());
+    report("Scenario not saved", message);
+    return message;
+  }
+  showMessage(QString("Scenario saved to %1").arg(path), 5000);
+  return {};
+}
+
+QString MainWindow::setBreathStyle(const QString& name) {
+  try {
+    m_settings.style = sim::loadBreathStyle(name.toStdString());
+  } catch (const sim::Error& e) {
+    report("Unknown breath style", e.what());
+    return e.what();
+  }
+  const QSignalBlocker block(m_styleCombo);
+  m_styleCombo->setCurrentText(name);
+  m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
+  m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
+  if (m_worker) m_worker->requestSettings(m_settings);
+  return {};
+}
+
+void MainWindow::play() { m_playAction->setChecked(true); }
+
+void MainWindow::pause() { m_playAction->setChecked(false); }
+
+bool MainWindow::runUntil(double time, int timeoutMs) {
+  if (!m_worker) return false;
+  QEventLoop loop;
+  bool isDone = false;
+  auto reached = connect(m_worker, &SimWorker::targetReached, &loop, [&] { isDone = true; loop.quit(); });
+  auto failed = connect(m_worker, &SimWorker::failed, &loop, [&] { loop.quit(); });
+  QTimer::singleShot(timeoutMs, &loop, &QEventLoop::quit);
+  {
+    const QSignalBlocker block(m_playAction);
+    m_playAction->setChecked(true);
+  }
+  m_worker->requestRunUntil(time);
+  loop.exec();
+  disconnect(reached);
+  disconnect(failed);
+  pause();
+  refresh();
+  return isDone;
+}
+
+bool MainWindow::scrubTo(double time, int timeoutMs) {
+  if (!m_worker) return false;
+  pause();
+  m_worker->requestScrub(time);
+  QElapsedTimer clock;
+  clock.start();
+  while (clock.elapsed() < timeoutMs) {
+    QApplication::processEvents(QEventLoop::AllEvents, 10);
+    refresh();
+    if (m_shown && m_shown->isScrubbed) return true;
+  }
+  return false;
+}
+
+void MainWindow::refresh() {
+  if (!m_worker) return;
+  Frame frame = m_worker->take();
+  if (!frame.snapshot) return;
+  const bool isNew = frame.snapshot != m_shown;
+  if (frame.snapshot->generation != m_generation) {
+    m_plots->clear();
+    m_generation = frame.snapshot->generation;
+  }
+  m_plots->append(std::move(frame.samples));
+  if (isNew) showSnapshot(frame.snapshot);
+  m_plots->refresh();
+
+  // render fps over one-second windows
+  const qint64 now = QDateTime::currentMSecsSinceEpoch();
+  if (now - m_fpsWindowStart >= 1000) {
+    m_fps = 1000.0 * m_framesRendered / static_cast<double>(now - m_fpsWindowStart);
+    m_framesRendered = 0;
+    m_fpsWindowStart = now;
+    m_statusFps->setText(QString("  Render %1 fps  ").arg(m_fps, 0, 'f', 0));
+  }
+}
+
+void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
+  m_shown = std::move(snapshot);
+  const Snapshot& s = *m_shown;
+  if (s.model == m_model) m_scene->update(s.state, s.metrics);
+  m_view->renderWindow()->Render();
+  ++m_framesRendered;
+
+  m_plots->setCursor(s.isScrubbed ? s.metrics.time : std::numeric_limits<double>::quiet_NaN());
+  m_statusTime->setText(QString("  t = %1 s%2  ").arg(s.state.time, 0, 'f', 2).arg(s.isScrubbed ? " (recorded)" : ""));
+  m_statusRtf->setText(s.isRunning ? QString("  Real-time factor %1  ").arg(s.realTimeFactor, 0, 'f', 2)
+                                   : QString("  Paused  "));
+  if (s.isRunning != m_playAction->isChecked() && !s.isRunning && !s.isScrubbed) {
+    const QSignalBlocker block(m_playAction);
+    m_playAction->setChecked(false);
+    m_playAction->setText("Play");
+    m_playAction->setIcon(style()->standardIcon(QStyle::SP_MediaPlay));
+  }
+  updateTimeline();
+
+  // keep the selection read-out live
+  if (m_selected.kind != viz::Pick::Kind::None) select(m_selected);
+}
+
+void MainWindow::updateTimeline() {
+  const Snapshot& s = *m_shown;
+  const double span = s.recordedTo - s.recordedFrom;
+  if (!m_timeline->isSliderDown()) {
+    const QSignalBlocker block(m_timeline);
+    m_timeline->setValue(span > 0.0 ? static_cast<int>(std::lround(1000.0 * (s.metrics.time - s.recordedFrom) / span)) : 1000);
+  }
+  m_timeLabel->setText(QString("t = %1 s of %2 s").arg(s.metrics.time, 0, 'f', 2).arg(s.recordedTo, 0, 'f', 2));
+}
+
+void MainWindow::select(const viz::Pick& pick) {
+  const bool isNewSelection = pick.kind != m_selected.kind || pick.index != m_selected.index;
+  m_selected = pick;
+  if (isNewSelection) m_scene->setHighlight(pick);
+  if (pick.kind == viz::Pick::Kind::None || !m_model || !m_shown) {
+    m_selection->setText("Click a muscle element or a bone in the 3D view.");
+    return;
+  }
+  // the elements whose tension the selection reports [N]
+  LivePlots::Trace trace;
+  trace.name = QString::fromStdString(m_scene->describe(pick));
+  if (pick.kind == viz::Pick::Kind::Element) {
+    trace.elements = {pick.index};
+  } else {
+    const sim::Elements& e = m_model->elements;
+    for (int i = 0; i < e.size(); ++i)
+      if (e.endA.body[static_cast<std::size_t>(i)] == pick.index || e.endB.body[static_cast<std::size_t>(i)] == pick.index)
+        trace.elements.push_back(i);
+  }
+  double tension = 0.0;
+  const Eigen::VectorXd& f = m_shown->metrics.elementForce;
+  for (int i : trace.elements)
+    if (i < f.size()) tension += std::max(0.0, -f(i));
+  const QString what = pick.kind == viz::Pick::Kind::Element
+                           ? (tension > 0.0 ? QString("tension %1 N").arg(tension, 0, 'f', 2) : QString("slack (0 N)"))
+                           : QString("attached muscle tension %1 N (%2 elements)").arg(tension, 0, 'f', 2).arg(trace.elements.size());
+  m_selection->setText(QString("<b>%1</b><br>%2").arg(trace.name, what));
+  if (isNewSelection) {
+    m_plots->addTrace(trace);
+    showMessage(QString("Selected %1: %2").arg(trace.name, what), 5000);
+  }
+}
+
+void MainWindow::pickAt(const QPoint& viewPos) {
+  const double ratio = m_view->devicePixelRatioF();
+  const int x = static_cast<int>(viewPos.x() * ratio);
+  const int y = static_cast<int>((m_view->height() - viewPos.y() - 1) * ratio);
+  select(m_scene->pick(x, y));
+  m_view->renderWindow()->Render();
+}
+
+bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
+  // a click (press and release without dragging) in the 3D view picks; drags rotate the camera
+  if (watched == m_view) {
+    if (event->type() == QEvent::MouseButtonPress) {
+      m_pressPos = static_cast<QMouseEvent*>(event)->pos();
+    } else if (event->type() == QEvent::MouseButtonRelease) {
+      const auto* mouse = static_cast<QMouseEvent*>(event);
+      if (mouse->button() == Qt::LeftButton && (mouse->pos() - m_pressPos).manhattanLength() < 4) pickAt(mouse->pos());
+    }
+  }
+  return QMainWindow::eventFilter(watched, event);
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  m_refresh->stop();
+  m_thread.quit();
+  m_thread.wait();
+  event->accept();
+}
+
+void MainWindow::exportPlotInteractive(const PlotView* plot) {
+  const QString path = QFileDialog::getSaveFileName(
+      this, QString("Export plot \u201c%1\u201d").arg(plot->title()), plot->title().toLower().replace(' ', '-') + ".png",
+      "PNG image (*.png);;SVG vector image (*.svg);;PDF document (*.pdf);;CSV data (*.csv)");
+  if (!path.isEmpty()) exportPlot(plot, path);
+}
+
+QString MainWindow::exportPlot(const PlotView* plot, const QString& path) {
+  const QString suffix = suffixOf(path);
+  try {
+    const viz::Plot chart = plot->toPlot();
+    if (suffix == "png") {
+      chart.writePng(path.toStdString());
+    } else if (suffix == "svg") {
+      chart.writeSvg(path.toStdString());
+    } else if (suffix == "csv") {
+      viz::writeFileAtomically(path.toStdString(), plot->toCsv());
+    } else if (suffix == "pdf") {
+      // the SVG drawn into a PDF page of the same aspect, through a temporary file
+      QSvgRenderer svg(QByteArray::fromStdString(chart.toSvg()));
+      const std::string temp = viz::temporaryPathFor(path.toStdString());
+      {
+        QPdfWriter pdf(QString::fromStdString(temp));
+        pdf.setTitle(plot->title());
+        pdf.setCreator("Pneuma");
+        pdf.setResolution(96);
+        pdf.setPageSize(QPageSize(QSizeF(svg.defaultSize()), QPageSize::Point));
+        pdf.setPageMargins(QMarginsF(0, 0, 0, 0));
+        QPainter painter;
+        if (!painter.begin(&pdf)) throw std::runtime_error("cannot write " + temp);
+        svg.render(&painter);
+        painter.end();
+      }
+      if (QFileInfo(QString::fromStdString(temp)).size() == 0) {
+        QFile::remove(QString::fromStdString(temp));
+        throw std::runtime_error("cannot write " + path.toStdString());
+      }
+      viz::commitTemporary(temp, path.toStdString());
+    } else {
+      throw std::runtime_error("unknown plot format '." + suffix.toStdString() + "' (use .png, .svg, .pdf or .csv)");
+    }
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot export plot to '%1': %2").arg(path, e.what());
+    report("Export failed", message);
+    return message;
+  }
+  showMessage(QString("Plot exported to %1").arg(path), 5000);
+  return {};
+}
+
+QString MainWindow::exportViewImage(const QString& path) {
+  const std::string temp = viz::temporaryPathFor(path.toStdString());
+  try {
+    if (!grabView().save(QString::fromStdString(temp), "PNG")) {
+      QFile::remove(QString::fromStdString(temp));
+      throw std::runtime_error("cannot write " + path.toStdString());
+    }
+    viz::commitTemporary(temp, path.toStdString());
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot export the 3D view: %1").arg(e.what());
+    report("Export failed", message);
+    return message;
+  }
+  showMessage(QString("3D view saved to %1").arg(path), 5000);
+  return {};
+}
+
+QString MainWindow::exportAnimation(const QString& path, double from, double to, double fps) {
+  const bool isMovie = suffixOf(path) == "ogv";
+  const QFileInfo info(path);
+  std::vector<std::string> written;  // temporaries, renamed only when every frame succeeded
+  try {
+    if (!m_worker || !(to > from) || !(fps > 0.0)) throw std::runtime_error("nothing recorded to export");
+    vtkNew<vtkImageData> image;
+    vtkNew<vtkOggTheoraWriter> movie;
+    const int frames = static_cast<int>(std::floor((to - from) * fps)) + 1;
+    for (int k = 0; k < frames; ++k) {
+      if (!scrubTo(from + k / fps)) throw std::runtime_error("the recording did not answer");
+      const QImage shot = grabView();
+      if (isMovie) {
+        copyToImageData(shot, image);
+        if (k == 0) {
+          written.push_back(viz::temporaryPathFor(path.toStdString()));
+          movie->SetInputData(image);
+          movie->SetFileName(written.back().c_str());
+          movie->SetRate(static_cast<int>(std::lround(fps)));
+          movie->SetQuality(2);
+          movie->Start();
+        }
+        movie->Write();
+        if (movie->GetError()) throw std::runtime_error("the Ogg Theora writer failed on " + path.toStdString());
+      } else {
+        const QString name = info.absoluteDir().absoluteFilePath(
+            QString("%1_%2.png").arg(info.completeBaseName()).arg(k, 4, 10, QChar('0')));
+        written.push_back(viz::temporaryPathFor(name.toStdString()));
+        if (!shot.save(QString::fromStdString(written.back()), "PNG"))
+          throw std::runtime_error("cannot write " + name.toStdString());
+      }
+    }
+    if (isMovie) {
+      movie->End();
+      viz::commitTemporary(written.front(), path.toStdString());
+    } else {
+      for (int k = 0; k < static_cast<int>(written.size()); ++k)
+        viz::commitTemporary(written[static_cast<std::size_t>(k)],
+                             info.absoluteDir()
+                                 .absoluteFilePath(QString("%1_%2.png").arg(info.completeBaseName()).arg(k, 4, 10, QChar('0')))
+                                 .toStdString());
+    }
+  } catch (const std::exception& e) {
+    for (const std::string& t : written) QFile::remove(QString::fromStdString(t));
+    const QString message = QString("Cannot export the animation: %1").arg(e.what());
+    report("Export failed", message);
+    return message;
+  }
+  showMessage(QString("Animation saved to %1").arg(path), 5000);
+  return {};
+}
 
 QImage MainWindow::grabView() {
   m_view->renderWindow()->Render();

@@ -1,19 +1,33 @@
 #pragma once
 /// @file MainWindow.h
-/// Pneuma's main window: the 3D view in the centre, the status bar below.
+/// Pneuma's main window, laid out like ParaView / 3D Slicer: the 3D view with a timeline in the
+/// centre, display and parameter panels on the left, the live plots on the right, transport and
+/// style controls in the toolbar, and render fps and the simulation's real-time factor in the status bar.
+///
+/// The simulation runs in a SimWorker on its own QThread; the window only queues edits and draws
+/// the snapshots the worker publishes (refreshed at 30 Hz).
+
+#include "gui/SimWorker.h"
+#include "viz/ModelScene.h"
 
 #include <QMainWindow>
+#include <QThread>
 
 #include <memory>
 
+class QAction;
+class QCheckBox;
+class QComboBox;
 class QLabel;
+class QSlider;
+class QTimer;
 class QVTKOpenGLNativeWidget;
 
-namespace pneuma::viz {
-class ModelScene;
-}
-
 namespace pneuma::app {
+
+class LivePlots;
+class ParameterPanel;
+class PlotView;
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -22,15 +36,109 @@ class MainWindow : public QMainWindow {
   explicit MainWindow(QWidget* parent = nullptr);
   ~MainWindow() override;
 
+  /// The model directory used at start-up: $PNEUMA_MODEL_DIR, else <bindir>/../models/default.
+  static QString defaultModelDir();
+
+  /// Loads a model directory and restarts the run on it. On failure the current model stays, the
+  /// error is shown in a dialog (non-blocking) and returned. @return empty on success, else the error.
+  QString openModel(const QString& dir);
+  /// Loads a scenario file (model, style, parameters). Same failure behaviour as openModel().
+  QString openScenario(const QString& path);
+  /// Writes the current model, style and parameters as a scenario file. @return empty or the error.
+  QString saveScenario(const QString& path);
+  /// Selects a breath style preset by name ("calm", "deep", "panting", "forced-exhale").
+  QString setBreathStyle(const QString& name);
+
+  void play();
+  void pause();
+  /// Runs as fast as possible until simulated time `time` [s], then pauses and shows that instant.
+  /// Blocks (processing events) at most `timeoutMs`. @return false on timeout or a sim error.
+  bool runUntil(double time, int timeoutMs = 60000);
+  /// Shows the recorded instant nearest to `time` [s] (pauses) and waits until it is on screen.
+  bool scrubTo(double time, int timeoutMs = 5000);
+
+  /// Exports a plot by file suffix: .png, .svg, .pdf or .csv. @return empty or the error.
+  QString exportPlot(const PlotView* plot, const QString& path);
+  /// Writes a PNG of the 3D view. @return empty or the error.
+  QString exportViewImage(const QString& path);
+  /// Renders the recorded run from `from` to `to` [s] at `fps` frames per second, as an Ogg Theora
+  /// movie (.ogv) or a PNG sequence (any other suffix: <base>_0000.png, ...). @return empty or the error.
+  QString exportAnimation(const QString& path, double from, double to, double fps);
+
   /// Renders the 3D view now and returns a grab of the whole window (what the user sees).
   QImage grabWindow();
   /// Renders the 3D view now and returns a grab of the 3D view only.
   QImage grabView();
 
+  viz::ModelScene& scene() { return *m_scene; }
+  LivePlots* plots() const { return m_plots; }
+  ParameterPanel* parameters() const { return m_params; }
+  /// The snapshot on screen (null before the first one).
+  const Snapshot* shown() const { return m_shown.get(); }
+  const sim::Model* model() const { return m_model.get(); }
+  /// Applies display options and redraws.
+  void setDisplayOptions(const viz::DisplayOptions& options);
+  /// Selects what is under view pixel (x, y) (Qt widget coordinates), as a click would.
+  void pickAt(const QPoint& viewPos);
+  /// The last error reported to the user (model, scenario, export or simulation).
+  QString lastError() const { return m_lastError; }
+
+ protected:
+  bool eventFilter(QObject* watched, QEvent* event) override;
+  void closeEvent(QCloseEvent* event) override;
+
  private:
+  void buildActions();
+  void buildDocks();
+  void buildTimeline(QWidget* centre);
+  void syncDisplayWidgets();
+  void startRun(std::shared_ptr<const sim::Model> model, const QString& modelDir, const RunSettings& settings);
+  void refresh();
+  void showSnapshot(std::shared_ptr<const Snapshot> snapshot);
+  void report(const QString& title, const QString& message);
+  /// Shows `text` in the status bar for a while, then the model line again.
+  void showMessage(const QString& text, int milliseconds);
+  void select(const viz::Pick& pick);
+  QString modelDirFor(const std::string& scenarioModel) const;
+  void exportPlotInteractive(const PlotView* plot);
+  void updateTimeline();
+
   std::unique_ptr<viz::ModelScene> m_scene;
   QVTKOpenGLNativeWidget* m_view = nullptr;
-  QLabel* m_statusText = nullptr;
+  LivePlots* m_plots = nullptr;
+  ParameterPanel* m_params = nullptr;
+
+  std::shared_ptr<const sim::Model> m_model;
+  QString m_modelDir;
+  RunSettings m_settings;
+  QThread m_thread;
+  SimWorker* m_worker = nullptr;
+  std::shared_ptr<const Snapshot> m_shown;
+  long long m_generation = -1;
+  viz::Pick m_selected;
+
+  QTimer* m_refresh = nullptr;
+  QAction* m_playAction = nullptr;
+  QComboBox* m_styleCombo = nullptr;
+  QComboBox* m_speedCombo = nullptr;
+  QComboBox* m_muscleColour = nullptr;
+  QComboBox* m_gutColour = nullptr;
+  std::vector<QCheckBox*> m_structureChecks;  // bones, gut, translucent gut, cavity, landmarks, labels
+  std::vector<QCheckBox*> m_groupChecks;
+  QLabel* m_selection = nullptr;
+  QSlider* m_timeline = nullptr;
+  QLabel* m_timeLabel = nullptr;
+  QLabel* m_statusModel = nullptr;
+  QString m_modelText = "No model";
+  QTimer* m_messageTimer = nullptr;
+  QLabel* m_statusTime = nullptr;
+  QLabel* m_statusFps = nullptr;
+  QLabel* m_statusRtf = nullptr;
+  QPoint m_pressPos;
+  int m_framesRendered = 0;
+  double m_fps = 0.0;
+  qint64 m_fpsWindowStart = 0;  // [ms]
+  QString m_lastError;
 };
 
 }  // namespace pneuma::app

@@ -1,24 +1,448 @@
 #include "viz/ModelScene.h"
 
+#include "pneuma/sim/Error.h"
+
+#include <vtkActor.h>
 #include <vtkAxesActor.h>
+#include <vtkBillboardTextActor3D.h>
+#include <vtkCamera.h>
 #include <vtkCaptionActor2D.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCellPicker.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkFloatArray.h>
+#include <vtkLookupTable.h>
+#include <vtkMatrix4x4.h>
 #include <vtkOrientationMarkerWidget.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkProperty.h>
+#include <vtkPropCollection.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkSphereSource.h>
 #include <vtkTextProperty.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
 
 namespace pneuma::viz {
 
-ModelScene::ModelScene() : m_renderer(vtkSmartPointer<vtkRenderer>::New()) {
+namespace {
+
+constexpr int kGroups = sim::kElementGroupCount;
+
+// colour scale of contractive force: pale orange (weak) to deep red (strong), never grey or blue
+vtkSmartPointer<vtkLookupTable> makeForceTable() {
+  vtkNew<vtkColorTransferFunction> ramp;
+  ramp->AddRGBPoint(0.0, 1.0, 0.78, 0.30);
+  ramp->AddRGBPoint(0.5, 0.95, 0.38, 0.08);
+  ramp->AddRGBPoint(1.0, 0.62, 0.0, 0.05);
+  auto table = vtkSmartPointer<vtkLookupTable>::New();
+  table->SetNumberOfTableValues(256);
+  for (int i = 0; i < 256; ++i) {
+    double rgb[3];
+    ramp->GetColor(i / 255.0, rgb);
+    table->SetTableValue(i, rgb[0], rgb[1], rgb[2], 1.0);
+  }
+  table->SetNanColor(0.62, 0.62, 0.62, 1.0);  // slack elements are grey (Figure 3)
+  table->Build();
+  return table;
+}
+
+// colour scale of the gut: deep blue to cyan to white
+vtkSmartPointer<vtkLookupTable> makeGutTable() {
+  vtkNew<vtkColorTransferFunction> ramp;
+  ramp->AddRGBPoint(0.0, 0.17, 0.25, 0.62);
+  ramp->AddRGBPoint(0.6, 0.25, 0.72, 0.85);
+  ramp->AddRGBPoint(1.0, 0.88, 0.97, 1.0);
+  auto table = vtkSmartPointer<vtkLookupTable>::New();
+  table->SetNumberOfTableValues(256);
+  for (int i = 0; i < 256; ++i) {
+    double rgb[3];
+    ramp->GetColor(i / 255.0, rgb);
+    table->SetTableValue(i, rgb[0], rgb[1], rgb[2], 1.0);
+  }
+  table->Build();
+  return table;
+}
+
+// a vertical colour legend at the right edge of the view, from height y to y + 0.4 (normalised viewport)
+vtkSmartPointer<vtkScalarBarActor> makeScalarBar(vtkLookupTable* table, const char* title, double y) {
+  auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
+  bar->SetLookupTable(table);
+  bar->SetTitle(title);
+  bar->SetNumberOfLabels(5);
+  bar->SetLabelFormat("%-#6.3g");
+  bar->SetPosition(0.875, y);
+  bar->SetWidth(0.115);
+  bar->SetHeight(0.4);
+  bar->SetBarRatio(0.28);
+  bar->UnconstrainedFontSizeOn();
+  for (vtkTextProperty* text : {bar->GetTitleTextProperty(), bar->GetLabelTextProperty()}) {
+    text->SetFontSize(13);
+    text->ShadowOff();
+    text->ItalicOff();
+    text->SetColor(0.93, 0.93, 0.93);
+  }
+  bar->GetTitleTextProperty()->BoldOn();
+  return bar;
+}
+
+// a rounded-up "nice" number (1, 2, 5 times a power of ten) for colour-scale tops
+double niceCeil(double v) {
+  if (!(v > 0.0)) return 1.0;
+  const double p = std::pow(10.0, std::floor(std::log10(v)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * p >= v) return m * p;
+  return 10.0 * p;
+}
+
+vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::string& bodyName) {
+  if (!std::filesystem::is_regular_file(path))
+    throw sim::Error("bodies." + bodyName + ".mesh: file not found: " + path);
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0 || reader->GetOutput()->GetNumberOfPoints() == 0)
+    throw sim::Error("bodies." + bodyName + ".mesh: not a readable VTK polydata file: " + path);
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputConnection(reader->GetOutputPort());
+  normals->SetFeatureAngle(60.0);
+  normals->Update();
+  return normals->GetOutput();
+}
+
+vtkSmartPointer<vtkBillboardTextActor3D> makeLabel(const std::string& text) {
+  auto label = vtkSmartPointer<vtkBillboardTextActor3D>::New();
+  label->SetInput(text.c_str());
+  label->GetTextProperty()->SetFontSize(15);
+  label->GetTextProperty()->SetColor(1.0, 1.0, 0.85);
+  label->GetTextProperty()->SetBackgroundColor(0.08, 0.09, 0.12);
+  label->GetTextProperty()->SetBackgroundOpacity(0.6);
+  label->GetTextProperty()->SetJustificationToCentered();
+  label->PickableOff();
+  return label;
+}
+
+}  // namespace
+
+const char* groupLabel(sim::ElementGroup g) {
+  switch (g) {
+    case sim::ElementGroup::IntercostalExternal: return "External intercostals";
+    case sim::ElementGroup::IntercostalInternal: return "Internal intercostals";
+    case sim::ElementGroup::Diaphragm: return "Diaphragm";
+    case sim::ElementGroup::Rectus: return "Rectus abdominis";
+    case sim::ElementGroup::TransversusObliques: return "Transversus / obliques";
+    case sim::ElementGroup::Cartilage: return "Costal cartilage";
+    case sim::ElementGroup::Count: break;
+  }
+  return "?";
+}
+
+std::array<double, 3> groupColour(sim::ElementGroup g) {
+  switch (g) {
+    case sim::ElementGroup::IntercostalExternal: return {0.30, 0.78, 0.36};
+    case sim::ElementGroup::IntercostalInternal: return {0.62, 0.42, 0.86};
+    case sim::ElementGroup::Diaphragm: return {0.78, 0.36, 0.18};   // rust
+    case sim::ElementGroup::Rectus: return {0.96, 0.62, 0.72};      // pink
+    case sim::ElementGroup::TransversusObliques: return {0.33, 0.52, 0.93};  // blue
+    case sim::ElementGroup::Cartilage: return {0.86, 0.86, 0.78};
+    case sim::ElementGroup::Count: break;
+  }
+  return {1.0, 1.0, 1.0};
+}
+
+struct ModelScene::Impl {
+  vtkSmartPointer<vtkRenderer> renderer = vtkSmartPointer<vtkRenderer>::New();
+  vtkSmartPointer<vtkOrientationMarkerWidget> marker;
+  vtkSmartPointer<vtkLookupTable> forceTable = makeForceTable();
+  vtkSmartPointer<vtkLookupTable> gutTable = makeGutTable();
+  vtkSmartPointer<vtkScalarBarActor> forceBar = makeScalarBar(forceTable, "Contractive\nforce [N]", 0.55);
+  vtkSmartPointer<vtkScalarBarActor> gutBar = makeScalarBar(gutTable, "Gut", 0.07);
+  DisplayOptions options;
+
+  sim::Model model;
+  double maxForceSeen = 0.0;  // [N]
+  double maxDisplacementSeen = 0.0;  // [m]
+
+  // muscle elements, one actor per group (points 2k, 2k+1 are the ends of the group's k-th element)
+  struct Group {
+    std::vector<int> element;  // model element index of each line
+    vtkSmartPointer<vtkPolyData> lines;
+    vtkSmartPointer<vtkFloatArray> force;  // [N] contractive force, NaN when slack
+    vtkSmartPointer<vtkActor> actor;
+  };
+  std::array<Group, kGroups> groups;
+  Eigen::Matrix3Xd endA, endB;  // [m] element end positions (3 x #E)
+
+  std::vector<vtkSmartPointer<vtkActor>> bodies;
+  std::vector<vtkSmartPointer<vtkMatrix4x4>> bodyPose;
+
+  vtkSmartPointer<vtkPolyData> gut;
+  vtkSmartPointer<vtkFloatArray> gutScalar;
+  vtkSmartPointer<vtkActor> gutActor;
+
+  vtkSmartPointer<vtkPolyData> cavity;
+  vtkSmartPointer<vtkActor> cavityActor;
+  Eigen::Matrix3Xd cavityPoints;  // [m]
+
+  vtkSmartPointer<vtkPolyData> landmarks;
+  vtkSmartPointer<vtkActor> landmarkActor;
+
+  // teaching labels: landmarks, group centres, and a few named bones
+  struct Label {
+    vtkSmartPointer<vtkBillboardTextActor3D> actor;
+    int landmark = -1, group = -1, body = -1;
+  };
+  std::vector<Label> labels;
+
+  Pick highlight;
+  vtkSmartPointer<vtkPolyData> highlightLine;
+  vtkSmartPointer<vtkActor> highlightActor;
+
+  void clear() {
+    for (vtkProp* prop : ownedProps()) renderer->RemoveViewProp(prop);
+    for (Group& g : groups) g = Group{};
+    bodies.clear();
+    bodyPose.clear();
+    labels.clear();
+    gutActor = cavityActor = landmarkActor = highlightActor = nullptr;
+    highlight = Pick{};
+    maxForceSeen = maxDisplacementSeen = 0.0;
+  }
+
+  std::vector<vtkProp*> ownedProps() const {
+    std::vector<vtkProp*> props;
+    for (const Group& g : groups)
+      if (g.actor) props.push_back(g.actor);
+    for (const auto& b : bodies) props.push_back(b);
+    for (const Label& l : labels) props.push_back(l.actor);
+    for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
+                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
+      if (p) props.push_back(p);
+    return props;
+  }
+
+  static vtkSmartPointer<vtkActor> actorFor(vtkPolyData* data) {
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputData(data);
+    auto actor = vtkSmartPointer<vtkActor>::New();
+    actor->SetMapper(mapper);
+    return actor;
+  }
+
+  static vtkSmartPointer<vtkPolyData> surface(int nPoints, const Eigen::Matrix3Xi& triangles) {
+    auto data = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPoints> points;
+    points->SetNumberOfPoints(nPoints);
+    data->SetPoints(points);
+    vtkNew<vtkCellArray> polys;
+    for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
+      const vtkIdType ids[3] = {triangles(0, t), triangles(1, t), triangles(2, t)};
+      polys->InsertNextCell(3, ids);
+    }
+    data->SetPolys(polys);
+    return data;
+  }
+
+  static void setPoints(vtkPolyData* data, const Eigen::Matrix3Xd& x) {
+    vtkPoints* points = data->GetPoints();
+    for (Eigen::Index i = 0; i < x.cols(); ++i) points->SetPoint(i, x(0, i), x(1, i), x(2, i));
+    points->Modified();
+  }
+
+  // body meshes in body-frame coordinates; a small sphere for bodies without one
+  static std::vector<vtkSmartPointer<vtkPolyData>> readBodyMeshes(const sim::Model& model, const std::string& modelDir) {
+    std::vector<vtkSmartPointer<vtkPolyData>> meshes;
+    for (int b = 0; b < model.bodies.size(); ++b) {
+      const std::string& file = model.bodies.mesh[static_cast<std::size_t>(b)];
+      if (file.empty()) {
+        vtkNew<vtkSphereSource> sphere;
+        sphere->SetRadius(0.008);
+        sphere->Update();
+        meshes.emplace_back(sphere->GetOutput());
+      } else {
+        meshes.push_back(readBodyMesh((std::filesystem::path(modelDir) / file).string(),
+                                      model.bodies.name[static_cast<std::size_t>(b)]));
+      }
+    }
+    return meshes;
+  }
+
+  void build(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes) {
+    // bones
+    for (int b = 0; b < model.bodies.size(); ++b) {
+      auto actor = actorFor(meshes[static_cast<std::size_t>(b)]);
+      const bool isFixed = model.bodies.isFixed[static_cast<std::size_t>(b)] != 0;
+      if (isFixed) actor->GetProperty()->SetColor(0.50, 0.49, 0.47);  // fixed bodies are dark (Figure 2)
+      else actor->GetProperty()->SetColor(0.93, 0.90, 0.82);
+      actor->GetProperty()->SetSpecular(0.25);
+      actor->GetProperty()->SetSpecularPower(20.0);
+      auto pose = vtkSmartPointer<vtkMatrix4x4>::New();
+      actor->SetUserMatrix(pose);
+      bodies.push_back(actor);
+      bodyPose.push_back(pose);
+    }
+
+    // muscle elements by group
+    for (int e = 0; e < model.elements.size(); ++e)
+      groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(e);
+    for (int gi = 0; gi < kGroups; ++gi) {
+      Group& g = groups[static_cast<std::size_t>(gi)];
+      const int n = static_cast<int>(g.element.size());
+      g.lines = vtkSmartPointer<vtkPolyData>::New();
+      vtkNew<vtkPoints> points;
+      points->SetNumberOfPoints(2 * n);
+      g.lines->SetPoints(points);
+      vtkNew<vtkCellArray> cells;
+      for (int k = 0; k < n; ++k) {
+        const vtkIdType ids[2] = {2 * k, 2 * k + 1};
+        cells->InsertNextCell(2, ids);
+      }
+      g.lines->SetLines(cells);
+      g.force = vtkSmartPointer<vtkFloatArray>::New();
+      g.force->SetName("contractive_force_N");
+      g.force->SetNumberOfValues(n);
+      g.force->Fill(std::numeric_limits<float>::quiet_NaN());
+      g.lines->GetCellData()->SetScalars(g.force);
+      g.actor = actorFor(g.lines);
+      g.actor->GetMapper()->SetLookupTable(forceTable);
+      g.actor->GetMapper()->SetScalarModeToUseCellData();
+      g.actor->GetMapper()->UseLookupTableScalarRangeOn();
+      g.actor->GetProperty()->SetLineWidth(gi == static_cast<int>(sim::ElementGroup::Cartilage) ? 3.0f : 2.5f);
+      g.actor->GetProperty()->SetRenderLinesAsTubes(true);
+    }
+
+    // gut, cavity, landmarks
+    gut = surface(model.nodes.size(), model.gut.triangles);
+    gutScalar = vtkSmartPointer<vtkFloatArray>::New();
+    gutScalar->SetNumberOfValues(model.nodes.size());
+    gutScalar->Fill(0.0f);
+    gut->GetPointData()->SetScalars(gutScalar);
+    vtkNew<vtkPolyDataNormals> gutNormals;
+    gutNormals->SetInputData(gut);
+    gutNormals->SplittingOff();
+    vtkNew<vtkPolyDataMapper> gutMapper;
+    gutMapper->SetInputConnection(gutNormals->GetOutputPort());
+    gutMapper->SetLookupTable(gutTable);
+    gutMapper->UseLookupTableScalarRangeOn();
+    gutActor = vtkSmartPointer<vtkActor>::New();
+    gutActor->SetMapper(gutMapper);
+    gutActor->PickableOff();
+
+    cavity = surface(model.cavity.vertices.size(), model.cavity.triangles);
+    cavityActor = actorFor(cavity);
+    cavityActor->GetProperty()->SetColor(0.55, 0.78, 0.98);
+    cavityActor->GetProperty()->SetOpacity(0.28);
+    cavityActor->PickableOff();
+
+    landmarks = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPoints> lmPoints;
+    lmPoints->SetNumberOfPoints(static_cast<vtkIdType>(model.landmarks.name.size()));
+    landmarks->SetPoints(lmPoints);
+    vtkNew<vtkCellArray> verts;
+    for (vtkIdType i = 0; i < lmPoints->GetNumberOfPoints(); ++i) verts->InsertNextCell(1, &i);
+    landmarks->SetVerts(verts);
+    landmarkActor = actorFor(landmarks);
+    landmarkActor->GetProperty()->SetColor(0.25, 0.95, 0.55);
+    landmarkActor->GetProperty()->SetPointSize(11.0f);
+    landmarkActor->GetProperty()->SetRenderPointsAsSpheres(true);
+    landmarkActor->PickableOff();
+
+    // labels
+    for (std::size_t l = 0; l < model.landmarks.name.size(); ++l) {
+      Label label{makeLabel(model.landmarks.name[l]), static_cast<int>(l), -1, -1};
+      labels.push_back(label);
+    }
+    for (int gi = 0; gi < kGroups; ++gi)
+      if (!groups[static_cast<std::size_t>(gi)].element.empty())
+        labels.push_back(Label{makeLabel(groupLabel(static_cast<sim::ElementGroup>(gi))), -1, gi, -1});
+    for (int b = 0; b < model.bodies.size(); ++b) {
+      const std::string& name = model.bodies.name[static_cast<std::size_t>(b)];
+      if (name == "sternum" || name == "pelvis") labels.push_back(Label{makeLabel(name), -1, -1, b});
+    }
+
+    // selection highlight: one bright line
+    highlightLine = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPoints> hlPoints;
+    hlPoints->SetNumberOfPoints(2);
+    highlightLine->SetPoints(hlPoints);
+    vtkNew<vtkCellArray> hlCell;
+    const vtkIdType hlIds[2] = {0, 1};
+    hlCell->InsertNextCell(2, hlIds);
+    highlightLine->SetLines(hlCell);
+    highlightActor = actorFor(highlightLine);
+    highlightActor->GetProperty()->SetColor(0.2, 1.0, 1.0);
+    highlightActor->GetProperty()->SetLineWidth(7.0f);
+    highlightActor->GetProperty()->SetRenderLinesAsTubes(true);
+    highlightActor->PickableOff();
+    highlightActor->VisibilityOff();
+
+    for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
+  }
+
+  void applyOptions() {
+    const bool byForce = options.muscleColouring == MuscleColouring::Force;
+    bool anyMuscleShown = false;
+    for (int gi = 0; gi < kGroups; ++gi) {
+      Group& g = groups[static_cast<std::size_t>(gi)];
+      if (!g.actor) continue;
+      const auto group = static_cast<sim::ElementGroup>(gi);
+      // structural springs keep their own colour: they carry no muscle force
+      const bool colourByForce = byForce && sim::isMuscleGroup(group);
+      g.actor->GetMapper()->SetScalarVisibility(colourByForce);
+      const auto rgb = groupColour(group);
+      g.actor->GetProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
+      const bool shown = options.showGroup[static_cast<std::size_t>(gi)];
+      g.actor->SetVisibility(shown);
+      anyMuscleShown = anyMuscleShown || (shown && colourByForce && !g.element.empty());
+    }
+    forceBar->SetVisibility(anyMuscleShown);
+    for (const auto& b : bodies) b->SetVisibility(options.showBones);
+    if (gutActor) {
+      gutActor->SetVisibility(options.showGut);
+      gutActor->GetProperty()->SetOpacity(options.isGutTranslucent ? 0.35 : 1.0);
+      const bool coloured = options.gutColouring != GutColouring::Plain;
+      gutActor->GetMapper()->SetScalarVisibility(coloured);
+      gutActor->GetProperty()->SetColor(0.72, 0.58, 0.82);
+      gutBar->SetTitle(options.gutColouring == GutColouring::Pressure ? "Gut\npressure [Pa]"
+                                                                       : "Gut\ndisplacement\n[mm]");
+      gutBar->SetVisibility(options.showGut && coloured);
+    }
+    if (cavityActor) cavityActor->SetVisibility(options.showCavity);
+    if (landmarkActor) landmarkActor->SetVisibility(options.showLandmarks);
+    for (const Label& l : labels) {
+      const bool relevant = l.group >= 0 ? options.showGroup[static_cast<std::size_t>(l.group)]
+                          : l.landmark >= 0 ? options.showLandmarks
+                                            : options.showBones;
+      l.actor->SetVisibility(options.showLabels && relevant);
+    }
+  }
+};
+
+ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
+  vtkRenderer* r = m_impl->renderer;
   // paraview-like blue-grey gradient
-  m_renderer->GradientBackgroundOn();
-  m_renderer->SetBackground(0.11, 0.12, 0.16);
-  m_renderer->SetBackground2(0.36, 0.39, 0.47);
+  r->GradientBackgroundOn();
+  r->SetBackground(0.11, 0.12, 0.16);
+  r->SetBackground2(0.36, 0.39, 0.47);
+  r->AddViewProp(m_impl->forceBar);
+  r->AddViewProp(m_impl->gutBar);
+  m_impl->forceBar->VisibilityOff();
+  m_impl->gutBar->VisibilityOff();
 }
 
 ModelScene::~ModelScene() = default;
 
-vtkRenderer* ModelScene::renderer() const { return m_renderer; }
+vtkRenderer* ModelScene::renderer() const { return m_impl->renderer; }
 
 void ModelScene::installOrientationMarker(vtkRenderWindowInteractor* interactor) {
   // axes labelled with the anatomical directions of the RAS world frame
@@ -32,13 +456,195 @@ void ModelScene::installOrientationMarker(vtkRenderWindowInteractor* interactor)
     caption->GetCaptionTextProperty()->ShadowOff();
     caption->GetCaptionTextProperty()->ItalicOff();
   }
-  m_marker = vtkSmartPointer<vtkOrientationMarkerWidget>::New();
-  m_marker->SetOrientationMarker(axes);
-  m_marker->SetInteractor(interactor);
-  m_marker->SetDefaultRenderer(m_renderer);
-  m_marker->SetViewport(0.0, 0.0, 0.16, 0.22);
-  m_marker->SetEnabled(1);
-  m_marker->InteractiveOff();
+  m_impl->marker = vtkSmartPointer<vtkOrientationMarkerWidget>::New();
+  m_impl->marker->SetOrientationMarker(axes);
+  m_impl->marker->SetInteractor(interactor);
+  m_impl->marker->SetDefaultRenderer(m_impl->renderer);
+  m_impl->marker->SetViewport(0.0, 0.0, 0.14, 0.2);
+  m_impl->marker->SetEnabled(1);
+  m_impl->marker->InteractiveOff();
+}
+
+void ModelScene::setModel(const sim::Model& model, const std::string& modelDir) {
+  // read everything first so a failure leaves the current scene untouched
+  const auto meshes = Impl::readBodyMeshes(model, modelDir);
+  m_impl->clear();
+  m_impl->model = model;
+  m_impl->build(meshes);
+  m_impl->applyOptions();
+  const sim::State rest = sim::makeInitialState(model);
+  sim::Metrics relaxed;
+  relaxed.elementForce = Eigen::VectorXd::Zero(model.elements.size());
+  relaxed.isSlack.assign(static_cast<std::size_t>(model.elements.size()), 1);
+  update(rest, relaxed);
+  setCamera(CameraPreset::Oblique);
+}
+
+void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
+  Impl& s = *m_impl;
+  const sim::Model& model = s.model;
+
+  // bones: rigid transforms body -> world
+  for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+    const Eigen::Matrix3d R = state.bodyOrientation[b].toRotationMatrix();
+    const Eigen::Vector3d x = state.bodyPosition.col(static_cast<Eigen::Index>(b));
+    vtkMatrix4x4* m = s.bodyPose[b];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) m->SetElement(i, j, R(i, j));
+      m->SetElement(i, 3, x(i));
+    }
+    m->Modified();
+  }
+
+  // muscle elements: end positions and contractive force magnitude (NaN = slack = grey)
+  sim::anchorPositions(model.elements.endA, state, s.endA);
+  sim::anchorPositions(model.elements.endB, state, s.endB);
+  const bool hasForces = metrics.elementForce.size() == model.elements.size();
+  double maxForce = 0.0;
+  for (Impl::Group& g : s.groups) {
+    if (!g.lines) continue;
+    vtkPoints* points = g.lines->GetPoints();
+    for (std::size_t k = 0; k < g.element.size(); ++k) {
+      const int e = g.element[k];
+      const auto id = static_cast<vtkIdType>(2 * k);
+      points->SetPoint(id, s.endA(0, e), s.endA(1, e), s.endA(2, e));
+      points->SetPoint(id + 1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
+      const double tension = hasForces ? std::max(0.0, -metrics.elementForce(e)) : 0.0;
+      const bool isSlack = !(tension > 0.0) ||
+                           (static_cast<std::size_t>(e) < metrics.isSlack.size() && metrics.isSlack[static_cast<std::size_t>(e)]);
+      g.force->SetValue(static_cast<vtkIdType>(k), isSlack ? std::numeric_limits<float>::quiet_NaN()
+                                                           : static_cast<float>(tension));
+      if (!isSlack && sim::isMuscleGroup(model.elements.group[static_cast<std::size_t>(e)]))
+        maxForce = std::max(maxForce, tension);
+    }
+    points->Modified();
+    g.force->Modified();
+  }
+  s.maxForceSeen = std::max(s.maxForceSeen, maxForce);
+  const double top = s.options.forceRange > 0.0 ? s.options.forceRange : niceCeil(s.maxForceSeen);
+  s.forceTable->SetTableRange(0.0, top);
+
+  // gut surface and its colour
+  if (s.gut) {
+    Impl::setPoints(s.gut, state.nodePosition);
+    double maxDisp = 0.0;
+    for (int n = 0; n < model.nodes.size(); ++n) {
+      const double d = (state.nodePosition.col(n) - model.nodes.rest.col(n)).norm();
+      maxDisp = std::max(maxDisp, d);
+      const double value = s.options.gutColouring == GutColouring::Pressure ? metrics.gutPressure : 1000.0 * d;
+      s.gutScalar->SetValue(n, static_cast<float>(value));
+    }
+    s.gutScalar->Modified();
+    s.maxDisplacementSeen = std::max(s.maxDisplacementSeen, maxDisp);
+    if (s.options.gutColouring == GutColouring::Pressure) {
+      const double p = niceCeil(std::max(std::abs(metrics.gutPressure), 1.0));
+      s.gutTable->SetTableRange(-p, p);
+    } else {
+      s.gutTable->SetTableRange(0.0, niceCeil(std::max(1000.0 * s.maxDisplacementSeen, 1.0)));
+    }
+  }
+
+  // cavity and landmarks
+  if (s.cavity) {
+    sim::anchorPositions(model.cavity.vertices, state, s.cavityPoints);
+    Impl::setPoints(s.cavity, s.cavityPoints);
+  }
+  Eigen::Matrix3Xd lm;
+  sim::anchorPositions(model.landmarks.points, state, lm);
+  if (s.landmarks) Impl::setPoints(s.landmarks, lm);
+
+  // labels follow their structures
+  for (const Impl::Label& l : s.labels) {
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    if (l.landmark >= 0) {
+      at = lm.col(l.landmark) + Eigen::Vector3d(0.0, 0.0, 0.012);
+    } else if (l.body >= 0) {
+      at = state.bodyPosition.col(l.body);
+    } else {
+      const auto& elems = s.groups[static_cast<std::size_t>(l.group)].element;
+      for (int e : elems) at += 0.5 * (s.endA.col(e) + s.endB.col(e));
+      at /= static_cast<double>(std::max<std::size_t>(elems.size(), 1));
+    }
+    l.actor->SetPosition(at.x(), at.y(), at.z());
+  }
+
+  // selection highlight
+  if (s.highlight.kind == Pick::Kind::Element) {
+    const int e = s.highlight.index;
+    s.highlightLine->GetPoints()->SetPoint(0, s.endA(0, e), s.endA(1, e), s.endA(2, e));
+    s.highlightLine->GetPoints()->SetPoint(1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
+    s.highlightLine->GetPoints()->Modified();
+  }
+}
+
+void ModelScene::setOptions(const DisplayOptions& options) {
+  m_impl->options = options;
+  m_impl->applyOptions();
+}
+
+const DisplayOptions& ModelScene::options() const { return m_impl->options; }
+
+void ModelScene::setCamera(CameraPreset preset) {
+  Eigen::Vector3d dir(0.0, 1.0, 0.0);  // from the camera's side toward... the camera (RAS)
+  Eigen::Vector3d up(0.0, 0.0, 1.0);
+  switch (preset) {
+    case CameraPreset::Anterior: dir = {0.0, 1.0, 0.0}; break;
+    case CameraPreset::Lateral: dir = {1.0, 0.0, 0.0}; break;
+    case CameraPreset::Superior: dir = {0.0, 0.0, 1.0}; up = {0.0, 1.0, 0.0}; break;
+    case CameraPreset::Oblique: dir = Eigen::Vector3d(0.8, 1.0, 0.45).normalized(); break;
+  }
+  vtkCamera* camera = m_impl->renderer->GetActiveCamera();
+  camera->SetFocalPoint(0.0, 0.0, 0.0);
+  camera->SetPosition(dir.x(), dir.y(), dir.z());
+  camera->SetViewUp(up.x(), up.y(), up.z());
+  m_impl->renderer->ResetCamera();
+  camera->Zoom(1.15);
+  m_impl->renderer->ResetCameraClippingRange();
+}
+
+Pick ModelScene::pick(int x, int y) const {
+  vtkNew<vtkCellPicker> picker;
+  picker->SetTolerance(0.004);
+  if (!picker->Pick(x, y, 0.0, m_impl->renderer)) return {};
+  vtkActor* hit = picker->GetActor();
+  for (const Impl::Group& g : m_impl->groups)
+    if (hit && hit == g.actor && picker->GetCellId() >= 0 &&
+        static_cast<std::size_t>(picker->GetCellId()) < g.element.size())
+      return {Pick::Kind::Element, g.element[static_cast<std::size_t>(picker->GetCellId())]};
+  for (std::size_t b = 0; b < m_impl->bodies.size(); ++b)
+    if (hit == m_impl->bodies[b]) return {Pick::Kind::Body, static_cast<int>(b)};
+  return {};
+}
+
+void ModelScene::setHighlight(const Pick& pick) {
+  Impl& s = *m_impl;
+  // restore the previous body colour, then mark the new selection
+  if (s.highlight.kind == Pick::Kind::Body) {
+    const bool isFixed = s.model.bodies.isFixed[static_cast<std::size_t>(s.highlight.index)] != 0;
+    if (isFixed) s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.50, 0.49, 0.47);
+    else s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.93, 0.90, 0.82);
+  }
+  s.highlight = pick;
+  if (!s.highlightActor) return;
+  s.highlightActor->SetVisibility(pick.kind == Pick::Kind::Element);
+  if (pick.kind == Pick::Kind::Body)
+    s.bodies[static_cast<std::size_t>(pick.index)]->GetProperty()->SetColor(0.3, 0.95, 0.95);
+  if (pick.kind == Pick::Kind::Element) {
+    const int e = pick.index;
+    s.highlightLine->GetPoints()->SetPoint(0, s.endA(0, e), s.endA(1, e), s.endA(2, e));
+    s.highlightLine->GetPoints()->SetPoint(1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
+    s.highlightLine->GetPoints()->Modified();
+  }
+}
+
+std::string ModelScene::describe(const Pick& pick) const {
+  const sim::Model& model = m_impl->model;
+  if (pick.kind == Pick::Kind::Body) return model.bodies.name[static_cast<std::size_t>(pick.index)];
+  if (pick.kind == Pick::Kind::Element) {
+    const auto g = model.elements.group[static_cast<std::size_t>(pick.index)];
+    return std::string(groupLabel(g)) + " element " + std::to_string(pick.index);
+  }
+  return {};
 }
 
 }  // namespace pneuma::viz

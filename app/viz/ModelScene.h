@@ -1,18 +1,59 @@
 #pragma once
 /// @file ModelScene.h
-/// The 3D scene of a Pneuma model: a VTK renderer with a ParaView-like backdrop and an RAS
-/// orientation marker, into which the model's bodies, muscle elements, gut, cavity and landmarks are drawn.
+/// The 3D scene of a Pneuma model (Zordan et al. 2004, Figures 2 and 3): shaded bones, muscle
+/// elements drawn as tube-shaded lines coloured by contractive force (slack ones grey) or by group,
+/// the gut surface coloured by pressure or displacement, the lung cavity, landmarks and teaching labels,
+/// on a ParaView-like backdrop with an RAS orientation marker. Qt-free: the GUI puts renderer() into a
+/// QVTKOpenGLNativeWidget, the CLI into an off-screen window.
+
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Model.h"
+#include "pneuma/sim/State.h"
 
 #include <vtkSmartPointer.h>
 
+#include <array>
+#include <memory>
+#include <string>
+
 class vtkRenderer;
 class vtkRenderWindowInteractor;
-class vtkOrientationMarkerWidget;
 
 namespace pneuma::viz {
 
-/// Owns the renderer of one 3D view. Qt-free: the GUI puts the renderer into a QVTKOpenGLNativeWidget,
-/// the CLI into an off-screen render window.
+/// How muscle elements are coloured.
+enum class MuscleColouring { Force, Group };
+/// How the gut surface is coloured.
+enum class GutColouring { Plain, Pressure, Displacement };
+/// Camera presets, looking at the whole model.
+enum class CameraPreset { Anterior, Lateral, Superior, Oblique };
+
+/// Human-readable name of an element group for legends and labels ("External intercostals", ...).
+const char* groupLabel(sim::ElementGroup g);
+/// Display colour (RGB in [0, 1]) of an element group, after Figure 2 of Zordan et al. 2004.
+std::array<double, 3> groupColour(sim::ElementGroup g);
+
+/// What is drawn and how. Defaults: the teaching view of Figure 3 (force-coloured muscles, slack grey).
+struct DisplayOptions {
+  MuscleColouring muscleColouring = MuscleColouring::Force;
+  GutColouring gutColouring = GutColouring::Displacement;
+  bool isGutTranslucent = true;
+  bool showBones = true;
+  bool showGut = true;
+  bool showCavity = false;
+  bool showLandmarks = true;
+  bool showLabels = false;
+  std::array<bool, sim::kElementGroupCount> showGroup{true, true, true, true, true, true};
+  double forceRange = 0.0;  ///< [N] top of the force colour scale; 0 = adapt to the largest force seen
+};
+
+/// What a pick in the view hit.
+struct Pick {
+  enum class Kind { None, Element, Body } kind = Kind::None;
+  int index = -1;  ///< element or body index
+};
+
+/// Owns the renderer of one 3D view and the actors of one model.
 class ModelScene {
  public:
   ModelScene();
@@ -27,9 +68,33 @@ class ModelScene {
   /// driven by `interactor` (the marker is a widget, so it needs the window's interactor).
   void installOrientationMarker(vtkRenderWindowInteractor* interactor);
 
+  /// Replaces the drawn model. Body meshes (.vtp, body frame [m]) are read relative to `modelDir`;
+  /// bodies without a mesh are drawn as a small sphere at their centre of mass.
+  /// @throws sim::Error when a body mesh cannot be read (naming the body and file).
+  void setModel(const sim::Model& model, const std::string& modelDir);
+
+  /// Moves everything to `state` and colours it from `metrics` (elementForce [N], gutPressure [Pa]).
+  /// `state` and `metrics` must belong to the model given to setModel().
+  void update(const sim::State& state, const sim::Metrics& metrics);
+
+  /// Applies display options (visibility, colouring, translucency).
+  void setOptions(const DisplayOptions& options);
+  const DisplayOptions& options() const;
+
+  /// Points the camera at the whole model from a preset direction.
+  void setCamera(CameraPreset preset);
+
+  /// The element or body under display pixel (x, y) (VTK display coordinates, origin bottom-left).
+  Pick pick(int x, int y) const;
+  /// Highlights one element or body (Kind::None clears the highlight).
+  void setHighlight(const Pick& pick);
+
+  /// Display name of an element ("diaphragm element 12") or a body (its model name).
+  std::string describe(const Pick& pick) const;
+
  private:
-  vtkSmartPointer<vtkRenderer> m_renderer;
-  vtkSmartPointer<vtkOrientationMarkerWidget> m_marker;
+  struct Impl;
+  std::unique_ptr<Impl> m_impl;
 };
 
 }  // namespace pneuma::viz

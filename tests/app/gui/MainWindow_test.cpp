@@ -1,41 +1,58 @@
-// What the user sees in the main window, asserted on grabs under Xvfb.
+// What the user sees in the main window, asserted on grabs, widgets and exported files under Xvfb.
+// The run uses the sim tests' toy torso (every part of the default model at a tenth of the size).
 
+#include "GuiTestSupport.h"
+#include "gui/LivePlots.h"
 #include "gui/MainWindow.h"
+#include "gui/ParameterPanel.h"
+#include "gui/PlotView.h"
+#include "pneuma/sim/Metrics.h"
 
-#include <QApplication>
-#include <QImage>
-#include <QSurfaceFormat>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QFile>
+#include <QLineEdit>
+#include <QSvgRenderer>
+#include <QTextStream>
 #include <gtest/gtest.h>
 
-#include <set>
+#include <cmath>
+
+using namespace pneuma;
+using namespace pneuma::app::test;
+using pneuma::app::MainWindow;
 
 namespace {
 
-// one QApplication per test process, created on first use (test discovery never creates it)
-QApplication& app() {
-  static int argc = 1;
-  static char name[] = "pneuma_gui_tests";
-  static char* argv[] = {name, nullptr};
-  static QApplication* instance = [] {
-    QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
-    return new QApplication(argc, argv);
-  }();
-  return *instance;
-}
+// a window running the toy torso
+struct ToyWindow {
+  QApplication& qt = application();  // before any widget
+  QTemporaryDir dir;
+  QString modelDir;
+  MainWindow window;
+  ToyWindow() {
+    modelDir = writeToyModel(dir);
+    window.show();
+    QApplication::processEvents();
+    EXPECT_EQ(window.openModel(modelDir), QString());
+  }
+};
 
-int distinctColours(const QImage& image) {
-  std::set<QRgb> colours;
-  for (int y = 0; y < image.height(); y += 2)
-    for (int x = 0; x < image.width(); x += 2) colours.insert(image.pixel(x, y));
-  return static_cast<int>(colours.size());
+// the breathing rate [1/min] measured from the lung volume the volume plot holds, from time `from` [s]
+double plottedRate(const app::PlotView& plot, double from) {
+  sim::Trace trace;
+  for (std::size_t k = 0; k < plot.time().size(); ++k) {
+    sim::Metrics m;
+    m.time = plot.time()[k];
+    m.lungVolume = plot.series()[0].y[k];
+    trace.append(m);
+  }
+  return sim::summarize(trace, {}, from).breathsPerMinute;
 }
 
 }  // namespace
 
 TEST(MainWindow, ViewRendersBackdropAndAxes) {
-  app();
-  pneuma::app::MainWindow window;
+  application();
+  MainWindow window;
   window.show();
   QApplication::processEvents();
 
@@ -46,6 +63,187 @@ TEST(MainWindow, ViewRendersBackdropAndAxes) {
   EXPECT_GT(distinctColours(view), 20);
 
   // the whole-window grab includes the view, not a black hole where GL should be
-  const QImage whole = window.grabWindow();
-  EXPECT_GT(distinctColours(whole), 20);
+  EXPECT_GT(distinctColours(window.grabWindow()), 20);
+}
+
+TEST(MainWindow, InhaleShowsForceColouredMusclesAndHidingThemRemovesThem) {
+  ToyWindow w;
+  // the rest pose, before any force acts: every element slack, grey
+  const int atRest = forceColouredPixels(w.window.grabView());
+
+  // during inhale (the controller starts after the 2 s settling phase) taut muscles take colour
+  ASSERT_TRUE(w.window.runUntil(3.0));
+  const int inhale = forceColouredPixels(w.window.grabView());
+  EXPECT_GT(inhale, 500);
+  EXPECT_GT(inhale, 10 * (atRest + 10));
+
+  // all muscle groups hidden: no force colour left anywhere in the view
+  viz::DisplayOptions o = w.window.scene().options();
+  o.showGroup.fill(false);
+  w.window.setDisplayOptions(o);
+  EXPECT_LT(forceColouredPixels(w.window.grabView()), inhale / 200);
+
+  // colour by group: the diaphragm's rust stays, the force scale is gone
+  o.showGroup.fill(true);
+  o.muscleColouring = viz::MuscleColouring::Group;
+  w.window.setDisplayOptions(o);
+  EXPECT_LT(forceColouredPixels(w.window.grabView()), inhale);
+}
+
+TEST(MainWindow, ExportedPlotFilesHoldThePlottedData) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(2.5));
+  const app::PlotView* plot = w.window.plots()->volumePlot();
+  ASSERT_GT(plot->time().size(), 100u);
+  QTemporaryDir out;
+
+  // csv: a units header and exactly the plotted samples
+  ASSERT_EQ(w.window.exportPlot(plot, out.filePath("volume.csv")), QString());
+  QFile csv(out.filePath("volume.csv"));
+  ASSERT_TRUE(csv.open(QIODevice::ReadOnly));
+  const QStringList lines = QString::fromUtf8(csv.readAll()).split('\n', Qt::SkipEmptyParts);
+  ASSERT_EQ(static_cast<std::size_t>(lines.size()), plot->time().size() + 1);
+  EXPECT_EQ(lines[0], "time [s],lung volume [mL]");
+  for (std::size_t k = 0; k < plot->time().size(); k += 37) {
+    const QStringList cells = lines[static_cast<int>(k) + 1].split(',');
+    ASSERT_EQ(cells.size(), 2);
+    EXPECT_NEAR(cells[0].toDouble(), plot->time()[k], 1e-9);
+    EXPECT_NEAR(cells[1].toDouble(), plot->series()[0].y[k], 1e-6);
+  }
+
+  // svg: valid, titled, and drawing the curve
+  ASSERT_EQ(w.window.exportPlot(plot, out.filePath("volume.svg")), QString());
+  QSvgRenderer svg(out.filePath("volume.svg"));
+  EXPECT_TRUE(svg.isValid());
+  QFile svgFile(out.filePath("volume.svg"));
+  ASSERT_TRUE(svgFile.open(QIODevice::ReadOnly));
+  const QByteArray svgText = svgFile.readAll();
+  EXPECT_TRUE(svgText.contains("Lung-cavity volume"));
+  EXPECT_TRUE(svgText.contains("volume [mL]"));
+
+  // png: decodes, and is not blank
+  ASSERT_EQ(w.window.exportPlot(plot, out.filePath("volume.png")), QString());
+  const QImage png(out.filePath("volume.png"));
+  ASSERT_FALSE(png.isNull());
+  EXPECT_GT(distinctColours(png), 5);
+
+  // pdf: a complete PDF document
+  ASSERT_EQ(w.window.exportPlot(plot, out.filePath("volume.pdf")), QString());
+  QFile pdf(out.filePath("volume.pdf"));
+  ASSERT_TRUE(pdf.open(QIODevice::ReadOnly));
+  const QByteArray pdfBytes = pdf.readAll();
+  EXPECT_TRUE(pdfBytes.startsWith("%PDF-"));
+  EXPECT_TRUE(pdfBytes.trimmed().endsWith("%%EOF"));
+  EXPECT_GT(pdfBytes.size(), 1000);
+
+  // 3d view png
+  ASSERT_EQ(w.window.exportViewImage(out.filePath("view.png")), QString());
+  EXPECT_FALSE(QImage(out.filePath("view.png")).isNull());
+
+  // a failed export reports the error and leaves no file behind
+  const QString bad = out.filePath("missing-folder/volume.png");
+  EXPECT_NE(w.window.exportPlot(plot, bad), QString());
+  EXPECT_FALSE(QFile::exists(bad));
+  EXPECT_EQ(QDir(out.path()).entryList(QDir::Files).size(), 5);  // no temporaries left
+}
+
+TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
+  ToyWindow w;
+  app::ParameterPanel* panel = w.window.parameters();
+  const double before = panel->settings().style.breathsPerMinute;
+  panel->frequencyField()->setText("-4");
+  emit panel->frequencyField()->editingFinished();
+  EXPECT_TRUE(panel->refusal().contains("-4")) << panel->refusal().toStdString();
+  EXPECT_EQ(panel->settings().style.breathsPerMinute, before);
+  panel->frequencyField()->setText("fast");
+  emit panel->frequencyField()->editingFinished();
+  EXPECT_TRUE(panel->refusal().contains("not a number"));
+  EXPECT_EQ(panel->settings().style.breathsPerMinute, before);
+}
+
+// the toy torso is not calibrated to breathe cleanly, so the rate is measured on the default model
+TEST(MainWindow, FrequencyEditChangesTheMeasuredBreathingRate) {
+  const QString modelDir = defaultModelDir();
+  if (modelDir.isEmpty()) GTEST_SKIP() << "no default model at " << PNEUMA_DEFAULT_MODEL_DIR;
+  application();
+  MainWindow window;
+  window.show();
+  ASSERT_EQ(window.openModel(modelDir), QString());
+  app::ParameterPanel* panel = window.parameters();
+  window.plots()->setWindow(100.0);
+
+  // 30 breaths/min: the volume the plot records follows the new rate
+  panel->frequencyField()->setText("30");
+  emit panel->frequencyField()->editingFinished();
+  ASSERT_TRUE(panel->refusal().isEmpty()) << panel->refusal().toStdString();
+  ASSERT_TRUE(window.runUntil(9.0));
+  EXPECT_NEAR(plottedRate(*window.plots()->volumePlot(), 3.0), 30.0, 3.0);
+
+  // at 12 breaths/min the measured rate drops with it
+  panel->frequencyField()->setText("12");
+  emit panel->frequencyField()->editingFinished();
+  ASSERT_TRUE(window.runUntil(21.0));
+  EXPECT_NEAR(plottedRate(*window.plots()->volumePlot(), 11.0), 12.0, 1.5);
+}
+
+TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(5.0));
+  const app::PlotView* plot = w.window.plots()->volumePlot();
+  // the live sample nearest to t = 3 s
+  const auto& t = plot->time();
+  const std::size_t k = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), 3.0) - t.begin());
+  ASSERT_LT(k, t.size());
+  const double liveVolume = plot->series()[0].y[k];  // [mL]
+  const double latestVolume = plot->series()[0].y.back();
+
+  ASSERT_TRUE(w.window.scrubTo(t[k]));
+  const app::Snapshot* shown = w.window.shown();
+  ASSERT_TRUE(shown->isScrubbed);
+  EXPECT_NEAR(shown->state.time, t[k], 1e-6);
+  EXPECT_NEAR(1e6 * shown->metrics.lungVolume, liveVolume, 1e-6);  // the recorded state's volume
+  EXPECT_NEAR(plot->cursorValue(0), liveVolume, 1e-9);             // in the cursor read-out
+  EXPECT_NE(liveVolume, latestVolume);
+}
+
+TEST(MainWindow, CorruptModelOrScenarioKeepsThePreviousModel) {
+  ToyWindow w;
+  const sim::Model* before = w.window.model();
+  ASSERT_NE(before, nullptr);
+
+  // a model.json that is not JSON
+  QTemporaryDir bad;
+  QFile file(bad.filePath("model.json"));
+  ASSERT_TRUE(file.open(QIODevice::WriteOnly));
+  file.write("{\"format\": \"pneuma-model\", \"bodies\": [1, 2");
+  file.close();
+  const QString error = w.window.openModel(bad.path());
+  EXPECT_TRUE(error.contains("model.json")) << error.toStdString();
+  EXPECT_EQ(w.window.model(), before);
+
+  // a scenario with a bad field
+  QFile scenario(bad.filePath("run.json"));
+  ASSERT_TRUE(scenario.open(QIODevice::WriteOnly));
+  scenario.write("{\"format\": \"pneuma-scenario\", \"version\": 1, \"duration_s\": -3}");
+  scenario.close();
+  EXPECT_NE(w.window.openScenario(bad.filePath("run.json")), QString());
+  EXPECT_EQ(w.window.model(), before);
+
+  // and the kept model still runs
+  EXPECT_TRUE(w.window.runUntil(0.5));
+}
+
+TEST(MainWindow, ScenarioRoundTripKeepsModelAndParameters) {
+  ToyWindow w;
+  app::ParameterPanel* panel = w.window.parameters();
+  panel->frequencyField()->setText("21");
+  emit panel->frequencyField()->editingFinished();
+  QTemporaryDir out;
+  ASSERT_EQ(w.window.saveScenario(out.filePath("lecture.json")), QString());
+  panel->frequencyField()->setText("9");
+  emit panel->frequencyField()->editingFinished();
+
+  ASSERT_EQ(w.window.openScenario(out.filePath("lecture.json")), QString());
+  EXPECT_EQ(w.window.parameters()->settings().style.breathsPerMinute, 21.0);
+  EXPECT_EQ(w.window.model()->name, "toy_torso");
 }

@@ -1,0 +1,64 @@
+#pragma once
+/// @file LivePlots.h
+/// The four live plots of the main window over a rolling time window, fed with the worker's samples:
+///  1. lung-cavity volume [mL] with the current tidal volume;
+///  2. gut volume error [%] with the 0.5 % and 2 % bands;
+///  3. activations r (solid) and alpha (dashed) per muscle group [-];
+///  4. total tension per muscle group [N], plus the force trace of each picked element or body.
+
+#include "gui/SimWorker.h"
+
+#include <QWidget>
+
+#include <deque>
+#include <vector>
+
+namespace pneuma::app {
+
+class PlotView;
+
+class LivePlots : public QWidget {
+  Q_OBJECT
+
+ public:
+  /// A picked element (its force) or body (tension of the elements attached to it).
+  struct Trace {
+    QString name;
+    std::vector<int> elements;  ///< elements whose tension max(0, -F) is summed [N]
+  };
+
+  explicit LivePlots(QWidget* parent = nullptr);
+
+  /// Forgets all samples (reset, new model).
+  void clear();
+  /// Appends output frames (oldest first).
+  void append(std::vector<PlotSample> samples);
+  /// Redraws every plot from the history (call at the display rate).
+  void refresh();
+  /// Time span shown [s].
+  void setWindow(double seconds);
+  /// Breath period [s] over which the tidal volume is measured.
+  void setBreathPeriod(double seconds);
+  /// Plot cursor at time [s] (NaN hides it), e.g. the scrubbed instant.
+  void setCursor(double time);
+  /// Adds a force trace to the tension plot (at most 4 are kept; the oldest goes first).
+  void addTrace(const Trace& trace);
+  void clearTraces();
+
+  /// The plots, in the order listed above.
+  const std::vector<PlotView*>& plots() const { return m_plots; }
+  PlotView* volumePlot() const { return m_plots[0]; }
+  /// [m^3] current tidal volume: max - min of the lung volume over the last breath period.
+  double tidalVolume() const;
+
+ private:
+  std::deque<PlotSample> m_history;
+  std::vector<PlotView*> m_plots;
+  std::vector<Trace> m_traces;
+  double m_window = 20.0;       // [s]
+  double m_breathPeriod = 4.0;  // [s]
+  double m_cursor;              // [s]
+  bool m_isDirty = true;
+};
+
+}  // namespace pneuma::app

@@ -1,0 +1,133 @@
+#include "gui/ParameterPanel.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <QCheckBox>
+#include <QFormLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QVBoxLayout>
+
+namespace pneuma::app {
+
+namespace {
+
+// scales applied to every muscle group at once (cartilage keeps its own gains)
+double muscleScale(const std::array<double, sim::kElementGroupCount>& scales) { return scales[0]; }
+void setMuscleScale(std::array<double, sim::kElementGroupCount>& scales, double v) {
+  for (int g = 0; g < sim::kElementGroupCount; ++g)
+    if (sim::isMuscleGroup(static_cast<sim::ElementGroup>(g))) scales[static_cast<std::size_t>(g)] = v;
+}
+
+}  // namespace
+
+ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  auto* form = new QFormLayout;
+  form->setFieldGrowthPolicy(QFormLayout::ExpandingFieldsGrow);
+  layout->addLayout(form);
+
+  addField("Frequency", "breaths/min", "Breathing rate of the breath style (Table 2)",
+           [](const RunSettings& s) { return s.style.breathsPerMinute; },
+           [](RunSettings& s, double v) { s.style.breathsPerMinute = v; });
+  addField("Diaphragm r", "-", "Diaphragm contraction ratio during inhale (Eq. 2)",
+           [](const RunSettings& s) { return s.style.diaphragmR; },
+           [](RunSettings& s, double v) { s.style.diaphragmR = v; });
+  addField("Intercostal r mean", "-", "Mean contraction ratio of the intercostal sinusoids",
+           [](const RunSettings& s) { return s.style.intercostalMean; },
+           [](RunSettings& s, double v) { s.style.intercostalMean = v; });
+  addField("Intercostal r \u00b1", "-", "Amplitude of the intercostal sinusoids (Table 2)",
+           [](const RunSettings& s) { return s.style.intercostalAmplitude; },
+           [](RunSettings& s, double v) { s.style.intercostalAmplitude = v; });
+  addField("Active gain k_ac \u00d7", "-", "Scale of every muscle's active gain",
+           [](const RunSettings& s) { return muscleScale(s.options.step.activeGainScale); },
+           [](RunSettings& s, double v) { setMuscleScale(s.options.step.activeGainScale, v); });
+  addField("Passive gain k_pe \u00d7", "-", "Scale of every muscle's passive gain and damping",
+           [](const RunSettings& s) { return muscleScale(s.options.step.passiveGainScale); },
+           [](RunSettings& s, double v) { setMuscleScale(s.options.step.passiveGainScale, v); });
+  addField("Gut \u03ba", "kPa", "Bulk modulus of the gut, P = \u03ba (V0/V - 1) (Eq. 4)",
+           [this](const RunSettings& s) { return 1e-3 * (s.options.step.kappa >= 0.0 ? s.options.step.kappa : m_modelKappa); },
+           [](RunSettings& s, double v) { s.options.step.kappa = 1e3 * v; });
+  addField("Joint friction \u03bc \u00d7", "-", "Scale of every joint's friction (Eq. 3)",
+           [](const RunSettings& s) { return s.options.step.jointFrictionScale; },
+           [](RunSettings& s, double v) { s.options.step.jointFrictionScale = v; });
+  for (const Field& f : m_fields) {
+    auto* label = new QLabel(f.edit->property("label").toString());
+    label->setToolTip(f.edit->toolTip());
+    form->addRow(label, f.edit);
+  }
+
+  m_gravity = new QCheckBox("Gravity");
+  m_gravity->setToolTip("Apply the model's gravity to bodies and gut nodes");
+  connect(m_gravity, &QCheckBox::toggled, this, [this](bool on) {
+    m_settings.options.step.gravity = on;
+    emit settingsEdited(m_settings);
+  });
+  form->addRow(QString(), m_gravity);
+
+  m_reason = new QLabel;
+  m_reason->setWordWrap(true);
+  m_reason->setStyleSheet("color: #b00020;");
+  layout->addWidget(m_reason);
+  layout->addStretch(1);
+}
+
+void ParameterPanel::addField(const QString& label, const QString& unit, const QString& tip,
+                              std::function<double(const RunSettings&)> get,
+                              std::function<void(RunSettings&, double)> set) {
+  Field f;
+  f.edit = new QLineEdit;
+  f.edit->setProperty("label", unit == "-" ? label : QString("%1 [%2]").arg(label, unit));
+  f.edit->setToolTip(tip);
+  f.get = std::move(get);
+  f.set = std::move(set);
+  m_fields.push_back(f);
+  const std::size_t index = m_fields.size() - 1;
+  connect(f.edit, &QLineEdit::editingFinished, this, [this, index] { edited(m_fields[index]); });
+}
+
+void ParameterPanel::setSettings(const RunSettings& settings, double modelKappa) {
+  m_settings = settings;
+  m_modelKappa = modelKappa;
+  for (const Field& f : m_fields) {
+    f.edit->setText(QString::number(f.get(m_settings), 'g', 6));
+    f.edit->setStyleSheet(QString());
+  }
+  const QSignalBlocker block(m_gravity);
+  m_gravity->setChecked(m_settings.options.step.gravity);
+  m_reason->clear();
+}
+
+QString ParameterPanel::refusal() const { return m_reason->text(); }
+
+void ParameterPanel::refuse(QLineEdit* edit, const QString& reason) {
+  edit->setStyleSheet("background: #ffd9dc;");
+  m_reason->setText(reason);
+}
+
+void ParameterPanel::edited(const Field& field) {
+  bool isNumber = false;
+  const double value = field.edit->text().trimmed().toDouble(&isNumber);
+  const QString name = field.edit->property("label").toString();
+  if (!isNumber) return refuse(field.edit, QString("%1: '%2' is not a number").arg(name, field.edit->text()));
+  if (value == field.get(m_settings)) {
+    field.edit->setStyleSheet(QString());
+    return;
+  }
+
+  // check the candidate with the sim's validators; apply nothing unless it passes
+  RunSettings candidate = m_settings;
+  field.set(candidate, value);
+  try {
+    sim::validateBreathStyle(candidate.style);
+    sim::validateSimulationOptions(candidate.options);
+  } catch (const sim::Error& e) {
+    return refuse(field.edit, QString("%1 = %2 refused: %3").arg(name, field.edit->text(), e.what()));
+  }
+  field.edit->setStyleSheet(QString());
+  m_reason->clear();
+  m_settings = candidate;
+  emit settingsEdited(m_settings);
+}
+
+}  // namespace pneuma::app

@@ -1,0 +1,58 @@
+#pragma once
+/// @file ParameterPanel.h
+/// The parameter panel: breathing frequency, contraction ratios r, gain scales, gut kappa, joint
+/// friction and gravity. Each edit is checked with the sim's own validators before anything is applied;
+/// an invalid value stays in its field, marked red, with the validator's reason shown under the panel.
+
+#include "gui/SimWorker.h"
+
+#include <QWidget>
+
+#include <functional>
+#include <vector>
+
+class QCheckBox;
+class QLabel;
+class QLineEdit;
+
+namespace pneuma::app {
+
+class ParameterPanel : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit ParameterPanel(QWidget* parent = nullptr);
+
+  /// Shows `settings`; `modelKappa` [Pa] is the model's own kappa (shown when the options do not override it).
+  void setSettings(const RunSettings& settings, double modelKappa);
+  const RunSettings& settings() const { return m_settings; }
+
+  /// The reason the last edit was refused, or empty.
+  QString refusal() const;
+  /// The field editing the breathing frequency [breaths/min] (for tests and shortcuts).
+  QLineEdit* frequencyField() const { return m_fields.front().edit; }
+
+ signals:
+  /// A valid edit: apply at the next sync point.
+  void settingsEdited(const RunSettings& settings);
+
+ private:
+  struct Field {
+    QLineEdit* edit = nullptr;
+    std::function<double(const RunSettings&)> get;  // value shown, in the field's unit
+    std::function<void(RunSettings&, double)> set;  // from the field's unit
+  };
+
+  void addField(const QString& label, const QString& unit, const QString& tip,
+                std::function<double(const RunSettings&)> get, std::function<void(RunSettings&, double)> set);
+  void edited(const Field& field);
+  void refuse(QLineEdit* edit, const QString& reason);
+
+  RunSettings m_settings;
+  double m_modelKappa = 0.0;  // [Pa]
+  std::vector<Field> m_fields;
+  QCheckBox* m_gravity = nullptr;
+  QLabel* m_reason = nullptr;
+};
+
+}  // namespace pneuma::app

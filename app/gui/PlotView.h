@@ -1,0 +1,86 @@
+#pragma once
+/// @file PlotView.h
+/// A live line chart drawn with QPainter (cheap enough for 60 Hz): series over a rolling time window,
+/// horizontal reference lines (tolerance bands), a time cursor with its read-out, and a note line
+/// (e.g. the current tidal volume). The same content converts to a viz::Plot for PNG/SVG/PDF export
+/// and to CSV, so exports show exactly the plotted data.
+
+#include "viz/Plot.h"
+
+#include <QColor>
+#include <QString>
+#include <QWidget>
+
+#include <vector>
+
+namespace pneuma::app {
+
+class PlotView : public QWidget {
+  Q_OBJECT
+
+ public:
+  struct Series {
+    QString name;
+    QColor colour;
+    bool isDashed = false;
+    std::vector<double> y;  ///< one value per time sample, in the y axis unit; NaN leaves a gap
+    QString legend;         ///< legend text; empty: no legend entry (the CSV header still uses `name`)
+  };
+  struct Reference {
+    QString name;
+    double y = 0.0;  ///< in the y axis unit
+    QColor colour;
+  };
+
+  /// @param title   headline
+  /// @param yLabel  y axis label with unit, e.g. "lung-cavity volume [mL]"
+  PlotView(QString title, QString yLabel, QWidget* parent = nullptr);
+
+  /// Replaces the data: shared time samples [s] and one Series per curve (each of time.size() values).
+  void setData(std::vector<double> time, std::vector<Series> series);
+  void setReferences(std::vector<Reference> references);
+  /// Time span shown [s], ending at the newest sample (0 = everything).
+  void setWindow(double seconds);
+  /// Vertical cursor at time [s] (NaN hides it); the read-out lists each series' value there.
+  void setCursor(double time);
+  /// One line of text under the title, e.g. "tidal volume 498 mL".
+  void setNote(QString note);
+  /// Always include 0 in the y range (e.g. tensions).
+  void setIncludeZero(bool includeZero);
+
+  QString title() const { return m_title; }
+  QString yLabel() const { return m_yLabel; }
+  const std::vector<double>& time() const { return m_time; }
+  const std::vector<Series>& series() const { return m_series; }
+  /// Value of series `i` at the cursor (nearest sample), NaN when there is none.
+  double cursorValue(std::size_t i) const;
+
+  /// The same chart as a viz::Plot (shown window only), for PNG and SVG export.
+  viz::Plot toPlot() const;
+  /// The shown data as CSV: "time [s],<series name> [<unit>],..." then one row per sample.
+  std::string toCsv() const;
+
+ signals:
+  /// The user asked for the context menu (export actions).
+  void contextMenuRequested(const QPoint& globalPos);
+
+ protected:
+  void paintEvent(QPaintEvent* event) override;
+  void contextMenuEvent(QContextMenuEvent* event) override;
+
+ private:
+  std::size_t firstShown() const;
+  QString unit() const;
+
+  QString m_title;
+  QString m_yLabel;
+  QString m_note;
+  std::vector<double> m_time;
+  std::vector<Series> m_series;
+  std::vector<Reference> m_references;
+  double m_window = 20.0;  // [s]
+  double m_cursor;         // [s], NaN = none
+  bool m_includeZero = false;
+};
+
+}  // namespace pneuma::app

@@ -1,0 +1,244 @@
+#include "gui/SimWorker.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <QTimer>
+
+#include <algorithm>
+
+namespace pneuma::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kWallBudget = 0.030;  // [s] longest stepping batch between two sync points
+constexpr int kTickMs = 8;             // [ms] worker tick
+
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+SimWorker::SimWorker(std::shared_ptr<const sim::Model> model, std::unique_ptr<sim::Simulation> simulation,
+                     RunSettings settings)
+    : m_model(std::move(model)), m_sim(std::move(simulation)), m_settings(std::move(settings)) {
+  publish(false);
+}
+
+SimWorker::~SimWorker() = default;
+
+void SimWorker::setRunning(bool isRunning) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.isRunning = isRunning;
+}
+
+void SimWorker::requestStep() {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.doStep = true;
+}
+
+void SimWorker::requestReset() {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.doReset = true;
+}
+
+void SimWorker::setSpeed(double speed) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.speed = speed;
+}
+
+void SimWorker::requestSettings(const RunSettings& settings) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.settings = settings;
+}
+
+void SimWorker::requestSimulation(std::shared_ptr<const sim::Model> model, std::unique_ptr<sim::Simulation> simulation,
+                                  const RunSettings& settings) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.model = std::move(model);
+  m_pending.simulation = std::move(simulation);
+  m_pending.settings = settings;
+}
+
+void SimWorker::requestScrub(double time) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.scrubTime = time;
+  m_pending.isRunning = false;
+}
+
+void SimWorker::requestRunUntil(double time) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.runUntil = time;
+  m_pending.isRunning = true;
+}
+
+Frame SimWorker::take() {
+  std::lock_guard lock(m_outboxMutex);
+  Frame frame;
+  frame.snapshot = m_outbox.snapshot;
+  frame.samples.swap(m_outbox.samples);
+  return frame;
+}
+
+void SimWorker::start() {
+  m_timer = new QTimer(this);
+  m_timer->setInterval(kTickMs);
+  connect(m_timer, &QTimer::timeout, this, &SimWorker::tick);
+  m_lastTick = Clock::now();
+  m_timer->start();
+}
+
+void SimWorker::stop() {
+  if (m_timer) m_timer->stop();
+}
+
+void SimWorker::sync() {
+  Pending p;
+  {
+    std::lock_guard lock(m_pendingMutex);
+    std::swap(p, m_pending);
+  }
+  // apply the queued edits, in a fixed order
+  if (p.simulation) {
+    m_model = std::move(p.model);
+    m_sim = std::move(p.simulation);
+    m_rtf = 0.0;
+    m_samples.clear();
+    ++m_generation;
+  }
+  if (p.settings) applySettings(*p.settings);
+  if (p.doReset) {
+    m_sim->reset();
+    m_runUntil = -1.0;
+    m_samples.clear();
+    ++m_generation;
+  }
+  if (p.speed) m_speed = *p.speed;
+  if (p.runUntil) {
+    m_runUntil = *p.runUntil;
+    m_speed = 0.0;
+  }
+  if (p.isRunning) {
+    m_isRunning = *p.isRunning;
+    m_debt = 0.0;
+  }
+  if (p.doStep) {
+    m_isRunning = false;
+    m_sim->stepOnce();
+    collect(*m_sim);
+  }
+  if (p.simulation || p.doReset || p.doStep || p.settings) publish(false);
+  if (p.scrubTime && !m_isRunning) {
+    m_scrubTime = *p.scrubTime;
+    publish(true);
+  }
+}
+
+void SimWorker::applySettings(const RunSettings& settings) {
+  m_sim->setOptions(settings.options);
+  if (settings.style.breathsPerMinute != m_settings.style.breathsPerMinute ||
+      settings.style.name != m_settings.style.name || settings.style.diaphragmR != m_settings.style.diaphragmR ||
+      settings.style.intercostalMean != m_settings.style.intercostalMean ||
+      settings.style.intercostalAmplitude != m_settings.style.intercostalAmplitude ||
+      settings.style.inhaleFraction != m_settings.style.inhaleFraction ||
+      settings.style.rectusActive != m_settings.style.rectusActive || settings.style.rectusR != m_settings.style.rectusR)
+    m_sim->setController(std::make_unique<sim::BreathStyleController>(settings.style));
+  m_settings = settings;
+}
+
+void SimWorker::collect(const sim::Simulation& simulation) {
+  const sim::Metrics& m = simulation.latestMetrics();
+  PlotSample s;
+  s.time = m.time;
+  s.lungVolume = m.lungVolume;
+  s.gutVolumeError = m.gutVolumeError;
+  s.activations = m.activations;
+  s.groupTension = m.groupTension;
+  s.elementForce.assign(m.elementForce.data(), m.elementForce.data() + m.elementForce.size());
+  m_samples.push_back(std::move(s));
+}
+
+void SimWorker::tick() {
+  const double wall = secondsSince(m_lastTick);
+  m_lastTick = Clock::now();
+  try {
+    sync();
+    if (!m_isRunning) return;
+
+    // how much simulated time this batch owes: real-time pacing, or as much as fits the budget
+    const double t0 = m_sim->state().time;
+    double duration = 0.0;
+    if (m_speed > 0.0) {
+      m_debt = std::min(m_debt + m_speed * wall, m_speed * kWallBudget * 4.0);
+      duration = m_debt;
+    } else {
+      duration = 1.0;  // cut short by the wall budget below
+    }
+    if (m_runUntil >= 0.0) duration = std::min(duration, std::max(m_runUntil - t0, 0.0));
+
+    const auto start = Clock::now();
+    if (duration > 0.0) {
+      m_sim->advance(duration, [&](const sim::Simulation& s) {
+        collect(s);
+        return secondsSince(start) < kWallBudget;
+      });
+    }
+    const double advanced = m_sim->state().time - t0;
+    if (m_speed > 0.0) m_debt = std::max(0.0, m_debt - advanced);
+
+    // real-time factor: simulated seconds per wall second over this tick, smoothed
+    const double rtf = advanced / std::max(wall, 1e-3);
+    m_rtf = m_rtf > 0.0 ? 0.8 * m_rtf + 0.2 * rtf : rtf;
+
+    const bool reached = m_runUntil >= 0.0 && m_sim->state().time >= m_runUntil - 1e-9;
+    if (reached) {
+      m_isRunning = false;
+      m_runUntil = -1.0;
+    }
+    publish(false);
+    if (reached) emit targetReached();
+  } catch (const sim::Error& e) {
+    m_isRunning = false;
+    m_runUntil = -1.0;
+    publish(false);
+    emit failed(QString::fromStdString(e.what()));
+  }
+}
+
+void SimWorker::publish(bool isScrubbed) {
+  auto snap = std::make_shared<Snapshot>();
+  snap->model = m_model;
+  snap->realTimeFactor = m_isRunning ? m_rtf : 0.0;
+  snap->isRunning = m_isRunning;
+  snap->generation = m_generation;
+  const sim::Recorder& rec = m_sim->recorder();
+  if (!rec.empty()) {
+    snap->recordedFrom = rec.frame(0).time;
+    snap->recordedTo = rec.frame(rec.size() - 1).time;
+  }
+  snap->metrics = m_sim->latestMetrics();
+  if (isScrubbed && !rec.empty()) {
+    // the recorded frame nearest to the requested time, for display
+    const std::size_t i = rec.indexAt(m_scrubTime);
+    const sim::RecordedFrame& f = rec.frame(i);
+    rec.restore(i, snap->state);
+    snap->metrics.time = f.time;
+    snap->metrics.lungVolume = f.lungVolume;
+    snap->metrics.gutVolumeError = f.gutVolumeError;
+    snap->metrics.elementForce = Eigen::Map<const Eigen::VectorXf>(f.elementForce.data(),
+                                                                   static_cast<Eigen::Index>(f.elementForce.size()))
+                                     .cast<double>();
+    snap->metrics.isSlack.clear();
+    snap->isScrubbed = true;
+  } else {
+    snap->state = m_sim->state();
+  }
+
+  std::lock_guard lock(m_outboxMutex);
+  if (m_outbox.snapshot && m_outbox.snapshot->generation != m_generation) m_outbox.samples.clear();
+  m_outbox.snapshot = std::move(snap);
+  for (PlotSample& s : m_samples) m_outbox.samples.push_back(std::move(s));
+  m_samples.clear();
+  emit snapshotReady();
+}
+
+}  // namespace pneuma::app

@@ -1,0 +1,144 @@
+#pragma once
+/// @file SimWorker.h
+/// Runs a pneuma::sim::Simulation off the GUI thread. The GUI never touches the live simulation:
+/// it queues edits (MuJoCo simulate's `pending_`), which the worker applies at one sync point
+/// before each batch of steps, and it reads immutable snapshots the worker publishes after each batch.
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/State.h"
+
+#include <QObject>
+#include <QString>
+
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+class QTimer;
+
+namespace pneuma::app {
+
+/// The user-editable run settings: the breath style (frequency, r values) and the simulation options
+/// (gains, kappa, joint friction, gravity).
+struct RunSettings {
+  sim::BreathStyle style;
+  sim::SimulationOptions options;
+};
+
+/// One output frame for the live plots (a slim copy of sim::Metrics).
+struct PlotSample {
+  double time = 0.0;                      ///< [s]
+  double lungVolume = 0.0;                ///< [m^3]
+  double gutVolumeError = 0.0;            ///< [-] signed (V - V0) / V0
+  sim::Activations activations{};         ///< r and alpha per group
+  std::array<double, sim::kElementGroupCount> groupTension{};  ///< [N]
+  std::vector<float> elementForce;        ///< [N] signed, per element (#E)
+};
+
+/// What the GUI draws at one instant, copied out of the simulation.
+struct Snapshot {
+  std::shared_ptr<const sim::Model> model;  ///< the model the state belongs to
+  sim::State state;
+  sim::Metrics metrics;
+  double realTimeFactor = 0.0;      ///< [-] simulated seconds per wall-clock second, last batch
+  bool isRunning = false;
+  bool isScrubbed = false;          ///< the state was restored from the recording (timeline)
+  double recordedFrom = 0.0;        ///< [s] oldest recorded frame
+  double recordedTo = 0.0;          ///< [s] newest recorded frame
+  long long generation = 0;         ///< increments on reset and model change: plots restart
+};
+
+/// What the GUI takes from the worker at each display refresh.
+struct Frame {
+  std::shared_ptr<const Snapshot> snapshot;  ///< the latest instant
+  std::vector<PlotSample> samples;           ///< output frames since the previous take, oldest first
+};
+
+class SimWorker : public QObject {
+  Q_OBJECT
+
+ public:
+  /// @param simulation the run to drive (constructed and validated by the caller).
+  /// @param model       the model `simulation` runs (kept alive by the snapshots)
+  /// @param simulation  the run to drive, constructed and validated by the caller
+  SimWorker(std::shared_ptr<const sim::Model> model, std::unique_ptr<sim::Simulation> simulation,
+            RunSettings settings);
+  ~SimWorker() override;
+
+  // thread-safe requests, applied at the next sync point
+  void setRunning(bool isRunning);
+  void requestStep();
+  void requestReset();
+  /// Simulated seconds per wall second; 0 = as fast as possible.
+  void setSpeed(double speed);
+  void requestSettings(const RunSettings& settings);
+  /// Replaces the simulation (new model); the settings travel with it.
+  void requestSimulation(std::shared_ptr<const sim::Model> model, std::unique_ptr<sim::Simulation> simulation,
+                         const RunSettings& settings);
+  /// Shows the recorded frame nearest to `time` [s] (pauses the run).
+  void requestScrub(double time);
+  /// Runs as fast as possible until simulated time `time` [s], then pauses and emits targetReached().
+  void requestRunUntil(double time);
+
+  /// The latest snapshot and the plot samples produced since the previous call (each handed out once).
+  Frame take();
+
+ public slots:
+  /// Starts the stepping timer; call in the worker thread (connect to QThread::started).
+  void start();
+  /// Stops the stepping timer; call in the worker thread before it quits.
+  void stop();
+
+ signals:
+  void snapshotReady();
+  /// The simulation threw (blow-up or bad parameter); the run is paused.
+  void failed(const QString& message);
+  void targetReached();
+
+ private:
+  struct Pending {
+    std::optional<bool> isRunning;
+    bool doStep = false;
+    bool doReset = false;
+    std::optional<double> speed;
+    std::optional<RunSettings> settings;
+    std::shared_ptr<const sim::Model> model;
+    std::unique_ptr<sim::Simulation> simulation;
+    std::optional<double> scrubTime;
+    std::optional<double> runUntil;
+  };
+
+  void tick();
+  void sync();
+  void applySettings(const RunSettings& settings);
+  void collect(const sim::Simulation& simulation);
+  void publish(bool isScrubbed);
+
+  std::shared_ptr<const sim::Model> m_model;
+  std::unique_ptr<sim::Simulation> m_sim;
+  RunSettings m_settings;
+  QTimer* m_timer = nullptr;
+
+  std::mutex m_pendingMutex;
+  Pending m_pending;
+
+  // worker-thread state
+  bool m_isRunning = false;
+  double m_speed = 1.0;                 // [-] simulated / wall seconds, 0 = max
+  double m_runUntil = -1.0;             // [s] < 0: none
+  double m_scrubTime = 0.0;             // [s] time of the shown recorded frame
+  double m_debt = 0.0;                  // [s] simulated time owed to real-time pacing
+  double m_rtf = 0.0;                   // [-]
+  long long m_generation = 0;
+  std::chrono::steady_clock::time_point m_lastTick;
+  std::vector<PlotSample> m_samples;    // collected since the last publish
+
+  std::mutex m_outboxMutex;
+  Frame m_outbox;
+};
+
+}  // namespace pneuma::app
