@@ -242,22 +242,44 @@ std::string serializeScenario(const Scenario& s) {
   return j.dump(2) + "\n";
 }
 
+namespace {
+
+// runs `load`, prefixing any error with the scenario field it came from
+template <class F>
+auto named(const Scenario& s, F&& load) {
+  try {
+    return load();
+  } catch (const Error& e) {
+    throw Error(std::string("controller.") + controllerKindName(s.controller) + ": " + e.what());
+  }
+}
+
+BreathStyle styleOf(const Scenario& s, const std::string& resourceDir) {
+  return named(s, [&] { return loadBreathStyle(s.controllerName, (fs::path(resourceDir) / "presets").string()); });
+}
+
+pattern::Pattern patternOf(const Scenario& s, const std::string& resourceDir) {
+  if (s.controller == ControllerKind::Affect) return named(s, [&] { return pattern::loadAffect(s.controllerName, resourceDir); });
+  if (s.patternText.empty()) return named(s, [&] { return pattern::loadPatternFile(s.controllerName, resourceDir); });
+  // inline: the pattern parser's message already carries the path below "controller.pattern"
+  return pattern::parsePattern(s.patternText, "controller.pattern", resourceDir);
+}
+
+}  // namespace
+
+void checkController(const Scenario& scenario, const std::string& resourceDir) {
+  if (scenario.controller == ControllerKind::Style) validateBreathStyle(styleOf(scenario, resourceDir));
+  else patternOf(scenario, resourceDir);
+}
+
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,
                                            const std::string& resourceDir) {
-  try {
-    if (scenario.controller == ControllerKind::Style)
-      return std::make_unique<BreathStyleController>(
-          loadBreathStyle(scenario.controllerName, (fs::path(resourceDir) / "presets").string()));
-    // parse the pattern first (cheap, reports bad names and fields), then calibrate the drive on the model
-    const pattern::Pattern p =
-        scenario.controller == ControllerKind::Affect ? pattern::loadAffect(scenario.controllerName, resourceDir)
-        : scenario.patternText.empty() ? pattern::loadPatternFile(scenario.controllerName, resourceDir)
-                                       : pattern::parsePattern(scenario.patternText, "inline pattern", resourceDir);
-    const pattern::DriveCalibration calibration = pattern::calibrateDrive(std::move(model), scenario.options);
-    return pattern::makePatternController(p, scenario.seed, calibration);
-  } catch (const Error& e) {
-    throw Error(std::string("controller.") + controllerKindName(scenario.controller) + ": " + e.what());
-  }
+  if (scenario.controller == ControllerKind::Style)
+    return std::make_unique<BreathStyleController>(styleOf(scenario, resourceDir));
+  // parse the pattern first (cheap, reports bad names and fields), then calibrate the drive on the model
+  const pattern::Pattern p = patternOf(scenario, resourceDir);
+  const pattern::DriveCalibration calibration = pattern::calibrateDrive(std::move(model), scenario.options);
+  return pattern::makePatternController(p, scenario.seed, calibration);
 }
 
 void saveScenario(const Scenario& scenario, const std::string& path) {

@@ -68,6 +68,10 @@ Scenario loadScenario(const std::string& path);
 /// The JSON text of a scenario (all fields written). Deterministic.
 std::string serializeScenario(const Scenario& scenario);
 
+/// Loads and checks the scenario's style preset, affect preset or pattern (file or inline) without
+/// running anything. @throws Error as makeController().
+void checkController(const Scenario& scenario, const std::string& resourceDir);
+
 /// The controller a scenario asks for: a BreathStyleController for a style (presets in
 /// `resourceDir`/presets), or a pattern::PatternController for an affect (`resourceDir`/presets/affect)
 /// or a pattern, seeded with `scenario.seed` and calibrated on `model` with pattern::calibrateDrive()
