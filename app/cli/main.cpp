@@ -5,7 +5,6 @@
 /// 2 bad usage or bad input (unknown option, missing model, unwritable output, invalid scenario).
 
 #include "Commands.h"
-#include "ModelCommand.h"
 
 #include <CLI/CLI.hpp>
 
@@ -41,7 +40,6 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("pneuma-cli ") + PNEUMA_VERSION, "Print the version and exit");
   pneuma::app::addSimulateCommand(app);
   pneuma::app::addScenarioCommand(app);
-  pneuma::app::addModelCommand(app);
   app.footer("Run 'pneuma-cli SUBCOMMAND --help' for the options of a subcommand. Docs: docs/cli.md");
 
   try {
