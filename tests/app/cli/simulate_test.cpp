@@ -1,0 +1,203 @@
+// pneuma-cli simulate: outputs, their units and values, interruption and bad input.
+#include "CliRunner.h"
+#include "ToyModelDir.h"
+
+#include <nlohmann/json.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+using pneuma::test::freshOutDir;
+using pneuma::test::runCli;
+using pneuma::test::slurp;
+using pneuma::test::toyModelDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) out.push_back(cell);
+  return out;
+}
+
+void expectPng(const std::string& path) {
+  const std::string png = slurp(path);
+  ASSERT_GT(png.size(), 24u) << path;
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << path;
+  // IHDR width and height, big-endian
+  auto be32 = [&](std::size_t at) {
+    return (static_cast<unsigned char>(png[at]) << 24) | (static_cast<unsigned char>(png[at + 1]) << 16) |
+           (static_cast<unsigned char>(png[at + 2]) << 8) | static_cast<unsigned char>(png[at + 3]);
+  };
+  EXPECT_EQ(be32(16), 960) << path;
+  EXPECT_EQ(be32(20), 540) << path;
+}
+
+}  // namespace
+
+TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
+  const std::string out = freshOutDir("calm");
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "8", "--settle", "1",
+                   "--output-rate", "30", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+
+  // summary.json: every documented field, consistent values
+  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  for (const char* key : {"tidal_volume_ml", "breaths_per_minute", "end_expiratory_volume_ml", "max_gut_volume_error_pct",
+                          "mean_gut_volume_error_pct", "diaphragm_apex_excursion_mm", "xiphoid_excursion_mm",
+                          "umbilicus_excursion_mm", "real_time_factor", "dt_s", "steps", "integrator", "model",
+                          "controller", "pneuma_version", "partial", "tracking_rms_pct"})
+    EXPECT_TRUE(s.contains(key)) << key;
+  EXPECT_FALSE(s["partial"].get<bool>());
+  EXPECT_EQ(s["pneuma_version"], PNEUMA_VERSION);
+  EXPECT_EQ(s["integrator"], "implicit-euler");
+  EXPECT_TRUE(s["tracking_rms_pct"].is_null());  // no volume target for a breath style
+  EXPECT_GT(s["tidal_volume_ml"].get<double>(), 0.0);
+  EXPECT_GT(s["breaths_per_minute"].get<double>(), 0.0);
+  EXPECT_GE(s["max_gut_volume_error_pct"].get<double>(), s["mean_gut_volume_error_pct"].get<double>());
+  EXPECT_GT(s["real_time_factor"].get<double>(), 0.0);
+  // steps = simulated time / dt (settling included)
+  EXPECT_NEAR(s["steps"].get<double>() * s["dt_s"].get<double>(), 9.0, 2.0 * s["dt_s"].get<double>());
+
+  // timeseries.csv: a header of "name [unit]" columns, one row per frame, numbers in every cell
+  std::ifstream csv(out + "/timeseries.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  const auto header = splitCsvLine(line);
+  EXPECT_EQ(header.at(0), "time [s]");
+  EXPECT_EQ(header.at(1), "lung_volume [mL]");
+  EXPECT_EQ(header.at(2), "gut_volume_error [%]");
+  for (const std::string& h : header) EXPECT_NE(h.find(" ["), std::string::npos) << "no unit: " << h;
+  for (const char* col : {"diaphragm.r [-]", "diaphragm.alpha [-]", "diaphragm.tension [N]", "xiphoid.z [mm]"})
+    EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << col;
+  // the summary's figures follow from the CSV's columns in their units (mL, %, mm), from the end of settling on
+  auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const std::size_t xi = column("xiphoid.x [mm]");
+  const double from = s["measured_from_s"].get<double>();
+  double vMin = 1e300, vMax = -1e300, gutMax = 0.0, lastTime = -1.0;
+  Eigen::Vector3d xMin = Eigen::Vector3d::Constant(1e300), xMax = -xMin;
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    const auto cells = splitCsvLine(line);
+    ASSERT_EQ(cells.size(), header.size()) << line;
+    const double t = std::stod(cells[0]);
+    EXPECT_GT(t, lastTime);
+    lastTime = t;
+    ++rows;
+    if (t < from) continue;
+    vMin = std::min(vMin, std::stod(cells[1]));
+    vMax = std::max(vMax, std::stod(cells[1]));
+    gutMax = std::max(gutMax, std::abs(std::stod(cells[2])));
+    for (int k = 0; k < 3; ++k) {
+      xMin(k) = std::min(xMin(k), std::stod(cells[xi + static_cast<std::size_t>(k)]));
+      xMax(k) = std::max(xMax(k), std::stod(cells[xi + static_cast<std::size_t>(k)]));
+    }
+  }
+  EXPECT_NEAR(rows, 9 * 30, 3);
+  EXPECT_LE(s["tidal_volume_ml"].get<double>(), vMax - vMin + 1e-6);
+  EXPECT_GE(s["end_expiratory_volume_ml"].get<double>(), vMin - 1e-6);
+  EXPECT_LE(s["end_expiratory_volume_ml"].get<double>(), vMax + 1e-6);
+  EXPECT_NEAR(s["max_gut_volume_error_pct"].get<double>(), gutMax, 1e-6 * std::max(1.0, gutMax));
+  EXPECT_NEAR(s["xiphoid_excursion_mm"].get<double>(), (xMax - xMin).maxCoeff(), 1e-6);
+
+  // plots: PNG decodes (signature, 960 x 540), SVG is an svg document
+  for (const char* stem : {"lung_volume", "gut_volume_error", "activations", "tensions"}) {
+    expectPng(out + "/" + stem + ".png");
+    const std::string svg = slurp(out + "/" + stem + ".svg");
+    EXPECT_NE(svg.find("<svg"), std::string::npos) << stem;
+    EXPECT_NE(svg.find("</svg>"), std::string::npos) << stem;
+    EXPECT_NE(svg.find("time [s]"), std::string::npos) << stem;
+  }
+  // no temporary files left behind
+  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
+TEST(CliSimulate, SameSeedAndInputsGiveIdenticalCsv) {
+  const std::string a = freshOutDir("det_a"), b = freshOutDir("det_b");
+  for (const std::string& out : {a, b}) {
+    auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "deep", "--duration", "2", "--settle", "0.5",
+                     "--out", out});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  EXPECT_EQ(slurp(a + "/timeseries.csv"), slurp(b + "/timeseries.csv"));
+}
+
+TEST(CliSimulate, VtkSeriesListsFourPartsPerFrame) {
+  const std::string out = freshOutDir("vtk");
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--settle", "0",
+                   "--output-rate", "10", "--vtk", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::string pvd = slurp(out + "/frames.pvd");
+  EXPECT_NE(pvd.find("type=\"Collection\""), std::string::npos);
+  std::size_t n = 0;
+  for (std::size_t p = 0; (p = pvd.find("<DataSet", p)) != std::string::npos; ++p) ++n;
+  EXPECT_EQ(n % 4, 0u);
+  EXPECT_GE(n, 4u * 5u);
+  EXPECT_TRUE(fs::exists(out + "/frames/muscles_000000.vtp"));
+  EXPECT_NE(slurp(out + "/frames/muscles_000000.vtp").find("force_N"), std::string::npos);
+}
+
+TEST(CliSimulate, SigintWritesValidPartialSummary) {
+  const std::string out = freshOutDir("sigint");
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "3000", "--out", out}, 1.5);
+  EXPECT_EQ(r.exitCode, 130) << r.err;
+  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  EXPECT_TRUE(s["partial"].get<bool>());
+  EXPECT_TRUE(s["interrupted"].get<bool>());
+  EXPECT_GT(s["simulated_time_s"].get<double>(), 0.0);
+  EXPECT_LT(s["simulated_time_s"].get<double>(), 3000.0);
+  EXPECT_GT(s["steps"].get<long long>(), 0);
+  EXPECT_TRUE(fs::exists(out + "/timeseries.csv"));
+  EXPECT_TRUE(fs::exists(out + "/lung_volume.png"));
+}
+
+TEST(CliSimulate, UnknownStyleListsValidNames) {
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "yodel", "--duration", "1", "--out", freshOutDir("bad")});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("yodel"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("calm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("panting"), std::string::npos) << r.err;
+  EXPECT_EQ(pneuma::test::lineCount(r.err), 1) << r.err;
+}
+
+TEST(CliSimulate, UnknownAffectListsValidNames) {
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "ennui", "--duration", "1", "--out", freshOutDir("bad")});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("ennui"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("startle"), std::string::npos) << r.err;
+}
+
+TEST(CliSimulate, BadInputIsOneLineErrorAndExit2) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string mentions;
+  };
+  const std::string out = freshOutDir("bad");
+  const std::vector<Case> cases = {
+      {{"--model", "/nonexistent/model", "--style", "calm", "--duration", "1", "--out", out}, "/nonexistent/model"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "0", "--out", out}, "--duration"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "-3", "--out", out}, "--duration"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--out", "/proc/pneuma-cannot-write"}, "--out"},
+      {{"--model", toyModelDir(), "--duration", "1", "--out", out}, "--style"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--dt", "-1", "--out", out}, "--dt"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--integrator", "rk4", "--out", out}, "rk4"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"simulate"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    auto r = runCli(args);
+    EXPECT_EQ(r.exitCode, 2) << c.mentions << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("pneuma-cli: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.mentions), std::string::npos) << r.err;
+    EXPECT_EQ(pneuma::test::lineCount(r.err), 1) << r.err;
+  }
+}
