@@ -119,9 +119,16 @@ void LivePlots::refresh() {
     return y;
   };
 
-  // lung volume [mL] and tidal volume
-  m_plots[0]->setData(time, {{"lung volume", QColor(20, 90, 190), false,
-                              column([](const PlotSample& s) { return 1e6 * s.lungVolume; }), QString()}});
+  // lung volume [mL], with the affect pattern's target when one plays
+  std::vector<PlotView::Series> volume{{"lung volume", QColor(20, 90, 190), false,
+                                        column([](const PlotSample& s) { return 1e6 * s.lungVolume; }), QString()}};
+  if (std::any_of(m_history.begin() + static_cast<std::ptrdiff_t>(first), m_history.end(),
+                  [](const PlotSample& s) { return std::isfinite(s.targetVolume); })) {
+    volume[0].legend = "simulated";
+    volume.push_back({"target volume", QColor(230, 90, 20), true,
+                      column([](const PlotSample& s) { return 1e6 * s.targetVolume; }), "target"});
+  }
+  m_plots[0]->setData(time, std::move(volume));
   m_plots[0]->setNote(n == 0 ? QString()
                              : QString("V = %1 mL    tidal volume %2 mL")
                                    .arg(1e6 * m_history.back().lungVolume, 0, 'f', 0)

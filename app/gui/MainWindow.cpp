@@ -6,6 +6,7 @@
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/pattern/Pattern.h"
 #include "viz/AtomicFile.h"
 
 #include <QAction>
@@ -208,6 +209,10 @@ void MainWindow::buildActions() {
                                                       "Ogg Theora movie (*.ogv);;PNG sequence (*.png)");
     if (!path.isEmpty()) exportAnimation(path, m_shown->recordedFrom, m_shown->recordedTo, 25.0);
   });
+  exportMenu->addAction("Run as ParaView series (.pvd)\u2026", this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, "Export run", "run.pvd", "ParaView data (*.pvd)");
+    if (!path.isEmpty()) exportRun(path);
+  });
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
 
@@ -249,6 +254,20 @@ void MainWindow::buildActions() {
   m_styleCombo->setMinimumWidth(130);
   connect(m_styleCombo, &QComboBox::textActivated, this, [this](const QString& name) { setBreathStyle(name); });
   tools->addWidget(m_styleCombo);
+  tools->addSeparator();
+  tools->addWidget(new QLabel(" Affect ", this));
+  m_affectCombo = new QComboBox(this);
+  m_affectCombo->setToolTip("Respiration pattern of an affective state (de Melo et al. 2010)");
+  const std::string resources = QFileInfo(QString::fromStdString(sim::defaultPresetDir())).path().toStdString();
+  for (const std::string& a : sim::pattern::listAffects(resources)) m_affectCombo->addItem(QString::fromStdString(a));
+  tools->addWidget(m_affectCombo);
+  m_affectMode = new QComboBox(this);
+  m_affectMode->addItems({"at end of cycle", "immediately"});
+  tools->addWidget(m_affectMode);
+  QAction* push = tools->addAction("Push");
+  push->setToolTip("Push the affect's respiration layers onto the pattern stack");
+  connect(push, &QAction::triggered, this,
+          [this] { pushAffect(m_affectCombo->currentText(), m_affectMode->currentIndex() == 1); });
   tools->addSeparator();
   tools->addWidget(new QLabel(" Camera ", this));
   const std::vector<std::pair<QString, viz::CameraPreset>> cameras{{"Anterior", viz::CameraPreset::Anterior},
@@ -447,6 +466,7 @@ QString MainWindow::openModel(const QString& dir) {
     connect(&m_thread, &QThread::started, m_worker, &SimWorker::start);
     connect(&m_thread, &QThread::finished, m_worker, &SimWorker::stop);
     connect(&m_thread, &QThread::finished, m_worker, &QObject::deleteLater);
+    connect(m_worker, &SimWorker::status, this, [this](const QString& message) { showMessage(message, 8000); });
     connect(m_worker, &SimWorker::failed, this, [this](const QString& message) {
       m_playAction->setChecked(false);
       report("Simulation stopped", message);
@@ -552,6 +572,13 @@ QString MainWindow::setBreathStyle(const QString& name) {
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   if (m_worker) m_worker->requestSettings(m_settings);
   return {};
+}
+
+void MainWindow::pushAffect(const QString& name, bool isImmediate) {
+  if (!m_worker || name.isEmpty()) return;
+  m_worker->requestAffect(name.toStdString(),
+                          isImmediate ? sim::pattern::SwitchMode::Immediate : sim::pattern::SwitchMode::EndOfCycle);
+  showMessage(QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"), 5000);
 }
 
 void MainWindow::play() { m_playAction->setChecked(true); }
@@ -825,6 +852,28 @@ QString MainWindow::exportAnimation(const QString& path, double from, double to,
     return message;
   }
   showMessage(QString("Animation saved to %1").arg(path), 5000);
+  return {};
+}
+
+QString MainWindow::exportRun(const QString& pvdPath) {
+  if (!m_worker) return "no model loaded";
+  const QFileInfo info(pvdPath);
+  QEventLoop loop;
+  QString error = "the export did not finish";
+  auto done = connect(m_worker, &SimWorker::exportDone, &loop, [&](const QString& e) {
+    error = e;
+    loop.quit();
+  });
+  m_worker->requestExportRun(m_modelDir.toStdString(), info.absolutePath().toStdString(),
+                             info.completeBaseName().toStdString());
+  loop.exec();
+  disconnect(done);
+  if (!error.isEmpty()) {
+    const QString message = QString("Cannot export the run to '%1': %2").arg(pvdPath, error);
+    report("Export failed", message);
+    return message;
+  }
+  showMessage(QString("Run saved as %1").arg(pvdPath), 5000);
   return {};
 }
 

@@ -64,6 +64,11 @@ class MainWindow : public QMainWindow {
   /// Renders the recorded run from `from` to `to` [s] at `fps` frames per second, as an Ogg Theora
   /// movie (.ogv) or a PNG sequence (any other suffix: <base>_0000.png, ...). @return empty or the error.
   QString exportAnimation(const QString& path, double from, double to, double fps);
+  /// Writes the recorded run as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it.
+  /// Blocks (processing events) until the worker has written it. @return empty or the error.
+  QString exportRun(const QString& pvdPath);
+  /// Pushes an affect preset (de Melo et al. 2010), at the end of the current breath or immediately.
+  void pushAffect(const QString& name, bool isImmediate);
 
   /// Renders the 3D view now and returns a grab of the whole window (what the user sees).
   QImage grabWindow();
@@ -121,6 +126,8 @@ class MainWindow : public QMainWindow {
   QAction* m_playAction = nullptr;
   QComboBox* m_styleCombo = nullptr;
   QComboBox* m_speedCombo = nullptr;
+  QComboBox* m_affectCombo = nullptr;
+  QComboBox* m_affectMode = nullptr;
   QComboBox* m_muscleColour = nullptr;
   QComboBox* m_gutColour = nullptr;
   std::vector<QCheckBox*> m_structureChecks;  // bones, gut, translucent gut, cavity, landmarks, labels

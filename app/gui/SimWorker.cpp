@@ -1,10 +1,13 @@
 #include "gui/SimWorker.h"
 
 #include "pneuma/sim/Error.h"
+#include "viz/VtkSeriesWriter.h"
 
 #include <QTimer>
 
 #include <algorithm>
+#include <filesystem>
+#include <limits>
 
 namespace pneuma::app {
 
@@ -71,6 +74,16 @@ void SimWorker::requestRunUntil(double time) {
   m_pending.isRunning = true;
 }
 
+void SimWorker::requestAffect(const std::string& name, sim::pattern::SwitchMode mode) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.affect = std::make_pair(name, mode);
+}
+
+void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.exportRun = std::array<std::string, 3>{modelDir, outDir, baseName};
+}
+
 Frame SimWorker::take() {
   std::lock_guard lock(m_outboxMutex);
   Frame frame;
@@ -101,6 +114,7 @@ void SimWorker::sync() {
   if (p.simulation) {
     m_model = std::move(p.model);
     m_sim = std::move(p.simulation);
+    m_pattern = nullptr;
     m_rtf = 0.0;
     m_samples.clear();
     ++m_generation;
@@ -121,6 +135,8 @@ void SimWorker::sync() {
     m_isRunning = *p.isRunning;
     m_debt = 0.0;
   }
+  if (p.affect) pushAffect(p.affect->first, p.affect->second);
+  if (p.exportRun) exportRun(*p.exportRun);
   if (p.doStep) {
     m_isRunning = false;
     m_sim->stepOnce();
@@ -140,8 +156,10 @@ void SimWorker::applySettings(const RunSettings& settings) {
       settings.style.intercostalMean != m_settings.style.intercostalMean ||
       settings.style.intercostalAmplitude != m_settings.style.intercostalAmplitude ||
       settings.style.inhaleFraction != m_settings.style.inhaleFraction ||
-      settings.style.rectusActive != m_settings.style.rectusActive || settings.style.rectusR != m_settings.style.rectusR)
+      settings.style.rectusActive != m_settings.style.rectusActive || settings.style.rectusR != m_settings.style.rectusR) {
     m_sim->setController(std::make_unique<sim::BreathStyleController>(settings.style));
+    m_pattern = nullptr;
+  }
   m_settings = settings;
 }
 
@@ -151,10 +169,62 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   s.time = m.time;
   s.lungVolume = m.lungVolume;
   s.gutVolumeError = m.gutVolumeError;
+  s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
+                             : std::numeric_limits<double>::quiet_NaN();
   s.activations = m.activations;
   s.groupTension = m.groupTension;
   s.elementForce.assign(m.elementForce.data(), m.elementForce.data() + m.elementForce.size());
   m_samples.push_back(std::move(s));
+}
+
+void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mode) {
+  // presets live in <resources>/presets/affect, beside the breath styles
+  const std::string resources = std::filesystem::path(sim::defaultPresetDir()).parent_path().string();
+  if (m_pattern) {
+    m_pattern->push(sim::pattern::loadAffect(name, resources).layers, mode);
+    return;
+  }
+  emit status(QString("Calibrating the muscle drive for affect patterns (a few simulated seconds)\u2026"));
+  const sim::pattern::DriveCalibration calibration = sim::pattern::calibrateDrive(m_model, m_sim->options());
+  auto controller = sim::pattern::makeAffectController(name, resources, 1, calibration);
+  m_pattern = controller.get();
+  m_sim->setController(std::move(controller));
+  emit status(QString("Playing affect '%1'").arg(QString::fromStdString(name)));
+}
+
+void SimWorker::restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const {
+  const sim::Recorder& rec = m_sim->recorder();
+  const sim::RecordedFrame& f = rec.frame(i);
+  rec.restore(i, state);
+  metrics.time = f.time;
+  metrics.lungVolume = f.lungVolume;
+  metrics.gutVolumeError = f.gutVolumeError;
+  // Eq. 4 with V0 / V = 1 / (1 + (V - V0) / V0)
+  const double kappa = m_sim->options().step.kappa >= 0.0 ? m_sim->options().step.kappa : m_model->gut.kappa;
+  metrics.gutPressure = kappa * (1.0 / (1.0 + f.gutVolumeError) - 1.0);
+  metrics.elementForce =
+      Eigen::Map<const Eigen::VectorXf>(f.elementForce.data(), static_cast<Eigen::Index>(f.elementForce.size()))
+          .cast<double>();
+  metrics.isSlack.clear();
+}
+
+void SimWorker::exportRun(const std::array<std::string, 3>& request) {
+  QString error;
+  try {
+    const sim::Recorder& rec = m_sim->recorder();
+    if (rec.empty()) throw std::runtime_error("nothing recorded yet: run the simulation first");
+    viz::VtkSeriesWriter writer(*m_model, request[0], request[1], request[2]);
+    sim::State state;
+    sim::Metrics metrics = m_sim->latestMetrics();
+    for (std::size_t i = 0; i < rec.size(); ++i) {
+      restoreRecorded(i, state, metrics);
+      writer.writeFrame(state, metrics);
+    }
+    writer.finish();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  emit exportDone(error);
 }
 
 void SimWorker::tick() {
@@ -218,16 +288,7 @@ void SimWorker::publish(bool isScrubbed) {
   snap->metrics = m_sim->latestMetrics();
   if (isScrubbed && !rec.empty()) {
     // the recorded frame nearest to the requested time, for display
-    const std::size_t i = rec.indexAt(m_scrubTime);
-    const sim::RecordedFrame& f = rec.frame(i);
-    rec.restore(i, snap->state);
-    snap->metrics.time = f.time;
-    snap->metrics.lungVolume = f.lungVolume;
-    snap->metrics.gutVolumeError = f.gutVolumeError;
-    snap->metrics.elementForce = Eigen::Map<const Eigen::VectorXf>(f.elementForce.data(),
-                                                                   static_cast<Eigen::Index>(f.elementForce.size()))
-                                     .cast<double>();
-    snap->metrics.isSlack.clear();
+    restoreRecorded(rec.indexAt(m_scrubTime), snap->state, snap->metrics);
     snap->isScrubbed = true;
   } else {
     snap->state = m_sim->state();

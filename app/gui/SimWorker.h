@@ -8,11 +8,13 @@
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/State.h"
+#include "pneuma/sim/pattern/PatternController.h"
 
 #include <QObject>
 #include <QString>
 
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -34,6 +36,7 @@ struct PlotSample {
   double time = 0.0;                      ///< [s]
   double lungVolume = 0.0;                ///< [m^3]
   double gutVolumeError = 0.0;            ///< [-] signed (V - V0) / V0
+  double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung volume; NaN without one
   sim::Activations activations{};         ///< r and alpha per group
   std::array<double, sim::kElementGroupCount> groupTension{};  ///< [N]
   std::vector<float> elementForce;        ///< [N] signed, per element (#E)
@@ -83,6 +86,13 @@ class SimWorker : public QObject {
   void requestScrub(double time);
   /// Runs as fast as possible until simulated time `time` [s], then pauses and emits targetReached().
   void requestRunUntil(double time);
+  /// Plays affect preset `name` (de Melo et al. 2010) by pushing its layers in `mode`. The first push
+  /// calibrates the muscle drive on the model (a few simulated seconds, in the worker thread) and
+  /// switches to a pattern controller; a later breath-style edit switches back.
+  void requestAffect(const std::string& name, sim::pattern::SwitchMode mode);
+  /// Writes the recorded frames as a ParaView series `outDir`/`baseName`.pvd (viz::VtkSeriesWriter),
+  /// then emits exportDone().
+  void requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName);
 
   /// The latest snapshot and the plot samples produced since the previous call (each handed out once).
   Frame take();
@@ -98,6 +108,10 @@ class SimWorker : public QObject {
   /// The simulation threw (blow-up or bad parameter); the run is paused.
   void failed(const QString& message);
   void targetReached();
+  /// A run export finished; `error` is empty on success.
+  void exportDone(const QString& error);
+  /// Progress worth showing in the status bar (e.g. calibration).
+  void status(const QString& message);
 
  private:
   struct Pending {
@@ -110,16 +124,24 @@ class SimWorker : public QObject {
     std::unique_ptr<sim::Simulation> simulation;
     std::optional<double> scrubTime;
     std::optional<double> runUntil;
+    std::optional<std::pair<std::string, sim::pattern::SwitchMode>> affect;
+    std::optional<std::array<std::string, 3>> exportRun;  // model dir, out dir, base name
   };
 
   void tick();
   void sync();
   void applySettings(const RunSettings& settings);
   void collect(const sim::Simulation& simulation);
+  void pushAffect(const std::string& name, sim::pattern::SwitchMode mode);
+  void exportRun(const std::array<std::string, 3>& request);
+  /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces,
+  /// and the gut pressure of Eq. 4 recomputed from the volume error).
+  void restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const;
   void publish(bool isScrubbed);
 
   std::shared_ptr<const sim::Model> m_model;
   std::unique_ptr<sim::Simulation> m_sim;
+  sim::pattern::PatternController* m_pattern = nullptr;  // the sim's controller when an affect plays
   RunSettings m_settings;
   QTimer* m_timer = nullptr;
 

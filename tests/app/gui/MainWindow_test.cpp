@@ -247,3 +247,56 @@ TEST(MainWindow, ScenarioRoundTripKeepsModelAndParameters) {
   EXPECT_EQ(w.window.parameters()->settings().style.breathsPerMinute, 21.0);
   EXPECT_EQ(w.window.model()->name, "toy_torso");
 }
+
+TEST(MainWindow, ClickingAMuscleSelectsItAndAddsItsForceTrace) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(3.0));
+  // a force-coloured pixel is a taut muscle element
+  const QImage view = w.window.grabView();
+  QPoint hit(-1, -1);
+  for (int y = view.height() / 4; y < view.height() && hit.x() < 0; ++y)
+    for (int x = view.width() / 4; x < static_cast<int>(0.8 * view.width()); ++x)
+      if (isForceColoured(view.pixel(x, y)) && isForceColoured(view.pixel(x + 1, y)) &&
+          isForceColoured(view.pixel(x, y + 1))) {
+        hit = QPoint(x, y);
+        break;
+      }
+  ASSERT_GE(hit.x(), 0);
+  const app::PlotView* tension = w.window.plots()->plots()[3];
+  const std::size_t before = tension->series().size();
+  w.window.pickAt(hit);
+  w.window.plots()->refresh();
+  ASSERT_EQ(tension->series().size(), before + 1);
+  EXPECT_TRUE(tension->series().back().name.contains("element")) << tension->series().back().name.toStdString();
+  // its trace holds the element's tension: positive while it is coloured
+  EXPECT_GT(tension->series().back().y.back(), 0.0);
+}
+
+TEST(MainWindow, RunExportsAsParaViewSeries) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(0.5));
+  QTemporaryDir out;
+  ASSERT_EQ(w.window.exportRun(out.filePath("run.pvd")), QString());
+  QFile pvd(out.filePath("run.pvd"));
+  ASSERT_TRUE(pvd.open(QIODevice::ReadOnly));
+  const QByteArray text = pvd.readAll();
+  EXPECT_TRUE(text.contains("<VTKFile type=\"Collection\""));
+  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 4 parts each)
+  EXPECT_GE(text.count("<DataSet"), 4 * 30);
+  EXPECT_FALSE(QDir(out.filePath("run")).entryList({"*.vtp"}, QDir::Files).isEmpty());
+
+  // an unwritable destination is an error, not a crash
+  EXPECT_NE(w.window.exportRun("/proc/pneuma-no-such-dir/run.pvd"), QString());
+}
+
+TEST(MainWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
+  ToyWindow w;
+  w.window.pushAffect("neutral", true);
+  ASSERT_TRUE(w.window.runUntil(4.0));
+  const app::PlotView* volume = w.window.plots()->volumePlot();
+  ASSERT_EQ(volume->series().size(), 2u);
+  EXPECT_EQ(volume->series()[1].name, "target volume");
+  // the target is defined once control starts after settling
+  EXPECT_TRUE(std::isfinite(volume->series()[1].y.back()));
+  EXPECT_GT(volume->series()[1].y.back(), 0.0);
+}
