@@ -327,7 +327,7 @@ std::vector<Plot::Primitive> Plot::layout() const {
   double yTickWidth = 0.0;
   for (double t : yticks) yTickWidth = std::max(yTickWidth, textWidth(tickLabel(t, ystep), tickSize));
 
-  // legend entries; more than five go outside, to the right of the plot box
+  // legend entries; more than three go outside, to the right of the plot box
   std::vector<const Series*> entries;
   for (const Series& s : m_series)
     if (!s.label.empty()) entries.push_back(&s);
@@ -337,7 +337,7 @@ std::vector<Plot::Primitive> Plot::layout() const {
   double legendTextWidth = 0.0;
   for (const Series* s : entries) legendTextWidth = std::max(legendTextWidth, textWidth(s->label, legendSize));
   const double legendW = legendTextWidth + 52.0;
-  const bool isLegendOutside = hasLegend && entries.size() > 5;
+  const bool isLegendOutside = hasLegend && entries.size() > 3;
 
   // plot box from the margins the labels need
   const double left = 14.0 + labelSize + 10.0 + yTickWidth + 8.0;

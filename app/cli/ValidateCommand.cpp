@@ -1,0 +1,241 @@
+/// @file ValidateCommand.cpp
+/// `pneuma-cli validate`: reruns the papers' experiments (sim/Experiments.h) on a model and writes
+/// report.html (self-contained, plots embedded), report.md and report.json. Exit 0 iff every check passes.
+
+#include "CliSupport.h"
+#include "Commands.h"
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Experiments.h"
+#include "pneuma/sim/ModelIO.h"
+#include "viz/AtomicFile.h"
+#include "viz/Plot.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+namespace pneuma::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ValidateArgs {
+  std::string model;
+  std::string out = "validation";
+  bool isQuick = false;
+  std::string integrator;
+};
+
+/// A figure of the report: its plot and a caption.
+struct Figure {
+  std::string stem;     // file name without extension
+  std::string caption;
+  viz::Plot plot;
+};
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const unsigned v = (bytes[i] << 16) | (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0) | (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+    out += table[(v >> 18) & 63];
+    out += table[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? table[v & 63] : '=';
+  }
+  return out;
+}
+
+std::string htmlEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+  return out;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+/// Figure 6 of Zordan et al. 2004: lung-cavity volume of every style, relative to calm end-expiration,
+/// with the 500 mL calm tidal volume as a dashed reference.
+viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
+  double base = 0.0;
+  for (const sim::StyleRun& r : runs)
+    if (r.style.name == "calm") base = r.summary.endExpiratoryVolume;
+  viz::Plot plot("Lung-cavity volume of the breath styles (cf. Zordan et al. 2004, Fig. 6)", "time since settling [s]",
+                 "volume above calm end-expiration [mL]");
+  for (const sim::StyleRun& r : runs) {
+    std::vector<double> t, v;
+    for (std::size_t i = 0; i < r.trace.size(); ++i)
+      if (r.trace.time[i] >= r.settleTime) {
+        t.push_back(r.trace.time[i] - r.settleTime);
+        v.push_back((r.trace.lungVolume[i] - base) * 1e6);
+      }
+    plot.addSeries(r.style.name, t, v);
+  }
+  plot.addReferenceLine("500 mL (calm tidal volume, textbook)", 500.0);
+  return plot;
+}
+
+void runValidate(const ValidateArgs& args) {
+  const std::string modelDir = resolveModelDir(args.model);
+  prepareOutputDir(args.out);
+  sim::ExperimentSettings settings = args.isQuick ? sim::quickExperimentSettings() : sim::ExperimentSettings{};
+  if (!args.integrator.empty() && !sim::integratorFromName(args.integrator, settings.simulation.step.integrator))
+    fail(kExitBadInput, "--integrator: unknown integrator '" + args.integrator + "' (valid: symplectic-euler, implicit-euler)");
+  std::shared_ptr<const sim::Model> model;
+  std::vector<sim::BreathStyle> styles;
+  try {
+    model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
+    for (const char* name : {"calm", "deep", "panting", "forced-exhale"})
+      styles.push_back(sim::loadBreathStyle(name, resourceDir() + "/presets"));
+  } catch (const sim::Error& e) {
+    fail(kExitBadInput, e.what());
+  }
+
+  // the experiments; a blow-up fails the run (exit 1) with the simulator's diagnosis
+  const auto wallStart = std::chrono::steady_clock::now();
+  auto progress = [](const std::string& what) { std::fprintf(stderr, "validate: %s\n", what.c_str()); };
+  std::vector<sim::StyleRun> runs;
+  sim::ImpactRun impact;
+  sim::SwayRun sway, swayFree;
+  try {
+    for (const sim::BreathStyle& s : styles) {
+      progress("breath style '" + s.name + "'");
+      runs.push_back(sim::runBreathStyle(model, s, settings));
+    }
+    progress("heavy impact");
+    impact = sim::runHeavyImpact(model, settings);
+    progress("spine sway with joint friction");
+    sway = sim::runSpineSway(model, styles[1], 1.0, settings);
+    progress("spine sway without joint friction");
+    swayFree = sim::runSpineSway(model, styles[1], 0.0, settings);
+  } catch (const sim::Error& e) {
+    fail(kExitFailed, std::string("validate: ") + e.what());
+  }
+  const double wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+
+  std::vector<sim::Check> checks = sim::breathStyleChecks(runs);
+  for (const sim::Check& c : sim::impactChecks(impact)) checks.push_back(c);
+  for (const sim::Check& c : sim::swayChecks(sway, swayFree)) checks.push_back(c);
+  int failed = 0;
+  for (const sim::Check& c : checks) failed += !c.isPassed();
+
+  // figures
+  std::vector<Figure> figures;
+  figures.push_back({"figure6_lung_volume", "Lung-cavity volume of the four breath styles; dashed: the 500 mL calm tidal volume of Figure 6.", figure6(runs)});
+  {
+    viz::Plot p("Gut volume error after a heavy impact (cf. Fig. 4)", "time after impact [s]", "gut volume error [%]");
+    std::vector<double> e;
+    for (double v : impact.trace.gutVolumeError) e.push_back(v * 100.0);
+    p.addSeries("gut volume error", impact.trace.time, e);
+    p.addReferenceLine("+0.5 % (Fig. 4)", 0.5);
+    p.addReferenceLine("-0.5 %", -0.5, viz::Color{0.5, 0.5, 0.5});
+    figures.push_back({"impact_gut_volume_error", "Signed gut volume error after the anterior wall is struck at " +
+                                                      number(settings.impactSpeed) + " m/s.", p});
+  }
+  {
+    viz::Plot p("Spine sway during deep breathing (cf. Sec. 5)", "time [s]", "anterior displacement of " + sway.spineBody + " [mm]");
+    auto mm = [](const std::vector<double>& v) {
+      std::vector<double> o;
+      for (double x : v) o.push_back(x * 1e3);
+      return o;
+    };
+    p.addSeries("with joint friction", sway.time, mm(sway.spineY));
+    p.addSeries("frictionless", swayFree.time, mm(swayFree.spineY));
+    figures.push_back({"spine_sway", "Anterior-posterior displacement of the top thoracic segment, with and without rib-joint friction (Eq. 3).", p});
+  }
+  for (const Figure& f : figures) {
+    f.plot.writePng(args.out + "/" + f.stem + ".png");
+    f.plot.writeSvg(args.out + "/" + f.stem + ".svg");
+  }
+
+  // report.json
+  nlohmann::json j;
+  j["pneuma_version"] = PNEUMA_VERSION;
+  j["model"] = modelDir;
+  j["model_name"] = model->name;
+  j["integrator"] = sim::integratorName(settings.simulation.step.integrator);
+  j["quick"] = args.isQuick;
+  j["wall_seconds"] = wallSeconds;
+  j["passed"] = failed == 0;
+  j["failed_count"] = failed;
+  for (const sim::Check& c : checks)
+    j["checks"].push_back({{"id", c.id}, {"what", c.what}, {"target", c.target}, {"measured", c.measured},
+                           {"unit", c.unit}, {"lower", std::isfinite(c.lower) ? nlohmann::json(c.lower) : nlohmann::json(nullptr)},
+                           {"upper", std::isfinite(c.upper) ? nlohmann::json(c.upper) : nlohmann::json(nullptr)},
+                           {"passed", c.isPassed()}, {"source", c.source}});
+  for (const sim::StyleRun& r : runs)
+    j["styles"][r.style.name] = {{"tidal_volume_ml", r.summary.tidalVolume * 1e6}, {"breaths_per_minute", r.summary.breathsPerMinute},
+                                 {"end_expiratory_volume_ml", r.summary.endExpiratoryVolume * 1e6},
+                                 {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
+                                 {"real_time_factor", r.summary.realTimeFactor}};
+  for (const Figure& f : figures) j["figures"].push_back(f.stem + ".png");
+  viz::writeFileAtomically(args.out + "/report.json", j.dump(2) + "\n");
+
+  // report.md and report.html share the table rows
+  std::ostringstream md, html, table;
+  const std::string verdict = failed == 0 ? "all " + std::to_string(checks.size()) + " checks pass"
+                                          : std::to_string(failed) + " of " + std::to_string(checks.size()) + " checks fail";
+  md << "# Pneuma validation report\n\nModel `" << modelDir << "` (" << model->name << "), integrator "
+     << sim::integratorName(settings.simulation.step.integrator) << (args.isQuick ? ", quick settings" : "")
+     << ", pneuma " << PNEUMA_VERSION << ". Result: **" << verdict << "**.\n\n"
+     << "| check | what | target | measured | result | source |\n|---|---|---|---|---|---|\n";
+  for (const sim::Check& c : checks) {
+    md << "| " << c.id << " | " << c.what << " | " << c.target << " | " << number(c.measured) << " " << c.unit << " | "
+       << (c.isPassed() ? "pass" : "**FAIL**") << " | " << c.source << " |\n";
+    table << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id) << "</td><td>"
+          << htmlEscape(c.what) << "</td><td>" << htmlEscape(c.target) << "</td><td>" << number(c.measured) << " "
+          << htmlEscape(c.unit) << "</td><td>" << (c.isPassed() ? "pass" : "FAIL") << "</td><td>" << htmlEscape(c.source)
+          << "</td></tr>\n";
+  }
+  md << "\n";
+  for (const Figure& f : figures) md << "![" << f.caption << "](" << f.stem << ".png)\n\n" << f.caption << "\n\n";
+  html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Pneuma validation report</title>\n<style>"
+       << "body{font-family:sans-serif;max-width:1000px;margin:2em auto}table{border-collapse:collapse;font-size:14px}"
+       << "td,th{border:1px solid #ccc;padding:4px 8px;text-align:left}tr.pass td:nth-child(5){color:#1a7f37}"
+       << "tr.fail td:nth-child(5){color:#c00;font-weight:bold}img{max-width:100%}</style></head><body>\n"
+       << "<h1>Pneuma validation report</h1>\n<p>Model <code>" << htmlEscape(modelDir) << "</code> (" << htmlEscape(model->name)
+       << "), integrator " << sim::integratorName(settings.simulation.step.integrator) << (args.isQuick ? ", quick settings" : "")
+       << ", pneuma " << PNEUMA_VERSION << ". Result: <b>" << verdict << "</b>.</p>\n"
+       << "<table><tr><th>check</th><th>what</th><th>target</th><th>measured</th><th>result</th><th>source</th></tr>\n"
+       << table.str() << "</table>\n";
+  for (const Figure& f : figures)
+    html << "<figure><img alt=\"" << htmlEscape(f.stem) << "\" src=\"data:image/png;base64," << base64(f.plot.toPng())
+         << "\"><figcaption>" << htmlEscape(f.caption) << "</figcaption></figure>\n";
+  html << "</body></html>\n";
+  viz::writeFileAtomically(args.out + "/report.md", md.str());
+  viz::writeFileAtomically(args.out + "/report.html", html.str());
+
+  // the table on stdout
+  std::printf("%-32s %-8s %-14s %s\n", "check", "result", "measured", "target");
+  for (const sim::Check& c : checks)
+    std::printf("%-32s %-8s %-14s %s\n", c.id.c_str(), c.isPassed() ? "pass" : "FAIL", (number(c.measured) + " " + c.unit).c_str(),
+                c.target.c_str());
+  std::printf("%s; report: %s/report.html (%.0f s)\n", verdict.c_str(), args.out.c_str(), wallSeconds);
+  if (failed > 0) throw CLI::RuntimeError(kExitFailed);
+}
+
+}  // namespace
+
+void addValidateCommand(CLI::App& app) {
+  auto args = std::make_shared<ValidateArgs>();
+  CLI::App* cmd = app.add_subcommand("validate", "Rerun the papers' experiments; write report.html, report.md, report.json");
+  cmd->add_option("--model", args->model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+  cmd->add_option("--out", args->out, "Output directory (default: ./validation)");
+  cmd->add_flag("--quick", args->isQuick, "Shorter runs (same checks), for tests and quick looks");
+  cmd->add_option("--integrator", args->integrator, "symplectic-euler or implicit-euler (default implicit-euler)");
+  cmd->callback([args] { runValidate(*args); });
+}
+
+}  // namespace pneuma::app

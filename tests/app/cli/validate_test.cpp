@@ -1,0 +1,57 @@
+// pneuma-cli validate: every check is reported with target, measured value, pass/fail and source, in
+// report.json, report.md and a self-contained report.html; the exit code says whether all passed.
+#include "CliRunner.h"
+#include "ToyModelDir.h"
+
+#include <nlohmann/json.hpp>
+
+using pneuma::test::freshOutDir;
+using pneuma::test::runCli;
+using pneuma::test::slurp;
+using pneuma::test::toyModelDir;
+
+TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
+  const std::string out = freshOutDir("validate");
+  auto r = runCli({"validate", "--quick", "--model", toyModelDir(), "--out", out});
+  ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 1) << r.err;
+
+  const nlohmann::json j = nlohmann::json::parse(slurp(out + "/report.json"));
+  const auto& checks = j.at("checks");
+  ASSERT_GE(checks.size(), 15u);  // four styles, impact, sway
+  int failed = 0;
+  for (const auto& c : checks) {
+    for (const char* key : {"id", "what", "target", "measured", "unit", "passed", "source"}) EXPECT_TRUE(c.contains(key)) << key;
+    EXPECT_FALSE(c["source"].get<std::string>().empty());
+    // pass/fail agrees with the bounds
+    const double m = c["measured"].get<double>();
+    const bool inside = (c["lower"].is_null() || m >= c["lower"].get<double>()) && (c["upper"].is_null() || m <= c["upper"].get<double>());
+    EXPECT_EQ(c["passed"].get<bool>(), inside) << c["id"];
+    failed += !c["passed"].get<bool>();
+  }
+  EXPECT_EQ(j["failed_count"].get<int>(), failed);
+  EXPECT_EQ(r.exitCode, failed == 0 ? 0 : 1);
+  for (const std::string id : {"calm.tidal_volume", "impact.gut_volume_error", "sway.friction_ratio"}) {
+    bool found = false;
+    for (const auto& c : checks) found = found || c["id"] == id;
+    EXPECT_TRUE(found) << id;
+  }
+
+  // report.md: one table row per check; report.html: self-contained (embedded PNGs), one row per check
+  const std::string md = slurp(out + "/report.md"), html = slurp(out + "/report.html");
+  for (const auto& c : checks) {
+    const std::string id = c["id"].get<std::string>();
+    EXPECT_NE(md.find("| " + id + " |"), std::string::npos) << id;
+    EXPECT_NE(html.find("<td>" + id + "</td>"), std::string::npos) << id;
+  }
+  EXPECT_NE(html.find("data:image/png;base64,iVBORw0KGgo"), std::string::npos);  // PNG signature in base64
+  EXPECT_EQ(html.find("src=\"figure"), std::string::npos);  // no external image references
+  EXPECT_NE(slurp(out + "/figure6_lung_volume.svg").find("500 mL"), std::string::npos);
+  // stdout carries the table
+  EXPECT_NE(r.out.find("calm.tidal_volume"), std::string::npos);
+}
+
+TEST(CliValidate, MissingModelIsBadInput) {
+  auto r = runCli({"validate", "--model", "/nonexistent/model", "--out", freshOutDir("validate_bad")});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(pneuma::test::lineCount(r.err), 1) << r.err;
+}
