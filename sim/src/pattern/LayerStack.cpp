@@ -116,9 +116,9 @@ void LayerStack::startBreath(double t, double fromVolume) {
 
   // cross-fade when the new breath does not start where the volume is (not for the very first breath)
   m_blendDuration = 0.0;
-  const bool isFirst = !m_hasPlayed;
-  m_hasPlayed = true;
-  if (!isFirst && std::abs(m_layers.back().cycle.volume(0.0, m_variation) - fromVolume) > kSameVolume) {
+  const bool hadVolume = m_hasVolume;
+  m_hasVolume = true;
+  if (hadVolume && std::abs(m_layers.back().cycle.volume(0.0, m_variation) - fromVolume) > kSameVolume) {
     m_blendFrom = fromVolume;
     m_blendStart = t;
     m_blendDuration = blendDuration(m_layers.back().cycle);
@@ -142,6 +142,12 @@ void LayerStack::endBreath(double t) {
     return;
   }
   startBreath(t, v);
+}
+
+void LayerStack::setStartVolume(double v) {
+  m_hold = std::clamp(v, 0.0, 1.0);
+  m_volume = m_hold;
+  m_hasVolume = true;
 }
 
 double LayerStack::balance() const { return m_layers.empty() ? 0.5 : m_layers.back().cycle.spec().balance; }

@@ -117,7 +117,7 @@ void PatternController::restart() {
   m_calibration = m_givenCalibration;
   m_isControlling = false;
   m_restVolumeSeen = 0.0;
-  m_lastTime = m_lastFrameControlTime = 0.0;
+  m_lastTime = m_lastFrameControlTime = m_startTime = 0.0;
   m_lastFrameTime = -1.0;
   m_target = m_measured = m_error = m_integral = 0.0;
   m_balance = m_stack.balance();
@@ -127,34 +127,42 @@ void PatternController::restart() {
 Activations PatternController::activations(double t, const Metrics& latest) {
   // control time going backwards means the simulation was reset: start the pattern over
   if (t < m_lastTime) restart();
+
   // settling (t = 0): hold the rest posture and learn the rest volume unless it was given
   if (!m_isControlling && t <= 0.0) {
     if (latest.lungVolume > 0.0 && m_calibration.restVolume == 0.0) m_restVolumeSeen = latest.lungVolume;
-    m_target = m_stack.sample(0.0);
-    return distribute(m_target - m_calibration.restFraction, m_balance);
+    m_target = m_calibration.restFraction;
+    return distribute(0.0, m_balance);
   }
+
+  // control starts: the pattern clock starts here, and its first breath blends from the measured volume
   if (!m_isControlling) {
     m_isControlling = true;
     if (m_calibration.restVolume == 0.0) m_calibration.restVolume = m_restVolumeSeen;
+    m_startTime = t;
+    m_lastTime = t;
     m_lastFrameTime = latest.time;
+    m_lastFrameControlTime = t;
+    m_stack.setStartVolume(m_calibration.restVolume > 0.0 && latest.lungVolume > 0.0
+                               ? volumeToFraction(latest.lungVolume)
+                               : m_calibration.restFraction);
   }
-  const double dt = std::max(t - m_lastTime, 0.0);
-  m_lastTime = std::max(t, m_lastTime);
+  const double dt = t - m_lastTime;
+  m_lastTime = t;
 
   // target and its rate of change
   const double previous = m_target;
-  m_target = m_stack.sample(m_lastTime);
+  m_target = m_stack.sample(t - m_startTime);
   const double targetRate = dt > 0.0 ? (m_target - previous) / dt : 0.0;  // [1/s]
 
   // feedback: a new frame was measured at this very control time
   if (latest.time > m_lastFrameTime && m_calibration.restVolume > 0.0) {
     m_measured = volumeToFraction(latest.lungVolume);
     m_error = m_target - m_measured;
-    const double frameDt = m_lastTime - m_lastFrameControlTime;
-    m_integral = std::clamp(m_integral + m_options.ki * m_error * frameDt, -m_options.integralLimit,
-                            m_options.integralLimit);
+    m_integral = std::clamp(m_integral + m_options.ki * m_error * (t - m_lastFrameControlTime),
+                            -m_options.integralLimit, m_options.integralLimit);
     m_lastFrameTime = latest.time;
-    m_lastFrameControlTime = m_lastTime;
+    m_lastFrameControlTime = t;
     // statistics
     m_tracking.frames += 1;
     m_tracking.sumSquaredError += m_error * m_error;

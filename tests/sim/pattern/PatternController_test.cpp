@@ -126,3 +126,31 @@ TEST(PatternController, RejectsAnUncalibratedGroup) {
     EXPECT_NE(std::string(e.what()).find("calibration.gain.rectus"), std::string::npos) << e.what();
   }
 }
+
+TEST(PatternController, TakesOverMidRunWithoutAJumpAndPlaysItsEventFirst) {
+  const DriveCalibration c = plantCalibration();
+  auto first = makeAffectController("excitement", kResources, 1, c);
+  Plant plant;
+  plant.run(*first, 20.3, c);  // somewhere inside a breath
+  const double before = first->measuredFraction();
+  // a fresh relief controller installed at t = 20.3 s (as Simulation::setController does)
+  auto second = makeAffectController("relief", kResources, 1, c);
+  second->activations(0.0, plant.latest);  // the validation call of setController
+  plant.run(*second, 20.31, c);
+  EXPECT_NEAR(second->targetFraction(), before, 0.02);
+  EXPECT_EQ(second->stack().currentLayerName(), "sigh");
+  plant.run(*second, 22.0, c);
+  EXPECT_EQ(second->stack().currentLayerName(), "sigh");
+}
+
+TEST(PatternController, RestartsWhenTheSimulationIsReset) {
+  const DriveCalibration c = plantCalibration();
+  auto ctl = makeAffectController("relief", kResources, 1, c);
+  Plant plant;
+  plant.run(*ctl, 12.0, c);
+  EXPECT_EQ(ctl->stack().currentLayerName(), "neutral");
+  Plant again;
+  again.run(*ctl, 1.0, c);  // time starts over
+  EXPECT_EQ(ctl->stack().currentLayerName(), "sigh");
+  EXPECT_LT(ctl->tracking().frames, 70);
+}

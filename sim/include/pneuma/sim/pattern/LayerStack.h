@@ -61,6 +61,10 @@ class LayerStack {
   /// is 0, and after the last layer popped the volume holds. @throws Error when t decreases or is not finite.
   double sample(double t);
 
+  /// Sets the volume fraction v in [0, 1] the stack holds before its first breath, which then cross-fades
+  /// from it (a pattern taking over a breathing torso). Call before the first sample().
+  void setStartVolume(double v);
+
   /// Volume fraction of the last sample.
   double volume() const { return m_volume; }
   /// [-] thoraco-abdominal balance of the playing layer (0.5 when nothing plays).
@@ -100,7 +104,8 @@ class LayerStack {
   double m_time = 0.0;                  // [s] last sample
   double m_volume = 0.0;                // [-] volume at m_time
   double m_hold = 0.0;                  // [-] volume held while nothing plays
-  bool m_hasPlayed = false;             // false until the first breath starts (it starts without cross-fade)
+  bool m_hasVolume = false;             // false until a breath started or setStartVolume(): the first breath
+                                        // then starts without cross-fade
   // the playing breath
   double m_breathStart = 0.0;           // [s]
   BreathVariation m_variation;

@@ -78,7 +78,10 @@ class PatternController : public Controller {
   PatternController(LayerStack stack, DriveCalibration calibration, PatternControllerOptions options = {},
                     std::string description = "pattern");
 
-  /// Control time going backwards (Simulation::reset()) restarts the pattern from its initial stack.
+  /// The pattern clock starts at the first call with t > 0 (earlier calls are the settling phase), and
+  /// its first breath cross-fades from the lung volume measured then, so a controller installed mid-run
+  /// (Simulation::setController()) takes over without a jump. Control time going backwards
+  /// (Simulation::reset()) restarts the pattern from its initial stack.
   Activations activations(double t, const Metrics& latest) override;
   std::string describe() const override;
   std::unique_ptr<Controller> clone() const override;
@@ -111,6 +114,7 @@ class PatternController : public Controller {
   bool m_isControlling = false;   // false during settling (t = 0 calls)
   double m_restVolumeSeen = 0.0;  // [m^3] latest lung volume seen while settling
   double m_lastTime = 0.0;        // [s] control time of the last call
+  double m_startTime = 0.0;       // [s] control time at which control (and the pattern clock) started
   double m_lastFrameTime = -1.0;  // [s] Metrics::time of the last frame used
   double m_lastFrameControlTime = 0.0;  // [s] control time at which that frame arrived
   double m_target = 0.0;          // [-] v_T at m_lastTime
