@@ -80,37 +80,49 @@ void applyAnchorForce(const AnchorSet& a, int i, const Vector3d& lever, const Ve
 
 Eigen::Index nodeOffset(const Model& m, int n) { return 6 * static_cast<Eigen::Index>(m.bodies.size()) + 3 * n; }
 
-Vector3d anchorVelocity(const AnchorSet& a, int i, const Vector3d& lever, const Model& m, const Eigen::VectorXd& u) {
-  const int b = a.body[at(i)];
-  if (b >= 0) return u.segment<3>(6 * b) + u.segment<3>(6 * b + 3).cross(lever);
+// velocity of endpoint `side` (0 = A, 1 = B) of element e under generalized velocity u, using the
+// per-element endpoint classification of StepWork (body, single node, or weighted nodes)
+Vector3d anchorVelocity(const Model& m, const StepWork& w, int side, int e, const Vector3d& lever,
+                        const Eigen::VectorXd& u) {
+  const double* x = u.data();
+  const int b = w.endpointBody(side, e);
+  if (b >= 0) return Eigen::Map<const Vector3d>(x + 6 * b) + Eigen::Map<const Vector3d>(x + 6 * b + 3).cross(lever);
+  const int n = w.endpointNode(side, e);
+  if (n >= 0) return Eigen::Map<const Vector3d>(x + nodeOffset(m, n));
+  const AnchorSet& a = side == 0 ? m.elements.endA : m.elements.endB;
   Vector3d v = Vector3d::Zero();
   for (int k = 0; k < 3; ++k) {
-    const int n = a.nodes(k, i);
-    if (n >= 0) v += a.weights(k, i) * u.segment<3>(nodeOffset(m, n));
+    const int nk = a.nodes(k, e);
+    if (nk >= 0) v += a.weights(k, e) * Eigen::Map<const Vector3d>(x + nodeOffset(m, nk));
   }
   return v;
 }
 
-void addAnchorGeneralized(const AnchorSet& a, int i, const Vector3d& lever, const Vector3d& f, const Model& m,
+// adds the generalized force of a point force f at endpoint `side` of element e to out
+void addAnchorGeneralized(const Model& m, const StepWork& w, int side, int e, const Vector3d& lever, const Vector3d& f,
                           Eigen::VectorXd& out) {
-  const int b = a.body[at(i)];
+  double* x = out.data();
+  const int b = w.endpointBody(side, e);
   if (b >= 0) {
-    out.segment<3>(6 * b) += f;
-    out.segment<3>(6 * b + 3) += lever.cross(f);
+    Eigen::Map<Vector3d>(x + 6 * b) += f;
+    Eigen::Map<Vector3d>(x + 6 * b + 3) += lever.cross(f);
     return;
   }
+  const int n = w.endpointNode(side, e);
+  if (n >= 0) {
+    Eigen::Map<Vector3d>(x + nodeOffset(m, n)) += f;
+    return;
+  }
+  const AnchorSet& a = side == 0 ? m.elements.endA : m.elements.endB;
   for (int k = 0; k < 3; ++k) {
-    const int n = a.nodes(k, i);
-    if (n >= 0) out.segment<3>(nodeOffset(m, n)) += a.weights(k, i) * f;
+    const int nk = a.nodes(k, e);
+    if (nk >= 0) Eigen::Map<Vector3d>(x + nodeOffset(m, nk)) += a.weights(k, e) * f;
   }
 }
 
 // zero the entries of fixed bodies and nodes
-void maskFixed(const Model& m, Eigen::VectorXd& x) {
-  for (int b = 0; b < m.bodies.size(); ++b)
-    if (m.bodies.isFixed[at(b)]) x.segment<6>(6 * b).setZero();
-  for (int n = 0; n < m.nodes.size(); ++n)
-    if (m.nodes.isFixed(n)) x.segment<3>(nodeOffset(m, n)).setZero();
+void maskFixed(const StepWork& w, Eigen::VectorXd& x) {
+  for (Eigen::Index i = 0; i < w.fixedDofs.size(); ++i) x(w.fixedDofs(i)) = 0.0;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -234,12 +246,12 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     const double kg = kScale * w.elementGeometric(e);
     if (ka == 0.0 && kg == 0.0) continue;
     const Vector3d ra = w.leverA.col(e), rb = w.leverB.col(e);
-    const Vector3d du = anchorVelocity(el.endB, e, rb, model, u) - anchorVelocity(el.endA, e, ra, model, u);
+    const Vector3d du = anchorVelocity(model, w, 1, e, rb, u) - anchorVelocity(model, w, 0, e, ra, u);
     const Vector3d d = w.elementDirection.col(e);
     const double along = d.dot(du);
     const Vector3d y = ka * along * d + kg * (du - along * d);
-    addAnchorGeneralized(el.endA, e, ra, -y, model, out);
-    addAnchorGeneralized(el.endB, e, rb, y, model, out);
+    addAnchorGeneralized(model, w, 0, e, ra, -y, out);
+    addAnchorGeneralized(model, w, 1, e, rb, y, out);
   }
   // rank-one gut pressure stiffness kappa V0 / V^2 g g^T while the pressure pushes (V < V0)
   if (w.gutPressure > 0.0 && kScale != 0.0) {
@@ -258,7 +270,7 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     out.segment<3>(6 * c + 3) += y;
     out.segment<3>(6 * p + 3) -= y;
   }
-  maskFixed(model, out);
+  maskFixed(w, out);
 }
 
 // out = M u (block diagonal: m I for translations, world inertia for rotations)
@@ -272,8 +284,9 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
     out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
 }
 
-// Jacobi preconditioner: diagonal of M plus the element terms on translational entries
-void buildPreconditioner(const Model& model, const StepWork& w, double dt, Eigen::VectorXd& diag) {
+// Jacobi preconditioner: diagonal of M + dt D + dt^2 K (element terms on translations and, through the
+// lever arm, rotations; joint friction and stiffness on rotations)
+void buildPreconditioner(const Model& model, const StepOptions& o, const StepWork& w, double dt, Eigen::VectorXd& diag) {
   for (int b = 0; b < model.bodies.size(); ++b) {
     const Matrix3d& r = w.rotation[at(b)];
     const Matrix3d iw = r * model.bodies.inertia[at(b)] * r.transpose();
@@ -285,18 +298,28 @@ void buildPreconditioner(const Model& model, const StepWork& w, double dt, Eigen
   for (int e = 0; e < el.size(); ++e) {
     const double k = dt * dt * (w.elementStiffness(e) + w.elementGeometric(e)) + dt * w.elementDamping(e);
     if (k == 0.0) continue;
-    const Vector3d d2 = w.elementDirection.col(e).cwiseAbs2();
-    for (const AnchorSet* a : {&el.endA, &el.endB}) {
-      const int b = a->body[at(e)];
+    const Vector3d d = w.elementDirection.col(e);
+    const Vector3d d2 = d.cwiseAbs2();
+    for (int side = 0; side < 2; ++side) {
+      const int b = w.endpointBody(side, e);
       if (b >= 0) {
+        const Vector3d lever = side == 0 ? w.leverA.col(e) : w.leverB.col(e);
         diag.segment<3>(6 * b) += k * d2;
+        diag.segment<3>(6 * b + 3) += k * lever.cross(d).cwiseAbs2();
         continue;
       }
+      const AnchorSet& a = side == 0 ? el.endA : el.endB;
       for (int i = 0; i < 3; ++i) {
-        const int n = a->nodes(i, e);
-        if (n >= 0) diag.segment<3>(nodeOffset(model, n)) += (k * a->weights(i, e) * a->weights(i, e)) * d2;
+        const int n = a.nodes(i, e);
+        if (n >= 0) diag.segment<3>(nodeOffset(model, n)) += (k * a.weights(i, e) * a.weights(i, e)) * d2;
       }
     }
+  }
+  const Joints& j = model.joints;
+  for (int i = 0; i < j.size(); ++i) {
+    const double kj = dt * dt * j.stiffness(i) + dt * j.friction(i) * o.jointFrictionScale;
+    diag.segment<3>(6 * j.parent[at(i)] + 3).array() += kj;
+    diag.segment<3>(6 * j.child[at(i)] + 3).array() += kj;
   }
   for (Eigen::Index i = 0; i < diag.size(); ++i) diag(i) = diag(i) > 0.0 ? 1.0 / diag(i) : 0.0;
 }
@@ -319,25 +342,26 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   }
   applyStiffnessDamping(model, o, w, p, dt * dt, 0.0, q);
   rhs = dt * rhs - q;
-  maskFixed(model, rhs);
+  maskFixed(w, rhs);
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
-  buildPreconditioner(model, w, dt, w.cgDiag);
-  maskFixed(model, x);
+  buildPreconditioner(model, o, w, dt, w.cgDiag);
+  maskFixed(w, x);
   applyStiffnessDamping(model, o, w, x, dt * dt, dt, q);
   applyMass(model, w, x, z);
   r = rhs - q - z;
-  maskFixed(model, r);
+  maskFixed(w, r);
   z = w.cgDiag.cwiseProduct(r);
   p = z;
   double rz = r.dot(z);
-  const double stop = o.cgTolerance * o.cgTolerance * std::max(rhs.dot(w.cgDiag.cwiseProduct(rhs)), 1e-300);
+  // stop on a relative residual, or when the residual's energy norm r^T P r is below 1e-12 J
+  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(w.cgDiag.cwiseProduct(rhs)), 1e-24);
   int it = 0;
   for (; it < o.cgMaxIterations && rz > stop; ++it) {
     applyStiffnessDamping(model, o, w, p, dt * dt, dt, q);
     applyMass(model, w, p, z);
     q += z;
-    maskFixed(model, q);
+    maskFixed(w, q);
     const double alpha = rz / p.dot(q);
     x += alpha * p;
     r -= alpha * q;
@@ -544,6 +568,24 @@ StepWork makeStepWork(const Model& model) {
     w.jointLocalParent.col(i) = model.joints.anchor.col(i) - model.bodies.com.col(model.joints.parent[at(i)]);
     w.jointLocalChild.col(i) = model.joints.anchor.col(i) - model.bodies.com.col(model.joints.child[at(i)]);
   }
+  w.endpointBody.resize(2, ne);
+  w.endpointNode.resize(2, ne);
+  for (int e = 0; e < ne; ++e) {
+    for (int side = 0; side < 2; ++side) {
+      const AnchorSet& a = side == 0 ? model.elements.endA : model.elements.endB;
+      w.endpointBody(side, e) = a.body[at(e)];
+      const bool single = a.body[at(e)] < 0 && a.nodes(1, e) < 0 && a.nodes(2, e) < 0 && a.weights(0, e) == 1.0;
+      w.endpointNode(side, e) = single ? a.nodes(0, e) : -1;
+    }
+  }
+  std::vector<int> fixed;
+  for (int b = 0; b < nb; ++b)
+    if (model.bodies.isFixed[at(b)])
+      for (int k = 0; k < 6; ++k) fixed.push_back(6 * b + k);
+  for (int i = 0; i < nn; ++i)
+    if (model.nodes.isFixed(i))
+      for (int k = 0; k < 3; ++k) fixed.push_back(6 * nb + 3 * i + k);
+  w.fixedDofs = Eigen::Map<const Eigen::VectorXi>(fixed.data(), static_cast<Eigen::Index>(fixed.size()));
   w.jointMassInverse.assign(at(nj), Matrix3d::Zero());
   w.rotation.assign(at(nb), Matrix3d::Identity());
   w.inverseInertiaWorld = w.inverseInertiaBody;
