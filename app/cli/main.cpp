@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   pneuma::app::addSimulateCommand(app);
   pneuma::app::addScenarioCommand(app);
   pneuma::app::addValidateCommand(app);
+  pneuma::app::addBenchCommand(app);
   app.footer("Run 'pneuma-cli SUBCOMMAND --help' for the options of a subcommand. Docs: docs/cli.md");
 
   try {

@@ -1,0 +1,31 @@
+// pneuma-cli bench: a real-time factor per breath style, and step time growing with the element count.
+#include "CliRunner.h"
+#include "ToyModelDir.h"
+
+#include <nlohmann/json.hpp>
+
+using pneuma::test::freshOutDir;
+using pneuma::test::runCli;
+using pneuma::test::slurp;
+using pneuma::test::toyModelDir;
+
+TEST(CliBench, ReportsEveryStyleAndIncreasingElementCounts) {
+  const std::string out = freshOutDir("bench");
+  auto r = runCli({"bench", "--model", toyModelDir(), "--seconds", "0.3", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(out + "/bench.json"));
+  std::vector<std::string> styles;
+  for (const auto& s : j.at("styles")) {
+    styles.push_back(s["style"]);
+    EXPECT_GT(s["real_time_factor"].get<double>(), 0.0);
+    // rtf = dt / step time when stepping dominates: both come from the same timing
+    EXPECT_NEAR(s["real_time_factor"].get<double>() * s["step_time_ms"].get<double>() * 1e-3, j["dt_s"].get<double>(),
+                0.05 * j["dt_s"].get<double>());
+  }
+  for (const char* name : {"calm", "deep", "panting", "forced-exhale"})
+    EXPECT_NE(std::find(styles.begin(), styles.end(), name), styles.end()) << name;
+  const auto& el = j.at("elements");
+  ASSERT_EQ(el.size(), 4u);
+  for (std::size_t i = 1; i < el.size(); ++i) EXPECT_GT(el[i]["elements"].get<int>(), el[i - 1]["elements"].get<int>());
+  EXPECT_NE(r.out.find("real-time factor"), std::string::npos);
+}
