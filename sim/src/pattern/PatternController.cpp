@@ -16,14 +16,22 @@ constexpr ElementGroup kDrivenGroups[] = {ElementGroup::IntercostalExternal, Ele
                                           ElementGroup::Diaphragm, ElementGroup::Rectus,
                                           ElementGroup::TransversusObliques};
 
-// split a volume-fraction demand between two muscles with gains gA, gB: A takes `shareA` of it, and a
-// muscle saturating at alpha = 1 hands its remainder to the other one
+// split a volume-fraction demand >= 0 between two muscles with useful gains gA, gB >= 0 (0: the muscle
+// cannot help): A takes `shareA` of it, and a muscle saturating at alpha = 1 (or unable to help) hands its
+// remainder to the other one
 std::pair<double, double> splitDemand(double demand, double shareA, double gA, double gB) {
-  double a = demand * shareA / gA, b = demand * (1.0 - shareA) / gB;
-  if (a > 1.0) b += (a - 1.0) * gA / gB, a = 1.0;
-  if (b > 1.0) a += (b - 1.0) * gB / gA, b = 1.0;
+  if (gA <= 0.0) shareA = 0.0;
+  if (gB <= 0.0) shareA = 1.0;
+  double a = gA > 0.0 ? demand * shareA / gA : 0.0, b = gB > 0.0 ? demand * (1.0 - shareA) / gB : 0.0;
+  if (a > 1.0 && gB > 0.0) b += (a - 1.0) * gA / gB, a = 1.0;
+  if (b > 1.0 && gA > 0.0) a += (b - 1.0) * gB / gA, b = 1.0;
   return {std::min(a, 1.0), std::min(b, 1.0)};
 }
+
+// useful gains: how much each group raises (inspiratory) or lowers (expiratory) the volume fraction per
+// unit alpha; a group acting the other way on this model gets 0 and is not used
+double raises(const DriveCalibration& c, ElementGroup g) { return std::max(c.gain[idx(g)], 0.0); }
+double lowers(const DriveCalibration& c, ElementGroup g) { return std::max(-c.gain[idx(g)], 0.0); }
 
 // holds one group at a constant activation during [start, end) of control time, relaxed otherwise
 class StepController : public Controller {
@@ -70,7 +78,7 @@ DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const Simula
     const double rest = meanVolume(sim.trace(), t0, t0 + kWindow);
     const double held = meanVolume(sim.trace(), t0 + kWindow + kHold - kWindow, t0 + kWindow + kHold);
     c.restVolume = rest;
-    c.gain[idx(g)] = std::abs(held - rest) / (c.volumePerFraction * kAlpha);
+    c.gain[idx(g)] = (held - rest) / (c.volumePerFraction * kAlpha);
   }
   return c;
 }
@@ -90,9 +98,14 @@ PatternController::PatternController(LayerStack stack, DriveCalibration calibrat
       m_description(std::move(description)) {
   const DriveCalibration& c = m_calibration;
   for (ElementGroup g : kDrivenGroups)
-    if (!(c.gain[idx(g)] > 0.0) || !std::isfinite(c.gain[idx(g)]))
-      throw Error(std::string("calibration.gain.") + groupName(g) + ": must be > 0, got " +
+    if (!std::isfinite(c.gain[idx(g)]))
+      throw Error(std::string("calibration.gain.") + groupName(g) + ": must be finite, got " +
                   std::to_string(c.gain[idx(g)]));
+  if (raises(c, ElementGroup::IntercostalExternal) + raises(c, ElementGroup::Diaphragm) <= 0.0)
+    throw Error("calibration.gain: neither intercostal_external nor diaphragm raises the lung volume");
+  if (lowers(c, ElementGroup::IntercostalInternal) + lowers(c, ElementGroup::Rectus) +
+          lowers(c, ElementGroup::TransversusObliques) <= 0.0)
+    throw Error("calibration.gain: none of intercostal_internal, rectus, transversus_obliques lowers the lung volume");
   if (!(c.volumePerFraction > 0.0)) throw Error("calibration.volumePerFraction: must be > 0");
   if (!(c.restVolume >= 0.0)) throw Error("calibration.restVolume: must be >= 0");
   if (!(c.contractionR > 0.0 && c.contractionR <= 1.5)) throw Error("calibration.contractionR: must be in (0, 1.5]");
@@ -180,23 +193,24 @@ Activations PatternController::activations(double t, const Metrics& latest) {
 }
 
 Activations PatternController::distribute(double drive, double balance) const {
-  const auto& g = m_calibration.gain;
+  const DriveCalibration& c = m_calibration;
   Activations a = relaxedActivations();
-  for (ElementGroup group : kDrivenGroups) a[idx(group)].r = m_calibration.contractionR;
+  for (ElementGroup group : kDrivenGroups) a[idx(group)].r = c.contractionR;
 
-  if (drive > 0.0) {
+  if (drive >= 0.0) {
     // inspiration: external intercostals (chest, share b) and diaphragm (belly, 1 - b)
-    const auto [chest, belly] =
-        splitDemand(drive, balance, g[idx(ElementGroup::IntercostalExternal)], g[idx(ElementGroup::Diaphragm)]);
+    const auto [chest, belly] = splitDemand(drive, balance, raises(c, ElementGroup::IntercostalExternal),
+                                            raises(c, ElementGroup::Diaphragm));
     a[idx(ElementGroup::IntercostalExternal)].alpha = chest;
     a[idx(ElementGroup::Diaphragm)].alpha = belly;
   } else {
     // expiration below rest: internal intercostals (chest) and the abdominal wall (belly), forced
-    const double wall = g[idx(ElementGroup::Rectus)] + g[idx(ElementGroup::TransversusObliques)];
-    const auto [chest, belly] = splitDemand(-drive, balance, g[idx(ElementGroup::IntercostalInternal)], wall);
+    const double rectus = lowers(c, ElementGroup::Rectus), obliques = lowers(c, ElementGroup::TransversusObliques);
+    const auto [chest, belly] =
+        splitDemand(-drive, balance, lowers(c, ElementGroup::IntercostalInternal), rectus + obliques);
     a[idx(ElementGroup::IntercostalInternal)].alpha = chest;
-    a[idx(ElementGroup::Rectus)].alpha = belly;
-    a[idx(ElementGroup::TransversusObliques)].alpha = belly;
+    a[idx(ElementGroup::Rectus)].alpha = rectus > 0.0 ? belly : 0.0;
+    a[idx(ElementGroup::TransversusObliques)].alpha = obliques > 0.0 ? belly : 0.0;
   }
   return a;
 }

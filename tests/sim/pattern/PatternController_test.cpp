@@ -20,9 +20,9 @@ DriveCalibration plantCalibration() {
   c.restVolume = 2.4e-3;  // [m^3]
   c.gain[idx(ElementGroup::IntercostalExternal)] = 0.3;
   c.gain[idx(ElementGroup::Diaphragm)] = 0.6;
-  c.gain[idx(ElementGroup::IntercostalInternal)] = 0.1;
-  c.gain[idx(ElementGroup::Rectus)] = 0.05;
-  c.gain[idx(ElementGroup::TransversusObliques)] = 0.05;
+  c.gain[idx(ElementGroup::IntercostalInternal)] = -0.1;
+  c.gain[idx(ElementGroup::Rectus)] = -0.05;
+  c.gain[idx(ElementGroup::TransversusObliques)] = -0.05;
   return c;
 }
 
@@ -35,10 +35,7 @@ struct Plant {
 
   double staticVolume(const Activations& a, const DriveCalibration& c) const {
     double f = 0.0;
-    for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::Diaphragm})
-      f += c.gain[idx(g)] * a[idx(g)].alpha;
-    for (ElementGroup g : {ElementGroup::IntercostalInternal, ElementGroup::Rectus, ElementGroup::TransversusObliques})
-      f -= c.gain[idx(g)] * a[idx(g)].alpha;
+    for (int g = 0; g < kElementGroupCount; ++g) f += c.gain[static_cast<std::size_t>(g)] * a[static_cast<std::size_t>(g)].alpha;
     return c.restVolume + gainError * f * c.volumePerFraction;
   }
   // runs `seconds` of control (after a 1 s settle) and returns the controller's tracking
@@ -116,14 +113,28 @@ TEST(PatternController, ExpiratoryMusclesWorkOnlyBelowRest) {
   EXPECT_GT(maxRectus, 0.3);
 }
 
-TEST(PatternController, RejectsAnUncalibratedGroup) {
+TEST(PatternController, AGroupActingTheWrongWayIsLeftOutAndItsPartnerTakesOver) {
+  // on this model the external intercostals lower the volume: the diaphragm does all the inspiration
   DriveCalibration c = plantCalibration();
-  c.gain[idx(ElementGroup::Rectus)] = 0.0;
+  c.gain[idx(ElementGroup::IntercostalExternal)] = -0.2;
+  auto ctl = makeAffectController("panic", kResources, 1, c);
+  Plant plant;
+  plant.run(*ctl, 20.0, c);
+  EXPECT_EQ(plant.last[idx(ElementGroup::IntercostalExternal)].alpha, 0.0);
+  EXPECT_LT(ctl->tracking().rmsPercentOfPeakToPeak(), 10.0);
+}
+
+TEST(PatternController, RejectsACalibrationThatCannotInhale) {
+  DriveCalibration c = plantCalibration();
+  c.gain[idx(ElementGroup::IntercostalExternal)] = 0.0;
+  c.gain[idx(ElementGroup::Diaphragm)] = -0.1;
   try {
     makeAffectController("neutral", kResources, 1, c);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("calibration.gain.rectus"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("calibration.gain: neither intercostal_external nor diaphragm"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -15,9 +15,9 @@
 /// u > 0 is inspiratory drive, split by the thoraco-abdominal balance b between the external intercostals
 /// (share b) and the diaphragm (share 1 - b); u < 0 is expiratory drive, split between the internal
 /// intercostals (b) and rectus + transversus/obliques (1 - b), which therefore work in forced expirations
-/// only. Each group's activation is alpha_g = share * |u| / g_g, where g_g [-] is the group's calibrated
-/// static gain (volume fraction per unit alpha, see calibrateDrive()); a group that saturates at alpha = 1
-/// hands the rest of its share to its partner. Unlike Zordan's binary alpha with a varying r, alpha is
+/// only. Each group's activation is alpha_g = share * |u| / |g_g|, where g_g [-] is the group's calibrated
+/// static gain (volume fraction per unit alpha, see calibrateDrive()); a group that saturates at alpha = 1,
+/// or that moves the volume the wrong way on this model, hands its share to its partner. Unlike Zordan's binary alpha with a varying r, alpha is
 /// graded and r fixed (contractionR): force then grows with the command and an idle antagonist adds
 /// no stiffness, which a feedback loop needs.
 
@@ -38,8 +38,9 @@ struct DriveCalibration {
   double restVolume = 0.0;        ///< [m^3] V_rest; 0 = take the settled volume when control starts
   double volumePerFraction = 2.5e-3;  ///< [m^3] S, lung volume per unit volume fraction
   double restFraction = 0.05;     ///< [-] v_rest, the fraction the relaxed torso represents
-  /// [-] |volume-fraction change| per unit alpha of each group alone (at r = contractionR), indexed by
-  /// ElementGroup; inspiratory groups raise the volume, expiratory ones lower it. Cartilage is unused.
+  /// [-] volume-fraction change per unit alpha of each group alone (at r = contractionR), indexed by
+  /// ElementGroup, positive when the group raises the volume. Inspiratory groups (external intercostals,
+  /// diaphragm) should be positive, expiratory ones negative; a group acting the other way is not used.
   std::array<double, kElementGroupCount> gain{};
   double contractionR = 0.6;      ///< [-] r of every driven group (Eq. 2)
 };
@@ -74,7 +75,7 @@ class PatternController : public Controller {
  public:
   /// @param stack        the pattern to play (e.g. makeLayerStack(loadAffect("panic", dir), seed))
   /// @param calibration  from calibrateDrive() on the same model
-  /// @throws Error when a gain is not positive for a driven group or an option is out of range.
+  /// @throws Error when no group can raise (or lower) the volume, or an option is out of range.
   PatternController(LayerStack stack, DriveCalibration calibration, PatternControllerOptions options = {},
                     std::string description = "pattern");
 
