@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <filesystem>
 #include <iostream>
@@ -108,6 +109,9 @@ void runSimulate(const SimulateArgs& args) {
   std::unique_ptr<sim::Simulation> simulation;
   try {
     model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
+    sim::checkController(scenario, resourceDir());
+    if (scenario.controller != sim::ControllerKind::Style)
+      std::fprintf(stderr, "calibrating the pattern controller's muscle drive on the model...\n");
     controller = sim::makeController(scenario, model, resourceDir());
     simulation = std::make_unique<sim::Simulation>(model, std::move(controller), scenario.options);
   } catch (const sim::Error& e) {

@@ -3,6 +3,11 @@
 #include "ToyModelDir.h"
 
 #include <nlohmann/json.hpp>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataReader.h>
 
 #include <Eigen/Core>
 
@@ -142,8 +147,77 @@ TEST(CliSimulate, VtkSeriesListsFourPartsPerFrame) {
   for (std::size_t p = 0; (p = pvd.find("<DataSet", p)) != std::string::npos; ++p) ++n;
   EXPECT_EQ(n % 4, 0u);
   EXPECT_GE(n, 4u * 5u);
-  EXPECT_TRUE(fs::exists(out + "/frames/muscles_000000.vtp"));
-  EXPECT_NE(slurp(out + "/frames/muscles_000000.vtp").find("force_N"), std::string::npos);
+  // the muscles part reads back as polydata: one line per element with its force, tension = max(0, -force)
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName((out + "/frames/muscles_000003.vtp").c_str());
+  reader->Update();
+  vtkPolyData* muscles = reader->GetOutput();
+  const auto toy = pneuma::sim::test::makeToyTorso();
+  ASSERT_EQ(muscles->GetNumberOfLines(), toy.elements.size());
+  vtkDataArray* force = muscles->GetCellData()->GetArray("force_N");
+  vtkDataArray* tension = muscles->GetCellData()->GetArray("tension_N");
+  ASSERT_NE(force, nullptr);
+  ASSERT_NE(tension, nullptr);
+  int taut = 0;
+  for (vtkIdType c = 0; c < force->GetNumberOfTuples(); ++c) {
+    EXPECT_DOUBLE_EQ(tension->GetTuple1(c), std::max(0.0, -force->GetTuple1(c)));
+    taut += force->GetTuple1(c) < 0.0;
+  }
+  EXPECT_GT(taut, 0);
+  // the gut part has the model's triangles
+  reader->SetFileName((out + "/frames/gut_000003.vtp").c_str());
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfPolys(), toy.gut.triangles.cols());
+}
+
+TEST(CliSimulate, AffectAddsTargetAndMeasuredVolumeFraction) {
+  const std::string out = freshOutDir("affect");
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "neutral", "--duration", "4", "--settle", "1",
+                   "--output-rate", "20", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  EXPECT_EQ(s["controller_kind"], "affect");
+  ASSERT_TRUE(s["tracking_rms_pct"].is_number());
+  EXPECT_GE(s["tracking_rms_pct"].get<double>(), 0.0);
+  std::ifstream csv(out + "/timeseries.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find("target_volume_fraction [-],measured_volume_fraction [-]"), std::string::npos);
+  // the neutral pattern breathes between 5 and 25 % of the volume range
+  double lo = 1.0, hi = 0.0;
+  for (std::string line; std::getline(csv, line);) {
+    const auto cells = splitCsvLine(line);
+    if (std::stod(cells[0]) < 2.0) continue;
+    lo = std::min(lo, std::stod(cells[cells.size() - 2]));
+    hi = std::max(hi, std::stod(cells[cells.size() - 2]));
+  }
+  EXPECT_NEAR(lo, 0.05, 0.03);
+  EXPECT_NEAR(hi, 0.25, 0.05);
+  expectPng(out + "/volume_fraction.png");
+}
+
+TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
+  const std::string out = freshOutDir("scenario");
+  fs::create_directories(out);
+  const std::string file = out + "/run.json";
+  std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "name": "deep-short", "model": ")" << toyModelDir()
+                      << R"(", "duration_s": 30, "controller": {"style": "deep"},
+      "overrides": {"settle_time_s": 0.5}, "outputs": {"output_rate_hz": 10, "plots": false}})";
+  auto r = runCli({"simulate", "--scenario", file, "--duration", "2", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  EXPECT_EQ(s["scenario"], "deep-short");
+  EXPECT_EQ(s["duration_s"].get<double>(), 2.0);  // the command line wins
+  EXPECT_NEAR(s["simulated_time_s"].get<double>(), 2.5, 1e-6);
+  EXPECT_EQ(s["frames"].get<int>(), 25);
+  EXPECT_FALSE(fs::exists(out + "/lung_volume.png"));  // plots off in the scenario
+
+  // a bad scenario names the file and the JSON path, exit 2
+  std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "duration_s": 3, "controller": {"style": "deep"},
+      "overrides": {"dt_s": -1}})";
+  r = runCli({"simulate", "--scenario", file, "--out", out});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("run.json: overrides.dt_s: must be > 0"), std::string::npos) << r.err;
 }
 
 TEST(CliSimulate, SigintWritesValidPartialSummary) {
