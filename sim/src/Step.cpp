@@ -324,6 +324,63 @@ void buildPreconditioner(const Model& model, const StepOptions& o, const StepWor
   for (Eigen::Index i = 0; i < diag.size(); ++i) diag(i) = diag(i) > 0.0 ? 1.0 / diag(i) : 0.0;
 }
 
+// the dense body block of M + dt D + dt^2 K (6 #B square), factored: the preconditioner of the stiff,
+// light ribcage; fixed bodies get identity rows
+void factorBodyBlock(const Model& model, const StepOptions& o, StepWork& w, double dt) {
+  const int nb = model.bodies.size();
+  Eigen::MatrixXd& a = w.bodyBlock;
+  a.setZero();
+  for (int b = 0; b < nb; ++b) {
+    const Matrix3d& r = w.rotation[at(b)];
+    a.block<3, 3>(6 * b, 6 * b) = model.bodies.mass(b) * Matrix3d::Identity();
+    a.block<3, 3>(6 * b + 3, 6 * b + 3) = r * model.bodies.inertia[at(b)] * r.transpose();
+  }
+  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints and sign -1 across the two ends
+  const Elements& el = model.elements;
+  Eigen::Matrix<double, 3, 6> ja, jb;
+  for (int e = 0; e < el.size(); ++e) {
+    const int ba = w.endpointBody(0, e), bb = w.endpointBody(1, e);
+    if (ba < 0 && bb < 0) continue;
+    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
+    if (ka == 0.0 && kg == 0.0) continue;
+    const Vector3d d = w.elementDirection.col(e);
+    const Matrix3d ke = ka * d * d.transpose() + kg * (Matrix3d::Identity() - d * d.transpose());
+    ja << Matrix3d::Identity(), -skew(w.leverA.col(e));
+    jb << Matrix3d::Identity(), -skew(w.leverB.col(e));
+    if (ba >= 0) a.block<6, 6>(6 * ba, 6 * ba) += ja.transpose() * ke * ja;
+    if (bb >= 0) a.block<6, 6>(6 * bb, 6 * bb) += jb.transpose() * ke * jb;
+    if (ba >= 0 && bb >= 0) {
+      const Eigen::Matrix<double, 6, 6> c = ja.transpose() * ke * jb;
+      a.block<6, 6>(6 * ba, 6 * bb) -= c;
+      a.block<6, 6>(6 * bb, 6 * ba) -= c.transpose();
+    }
+  }
+  // joint springs and friction on relative angular velocity
+  const Joints& j = model.joints;
+  for (int i = 0; i < j.size(); ++i) {
+    const double kj = dt * dt * j.stiffness(i) + dt * j.friction(i) * o.jointFrictionScale;
+    const int p = j.parent[at(i)], c = j.child[at(i)];
+    a.block<3, 3>(6 * c + 3, 6 * c + 3).diagonal().array() += kj;
+    a.block<3, 3>(6 * p + 3, 6 * p + 3).diagonal().array() += kj;
+    a.block<3, 3>(6 * c + 3, 6 * p + 3).diagonal().array() -= kj;
+    a.block<3, 3>(6 * p + 3, 6 * c + 3).diagonal().array() -= kj;
+  }
+  for (int b = 0; b < nb; ++b) {
+    if (!model.bodies.isFixed[at(b)]) continue;
+    a.middleRows(6 * b, 6).setZero();
+    a.middleCols(6 * b, 6).setZero();
+    a.block<6, 6>(6 * b, 6 * b).setIdentity();
+  }
+  w.bodyFactor.compute(a);
+}
+
+// z = P^-1 r: the factored body block for bodies, Jacobi for nodes
+void applyPreconditioner(const StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+  const Eigen::Index nb6 = w.bodyBlock.rows();
+  z = w.cgDiag.cwiseProduct(r);
+  if (nb6 > 0) z.head(nb6) = w.bodyFactor.solve(r.head(nb6));
+}
+
 // linearly implicit Euler (Baraff & Witkin 1998): (M + dt D + dt^2 K) dv = dt (f - dt K v), by PCG
 void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepOptions& o, StepWork& w) {
   const int nb = model.bodies.size(), nn = model.nodes.size();
@@ -346,16 +403,18 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
   buildPreconditioner(model, o, w, dt, w.cgDiag);
+  if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, w, dt);
   maskFixed(w, x);
   applyStiffnessDamping(model, o, w, x, dt * dt, dt, q);
   applyMass(model, w, x, z);
   r = rhs - q - z;
   maskFixed(w, r);
-  z = w.cgDiag.cwiseProduct(r);
+  applyPreconditioner(w, r, z);
   p = z;
   double rz = r.dot(z);
   // stop on a relative residual, or when the residual's energy norm r^T P r is below 1e-12 J
-  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(w.cgDiag.cwiseProduct(rhs)), 1e-24);
+  applyPreconditioner(w, rhs, q);
+  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(q), 1e-24);
   int it = 0;
   for (; it < o.cgMaxIterations && rz > stop; ++it) {
     applyStiffnessDamping(model, o, w, p, dt * dt, dt, q);
@@ -365,7 +424,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
     const double alpha = rz / p.dot(q);
     x += alpha * p;
     r -= alpha * q;
-    z = w.cgDiag.cwiseProduct(r);
+    applyPreconditioner(w, r, z);
     const double rzNew = r.dot(z);
     p = z + (rzNew / rz) * p;
     rz = rzNew;
@@ -522,7 +581,7 @@ bool integratorFromName(const std::string& name, IntegratorKind& out) {
   return false;
 }
 
-double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : 2e-3; }
+double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : 1e-2; }
 
 void validateStepOptions(const StepOptions& o) {
   auto fail = [](const std::string& field, double v, const char* rule) {
@@ -543,6 +602,7 @@ void validateStepOptions(const StepOptions& o) {
   if (o.jointIterations < 1) fail("jointIterations", o.jointIterations, "must be >= 1");
   if (!(o.jointTolerance > 0.0)) fail("jointTolerance", o.jointTolerance, "must be > 0");
   if (o.cgMaxIterations < 1) fail("cgMaxIterations", o.cgMaxIterations, "must be >= 1");
+  if (o.preconditionerRefresh < 1) fail("preconditionerRefresh", o.preconditionerRefresh, "must be >= 1");
   if (!(o.cgTolerance > 0.0)) fail("cgTolerance", o.cgTolerance, "must be > 0");
 }
 
@@ -594,6 +654,7 @@ StepWork makeStepWork(const Model& model) {
   w.nodeForce = Eigen::Matrix3Xd::Zero(3, nn);
   w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
+  w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
   for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgDiag, &w.cgB}) *v = Eigen::VectorXd::Zero(n);
   return w;
 }

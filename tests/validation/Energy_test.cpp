@@ -38,7 +38,8 @@ TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
     step(m, s, dt, relaxed, o, w);
     computeMetrics(m, s, relaxed, o, w, met);
     const double e = met.kineticEnergy + met.elasticEnergy;
-    ASSERT_LE(e, previous * (1.0 + 1e-9)) << "energy increased at t = " << s.time;
+    // allowance: the implicit step solves its linear system to a relative tolerance of 1e-4 (CG)
+    ASSERT_LE(e, previous + 1e-5 * e0) << "energy increased at t = " << s.time;
     previous = e;
   }
   EXPECT_LT(met.kineticEnergy, 1e-2 * e0) << "not at rest after 6 s";

@@ -27,6 +27,7 @@
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/State.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include <array>
@@ -56,6 +57,7 @@ struct StepOptions {
   int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
   int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
+  int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the body-block preconditioner every n steps
   double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (M^-1 norm)
 };
 
@@ -76,6 +78,9 @@ struct StepWork {
   Eigen::VectorXd elementStiffness;    ///< [N/m] |dF/dl| of taut elements, 0 when slack (#E)
   Eigen::VectorXd elementGeometric;    ///< [N/m] transverse stiffness |F| / l of elements in tension (#E)
   Eigen::VectorXd elementDamping;      ///< [N s/m] b of taut elements, 0 when slack (#E)
+  Eigen::Matrix2Xi endpointBody;       ///< body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
+  Eigen::Matrix2Xi endpointNode;       ///< the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
+  Eigen::VectorXi fixedDofs;           ///< indices of fixed-body and fixed-node entries of the implicit solver vectors
   std::vector<Eigen::Matrix3d> inverseInertiaBody;  ///< [1/(kg m^2)] I^-1 in the body frame, zero for fixed bodies (#B)
   Eigen::Matrix3Xd jointLocalParent;   ///< [m] joint anchor in the parent's body frame (3 x #J)
   Eigen::Matrix3Xd jointLocalChild;    ///< [m] joint anchor in the child's body frame (3 x #J)
@@ -87,6 +92,9 @@ struct StepWork {
   Eigen::Matrix3Xd gutGradient;        ///< [m^2] dV/dx per node (3 x #N)
   double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
   int cgIterations = 0;                ///< [-] CG iterations of the last implicit step
+  Eigen::MatrixXd bodyBlock;           ///< body block of the implicit system, dense (6 #B x 6 #B)
+  Eigen::LDLT<Eigen::MatrixXd> bodyFactor;  ///< its factorization, the CG preconditioner for body entries
+  long long stepsSinceFactor = 0;      ///< [-] counts implicit steps to refresh bodyFactor
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps dv
                                                           ///< of the last step as the next warm start
 };
