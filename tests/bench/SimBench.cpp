@@ -1,0 +1,83 @@
+// Speed of the simulation core (Google Benchmark): the real-time factor per breath style on the
+// default model (simulated seconds per wall-clock second, one thread), and the cost of one step as the
+// gut mesh is refined 4x per level (synthetic toy torso, 162 -> 642 -> 2562 gut nodes).
+#include "ToyTorso.h"
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Simulation.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+
+namespace pneuma::sim {
+namespace {
+
+std::shared_ptr<const Model> defaultModel() {
+  static std::shared_ptr<const Model> model = [] {
+    const char* env = std::getenv("PNEUMA_DEFAULT_MODEL_DIR");
+    const std::string dir = env != nullptr ? env : PNEUMA_DEFAULT_MODEL_DIR;
+    return std::filesystem::exists(dir + "/model.json") ? std::make_shared<const Model>(loadModel(dir)) : nullptr;
+  }();
+  return model;
+}
+
+// real-time factor of a breath style on the default model, after a 1 s settle
+void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator) {
+  const auto model = defaultModel();
+  if (!model) {
+    state.SkipWithError("default model missing: build it with 'pneuma-cli model build'");
+    return;
+  }
+  SimulationOptions o;
+  o.step.integrator = integrator;
+  o.settleTime = 1.0;
+  Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle(style)), o);
+  sim.advance(1.0);
+  constexpr double kChunk = 0.25;  // [s] simulated per iteration
+  for (auto _ : state) sim.advance(kChunk);
+  state.counters["rtf"] = benchmark::Counter(kChunk * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["dt_ms"] = sim.dt() * 1e3;
+}
+
+// wall time of one step() with the gut refined to `subdivisions`
+void stepTime(benchmark::State& state) {
+  const Model model = test::makeToyTorso(static_cast<int>(state.range(0)));
+  const BreathStyle calm = loadBreathStyle("calm");
+  BreathStyleController controller(calm);
+  StepOptions o;
+  State s = makeInitialState(model);
+  StepWork w = makeStepWork(model);
+  const double dt = defaultTimeStep(o.integrator);
+  double cgIterations = 0.0;
+  for (auto _ : state) {
+    step(model, s, dt, controller.activations(s.time, Metrics{}), o, w);
+    cgIterations += w.cgIterations;
+    benchmark::DoNotOptimize(s.nodePosition.data());
+  }
+  state.counters["cg_iterations"] = cgIterations / static_cast<double>(state.iterations());
+  state.counters["nodes"] = model.nodes.size();
+  state.counters["elements"] = model.elements.size();
+  state.counters["gut_faces"] = static_cast<double>(model.gut.triangles.cols());
+}
+
+const bool kRegistered = [] {
+  for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) {
+    benchmark::RegisterBenchmark((std::string("RealTimeFactor/implicit-euler/") + style).c_str(),
+                                 [style](benchmark::State& st) { realTimeFactor(st, style, IntegratorKind::ImplicitEuler); })
+        ->Unit(benchmark::kMillisecond);
+  }
+  benchmark::RegisterBenchmark("RealTimeFactor/symplectic-euler/calm",
+                               [](benchmark::State& st) { realTimeFactor(st, "calm", IntegratorKind::SymplecticEuler); })
+      ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("StepTime/gut_subdivisions", stepTime)->DenseRange(2, 4)->Unit(benchmark::kMicrosecond);
+  return true;
+}();
+
+}  // namespace
+}  // namespace pneuma::sim
+
+BENCHMARK_MAIN();
