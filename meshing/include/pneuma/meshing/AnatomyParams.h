@@ -1,0 +1,135 @@
+#pragma once
+/// @file AnatomyParams.h
+/// The measurements a torso is built from (resources/anatomy/*.json, sources in resources/anatomy/README.md),
+/// and the gains of its spring elements (resources/anatomy/muscle_gains.json, the single source of gains).
+///
+/// Files store millimetres and degrees; AnatomyParams holds SI units (metres, radians) after loading.
+/// World frame (RAS): +x right, +y anterior, +z superior; z = 0 at the L5/S1 disc, y = 0 at the
+/// vertebral body centres of the lumbar spine.
+
+#include "pneuma/sim/Model.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace pneuma::meshing {
+
+/// One rib level (Kindig & Kent 2013; Holcombe et al. 2016). The centreline lies in a plane through the
+/// costovertebral joint. In that plane it is a "half-egg" curve: from the head it runs posterolaterally
+/// round the rib angle (posterior semi-axis), laterally (lateral semi-axis) and anteriorly (anterior
+/// semi-axis) to the costochondral junction at `endAngle`. The lateral semi-axis is solved so that the
+/// centreline has `arcLength`. The plane is then pitched down anteriorly by `inclination` (the
+/// complement of the rib-spine angle) and tilted down laterally by `lateralTilt` (bucket handle).
+struct RibLevel {
+  double arcLength = 0.0;       ///< [m] centreline length, head to costochondral junction
+  double posteriorRatio = 0.0;  ///< [-] posterior semi-axis / lateral semi-axis
+  double anteriorRatio = 0.0;   ///< [-] anterior semi-axis / lateral semi-axis
+  double endAngle = 0.0;        ///< [rad] curve parameter of the costochondral junction (3 pi / 2 = most anterior)
+  double inclination = 0.0;     ///< [rad] anterior descent of the rib plane below horizontal
+  double lateralTilt = 0.0;     ///< [rad] lateral descent of the rib plane below horizontal
+  double height = 0.0;          ///< [m] cross-section height (superior-inferior)
+  double thickness = 0.0;       ///< [m] cross-section thickness (inner-outer)
+};
+
+/// Vertebral column: bodies stacked upward from z = 0 (L5 bottom).
+struct SpineParams {
+  std::vector<double> lumbarHeights;       ///< [m] vertebral body heights L5..L1 (5)
+  std::vector<double> thoracicHeights;     ///< [m] vertebral body heights T12..T1 (12)
+  double lumbarDisc = 0.0;                 ///< [m] lumbar disc height
+  double thoracicDisc = 0.0;               ///< [m] thoracic disc height
+  std::array<double, 2> lumbarBody{};      ///< [m] lumbar body width and depth
+  std::array<double, 2> thoracicBodyTop{}; ///< [m] T1 body width and depth
+  std::array<double, 2> thoracicBodyBottom{};  ///< [m] T12 body width and depth
+  double kyphosis = 0.0;                   ///< [m] posterior bulge of the thoracic curve at its middle
+  double spinousLength = 0.0;              ///< [m] posterior reach of a spinous process behind its body
+  std::vector<std::array<int, 2>> thoracicSegments;  ///< first and last vertebra (1..12) of each articulated segment
+};
+
+/// Sternum (Selthofer et al. 2006): a plate running down and forward from the jugular notch.
+struct SternumParams {
+  double manubriumLength = 0.0;  ///< [m]
+  double bodyLength = 0.0;       ///< [m]
+  double xiphoidLength = 0.0;    ///< [m]
+  double manubriumWidth = 0.0;   ///< [m]
+  double bodyWidth = 0.0;        ///< [m]
+  double thickness = 0.0;        ///< [m]
+  double notchLevel = 0.0;       ///< [-] thoracic vertebra (1..12, fractional) level with the jugular notch
+  double notchDepth = 0.0;       ///< [m] anterior distance from the T1-T12 body centres to the notch
+  double inclination = 0.0;      ///< [rad] angle of the sternum to the vertical (lower end forward)
+};
+
+/// Pelvis: fixed, drawn as two iliac wings and the sacrum.
+struct PelvisParams {
+  double width = 0.0;   ///< [m] bi-iliac (crest) breadth
+  double depth = 0.0;   ///< [m] anterior reach of the anterior superior iliac spines from the spine
+  double height = 0.0;  ///< [m] iliac wing height
+};
+
+/// Abdominal cavity (the gut body of Section 6) and the diaphragm dome on top of it.
+struct AbdomenParams {
+  double floorLevel = 0.0;       ///< [m] z of the pelvic floor (below L5/S1, negative)
+  double width = 0.0;            ///< [m] inner transverse diameter of the cavity at the umbilicus
+  double anteriorDepth = 0.0;    ///< [m] reach of the anterior wall in front of the lumbar body centre
+  double posteriorDepth = 0.0;   ///< [m] reach of the posterior wall (beside the spine) behind it
+  double domeHeight = 0.0;       ///< [m] rise of the diaphragm apex above the costal margin's mean level
+  double tendonFraction = 0.0;   ///< [-] radius fraction of the dome covered by the central tendon
+  double umbilicusLevel = 0.0;   ///< [m] z of the umbilicus
+};
+
+/// Sampling resolution of the generated meshes and networks.
+struct Resolution {
+  double boneEdge = 0.0;        ///< [m] isotropic remeshing target edge length of the bones
+  int wallRings = 0;            ///< rings of gut nodes from the pelvic floor to the costal margin
+  int ringNodes = 0;            ///< nodes per wall ring
+  int domeRings = 0;            ///< rings of the diaphragm dome between the central tendon and the rim
+  int domeRimNodes = 0;         ///< nodes on the rim of the dome (costal margin)
+  int intercostalSamples = 0;   ///< elements per rib pair, side and intercostal layer
+};
+
+/// Muscle and spring gains of one group. Each element gets k = gain * referenceLength / restLength
+/// (springs in series: a chain of elements behaves like one muscle of stiffness `gain` over referenceLength).
+struct GroupGains {
+  double kac = 0.0;      ///< [N/m] active gain at the reference length
+  double kpe = 0.0;      ///< [N/m] passive gain at the reference length
+  double damping = 0.0;  ///< [N s/m] at the reference length
+};
+
+/// Everything of resources/anatomy/muscle_gains.json.
+struct Gains {
+  double referenceLength = 0.0;  ///< [m] element length at which the group gains apply unscaled
+  std::array<GroupGains, sim::kElementGroupCount> group{};  ///< indexed by sim::ElementGroup
+  double gutKappa = 0.0;              ///< [Pa] bulk modulus of Eq. 4
+  double costovertebralFriction = 0.0;  ///< [N m s/rad] mu of Eq. 3
+  double costovertebralStiffness = 0.0; ///< [N m/rad]
+  double spineFriction = 0.0;           ///< [N m s/rad]
+  double spineStiffness = 0.0;          ///< [N m/rad]
+  double wallMass = 0.0;                ///< [kg] total mass of the moving gut nodes (8 kg, Section 6.1)
+};
+
+/// A whole anatomy preset.
+struct AnatomyParams {
+  std::string name;             ///< preset name, e.g. "adult_male"
+  std::string source;           ///< file it was read from
+  double boneDensity = 0.0;     ///< [kg/m^3] uniform bone density for mass properties
+  bool areFloatingRibsMoving = false;  ///< ribs 11-12: moving bodies (true) or fixed (false)
+  std::vector<RibLevel> ribs;   ///< rib levels 1..12 (index 0 = rib 1)
+  SpineParams spine;
+  SternumParams sternum;
+  PelvisParams pelvis;
+  AbdomenParams abdomen;
+  Resolution resolution;
+  Gains gains;
+};
+
+/// Reads and validates an anatomy preset and the gains file it names ("gains", relative to the preset).
+/// @throws sim::Error naming the file and field, e.g. "male.json: ribs[3].arc_length_mm: must be > 0, got -5".
+AnatomyParams loadAnatomy(const std::string& path);
+
+/// Parses an anatomy preset from JSON text; `gainsText` is the text of its gains file. The names are
+/// used in error messages only. @throws sim::Error as loadAnatomy().
+AnatomyParams parseAnatomy(const std::string& anatomyText, const std::string& gainsText,
+                           const std::string& sourceName = "anatomy.json",
+                           const std::string& gainsName = "muscle_gains.json");
+
+}  // namespace pneuma::meshing

@@ -1,0 +1,43 @@
+#pragma once
+/// @file ModelBuilder.h
+/// Builds the simulation model of a torso (Zordan et al. 2004, Sections 4-6) from an anatomy preset,
+/// and writes it as a model directory (model.json plus body render meshes).
+
+#include "pneuma/meshing/AnatomyParams.h"
+#include "pneuma/meshing/ModelSummary.h"
+#include "pneuma/meshing/TriangleMesh.h"
+#include "pneuma/sim/Model.h"
+
+#include <string>
+#include <vector>
+
+namespace pneuma::meshing {
+
+/// Numbers measured while building (beyond the model's own summary).
+struct BuildReport {
+  ModelSummary summary;            ///< counts, volumes and masses of the built model
+  int tetrahedra = 0;              ///< TetGen tetrahedra of the gut volume
+  double tetVolume = 0.0;          ///< [m^3] TetGen volume of the gut
+  double gutQualityMin = 0.0;      ///< [-] smallest pressure-surface triangle quality (1 = equilateral)
+  double gutQualityMean = 0.0;     ///< [-] mean pressure-surface triangle quality
+  int boneTriangles = 0;           ///< triangles of all remeshed bones
+};
+
+/// A built model with its render meshes.
+struct BuiltModel {
+  sim::Model model;
+  std::vector<TriangleMesh> bodyMeshes;  ///< per body, body frame [m] (written as meshes/<body>.vtp)
+  BuildReport report;
+};
+
+/// Builds bones (closed, checked and remeshed with CGAL; mass properties at the preset's bone density),
+/// joints, the gut (its volume checked against TetGen to 0.1 %), the elements, the lung cavity and the
+/// landmarks, then validates the model. Deterministic. @throws sim::Error naming the failing part.
+BuiltModel buildModel(const AnatomyParams& anatomy);
+
+/// Writes `built` to `dir` (model.json and meshes/*.vtp) through a temporary sibling directory that is
+/// renamed into place, so `dir` is either left untouched or holds the whole model.
+/// @throws sim::Error when the directory cannot be written.
+void writeModelDirectory(const BuiltModel& built, const std::string& dir);
+
+}  // namespace pneuma::meshing

@@ -1,0 +1,39 @@
+#pragma once
+/// @file ModelSummary.h
+/// The headline numbers of a model, as `pneuma-cli model build` and `model info` print them.
+
+#include "pneuma/sim/Model.h"
+
+#include <array>
+#include <string>
+
+namespace pneuma::meshing {
+
+/// Counts, volumes and masses of a model at rest.
+struct ModelSummary {
+  int bodies = 0;
+  int movingBodies = 0;
+  int joints = 0;
+  int nodes = 0;
+  int fixedNodes = 0;
+  std::array<int, sim::kElementGroupCount> elements{};  ///< per sim::ElementGroup
+  double gutVolume = 0.0;     ///< [m^3] enclosed by the gut surface at rest
+  double cavityVolume = 0.0;  ///< [m^3] enclosed by the lung-cavity surface at rest
+  double gutWallMass = 0.0;   ///< [kg] mass of the moving gut nodes
+  double boneMass = 0.0;      ///< [kg] mass of all bodies
+};
+
+/// World rest positions of the points of `set` (3 x #P) [m]: body points at com + local (body axes are
+/// world-parallel at rest), node points as the weighted sum of their nodes' rest positions.
+Eigen::Matrix3Xd restPoints(const sim::AnchorSet& set, const sim::Model& model);
+
+/// Summarises `model` at its rest pose.
+ModelSummary summarizeModel(const sim::Model& model);
+
+/// The summary as a JSON object with the keys of `model info --json` (volumes in mL, masses in kg).
+std::string summaryJson(const ModelSummary& s);
+
+/// The summary as human-readable lines.
+std::string summaryText(const ModelSummary& s);
+
+}  // namespace pneuma::meshing

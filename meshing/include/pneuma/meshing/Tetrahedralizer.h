@@ -1,0 +1,24 @@
+#pragma once
+/// @file Tetrahedralizer.h
+/// The TetGen side of meshing (all TetGen code lives in Tetrahedralizer.cpp).
+
+#include "pneuma/meshing/TriangleMesh.h"
+
+#include <string>
+
+namespace pneuma::meshing {
+
+/// A tetrahedral mesh of the volume a closed surface bounds.
+struct TetMesh {
+  Eigen::Matrix3Xd vertices;   ///< [m] (3 x #V): the surface vertices first, then interior Steiner points
+  Eigen::Matrix4Xi tets;       ///< vertex indices (4 x #T)
+  double volume = 0.0;         ///< [m^3] sum of the tetrahedra volumes
+  int boundaryTriangles = 0;   ///< triangles on the boundary (equals the input's: the surface is kept)
+};
+
+/// Quality tetrahedralisation of the volume bounded by a closed outward `surface` with TetGen
+/// (switches "pq1.5YQ": piecewise-linear complex, radius-edge ratio <= 1.5, boundary kept unsplit).
+/// @throws sim::Error naming `part` when TetGen rejects the surface.
+TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part);
+
+}  // namespace pneuma::meshing

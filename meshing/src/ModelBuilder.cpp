@@ -1,0 +1,158 @@
+#include "pneuma/meshing/ModelBuilder.h"
+
+#include "Anchors.h"
+#include "GutSurface.h"
+#include "LungCavity.h"
+#include "MuscleNetwork.h"
+#include "Skeleton.h"
+
+#include "pneuma/meshing/MeshTools.h"
+#include "pneuma/meshing/Tetrahedralizer.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace pneuma::meshing {
+
+namespace {
+
+constexpr double kTetVolumeTolerance = 1e-3;  // [-] TetGen vs divergence-theorem gut volume
+
+/// Remeshes every bone (a left rib is the mirror image of its remeshed right rib) and fills the bodies.
+void buildBodies(const AnatomyParams& a, const Skeleton& sk, BuiltModel& out) {
+  std::map<int, int> mirrorOf;  // left rib -> right rib
+  for (const auto& pair : sk.rib) mirrorOf[pair[kLeft]] = pair[kRight];
+
+  const int n = static_cast<int>(sk.bones.size());
+  std::vector<TriangleMesh> world(static_cast<std::size_t>(n));
+  sim::Bodies& b = out.model.bodies;
+  b.mass.resize(n);
+  b.com.resize(3, n);
+  for (int i = 0; i < n; ++i) {
+    const Bone& bone = sk.bones[static_cast<std::size_t>(i)];
+    auto m = mirrorOf.find(i);
+    world[static_cast<std::size_t>(i)] = m != mirrorOf.end() ? world[static_cast<std::size_t>(m->second)].mirroredX()
+                                                              : remeshIsotropic(bone.mesh, a.resolution.boneEdge, bone.name);
+    const MassProperties mp = massProperties(world[static_cast<std::size_t>(i)], a.boneDensity);
+    b.name.push_back(bone.name);
+    b.isFixed.push_back(bone.isFixed ? 1 : 0);
+    b.mass(i) = mp.mass;
+    b.com.col(i) = mp.com;
+    b.inertia.push_back(mp.inertia);
+    b.mesh.push_back("meshes/" + bone.name + ".vtp");
+    out.bodyMeshes.push_back(world[static_cast<std::size_t>(i)].translated(-mp.com));
+    out.report.boneTriangles += world[static_cast<std::size_t>(i)].triangleCount();
+  }
+}
+
+void buildJoints(const AnatomyParams& a, const Skeleton& sk, sim::Joints& j) {
+  const int n = static_cast<int>(sk.joints.size());
+  j.anchor.resize(3, n);
+  j.friction.resize(n);
+  j.stiffness.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const JointSpec& s = sk.joints[static_cast<std::size_t>(i)];
+    j.name.push_back(s.name);
+    j.parent.push_back(s.parent);
+    j.child.push_back(s.child);
+    j.anchor.col(i) = s.anchor;
+    j.friction(i) = s.isSpine ? a.gains.spineFriction : a.gains.costovertebralFriction;
+    j.stiffness(i) = s.isSpine ? a.gains.spineStiffness : a.gains.costovertebralStiffness;
+  }
+}
+
+/// Gut nodes with equal point masses; the moving ones add up to the wall mass (Section 6.1).
+void buildGutNodes(const AnatomyParams& a, const GutSurface& g, BuiltModel& out) {
+  sim::Model& m = out.model;
+  m.nodes.rest = g.rest;
+  m.nodes.region = g.region;
+  int moving = 0;
+  for (sim::NodeRegion r : g.region) moving += r != sim::NodeRegion::Fixed ? 1 : 0;
+  m.nodes.mass = Eigen::VectorXd::Constant(g.rest.cols(), a.gains.wallMass / moving);
+  m.gut.triangles = g.triangles;
+  m.gut.kappa = a.gains.gutKappa;
+
+  // tetrahedralise the enclosed volume and check it against the surface volume
+  TriangleMesh surface{g.rest, g.triangles};
+  const MeshCheck check = checkMesh(surface);
+  if (!check.isValid()) {
+    throw sim::Error(std::string("gut: surface is not sealed: manifold ") + (check.isManifold ? "yes" : "no") +
+                     ", closed " + (check.isClosed ? "yes" : "no") + ", self-intersecting " +
+                     (check.isSelfIntersecting ? "yes" : "no") + ", outward " + (check.isOutward ? "yes" : "no"));
+  }
+  const TetMesh tets = tetrahedralize(surface, "gut");
+  const double v = enclosedVolume(g.rest, g.triangles);
+  if (std::abs(tets.volume - v) > kTetVolumeTolerance * v) {
+    std::ostringstream s;
+    s << "gut: TetGen volume " << tets.volume * 1e6 << " mL differs from the surface volume " << v * 1e6 << " mL";
+    throw sim::Error(s.str());
+  }
+  out.report.tetrahedra = static_cast<int>(tets.tets.cols());
+  out.report.tetVolume = tets.volume;
+
+  // pressure-surface triangle quality
+  double qMin = 1.0, qSum = 0.0;
+  for (int f = 0; f < g.triangles.cols(); ++f) {
+    const double q = triangleQuality(g.rest.col(g.triangles(0, f)), g.rest.col(g.triangles(1, f)),
+                                     g.rest.col(g.triangles(2, f)));
+    qMin = std::min(qMin, q);
+    qSum += q;
+  }
+  out.report.gutQualityMin = qMin;
+  out.report.gutQualityMean = qSum / static_cast<double>(g.triangles.cols());
+}
+
+void buildLandmarks(const AnatomyParams& a, const Skeleton& sk, const GutSurface& g, sim::Model& m) {
+  auto add = [&](const std::string& name, const Endpoint& e) {
+    m.landmarks.name.push_back(name);
+    addEndpoint(m.landmarks.points, e, m.bodies);
+  };
+  add("xiphoid", Endpoint::onBody(sk.sternum, sk.xiphoidTip));
+  // umbilicus: the anterior midline wall node nearest the preset's umbilicus height
+  int navel = g.wallRing.front().front();
+  for (const auto& ring : g.wallRing) {
+    const int n = ring.front();
+    if (std::abs(g.rest(2, n) - a.abdomen.umbilicusLevel) < std::abs(g.rest(2, navel) - a.abdomen.umbilicusLevel)) navel = n;
+  }
+  add("umbilicus", Endpoint::atNode(navel, g.rest));
+  add("diaphragm_apex", Endpoint::atNode(g.apex, g.rest));
+  // rib 8 lateral: its centreline point farthest from the midline
+  for (int side : {kRight, kLeft}) {
+    const RibCurve& r = sk.ribCurve[7][static_cast<std::size_t>(side)];
+    std::size_t best = 0;
+    for (std::size_t i = 0; i < r.centre.size(); ++i) {
+      if (std::abs(r.centre[i].x()) > std::abs(r.centre[best].x())) best = i;
+    }
+    add(side == kRight ? "rib8_lateral_right" : "rib8_lateral_left",
+        Endpoint::onBody(sk.rib[7][static_cast<std::size_t>(side)], r.centre[best]));
+  }
+}
+
+}  // namespace
+
+BuiltModel buildModel(const AnatomyParams& a) {
+  BuiltModel out;
+  out.model.name = a.name;
+  out.model.anatomy = a.source.substr(a.source.find_last_of('/') + 1);
+
+  // bones and joints
+  const Skeleton sk = buildSkeleton(a);
+  buildBodies(a, sk, out);
+  buildJoints(a, sk, out.model.joints);
+
+  // gut, elements, cavity and landmarks
+  const GutSurface gut = buildGut(a, sk);
+  buildGutNodes(a, gut, out);
+  buildElements(a, sk, gut, out.model);
+  buildCavity(sk, gut, out.model);
+  buildLandmarks(a, sk, gut, out.model);
+
+  sim::validateModel(out.model);
+  out.report.summary = summarizeModel(out.model);
+  return out;
+}
+
+}  // namespace pneuma::meshing

@@ -1,0 +1,95 @@
+#include "pneuma/meshing/ModelSummary.h"
+
+#include "pneuma/meshing/TriangleMesh.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <sstream>
+
+namespace pneuma::meshing {
+
+namespace {
+
+constexpr double kMlPerM3 = 1e6;
+
+}  // namespace
+
+Eigen::Matrix3Xd restPoints(const sim::AnchorSet& set, const sim::Model& m) {
+  Eigen::Matrix3Xd p(3, set.size());
+  for (int i = 0; i < set.size(); ++i) {
+    const int b = set.body[static_cast<std::size_t>(i)];
+    if (b >= 0) {
+      p.col(i) = m.bodies.com.col(b) + set.local.col(i);
+    } else {
+      p.col(i).setZero();
+      for (int k = 0; k < 3; ++k) {
+        if (set.nodes(k, i) >= 0) p.col(i) += set.weights(k, i) * m.nodes.rest.col(set.nodes(k, i));
+      }
+    }
+  }
+  return p;
+}
+
+ModelSummary summarizeModel(const sim::Model& m) {
+  ModelSummary s;
+  s.bodies = m.bodies.size();
+  for (int b = 0; b < s.bodies; ++b) {
+    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) ++s.movingBodies;
+    s.boneMass += m.bodies.mass(b);
+  }
+  s.joints = m.joints.size();
+  s.nodes = m.nodes.size();
+  for (int i = 0; i < s.nodes; ++i) {
+    if (m.nodes.isFixed(i)) {
+      ++s.fixedNodes;
+    } else {
+      s.gutWallMass += m.nodes.mass(i);
+    }
+  }
+  for (sim::ElementGroup g : m.elements.group) ++s.elements[static_cast<std::size_t>(g)];
+  s.gutVolume = enclosedVolume(m.nodes.rest, m.gut.triangles);
+  s.cavityVolume = enclosedVolume(restPoints(m.cavity.vertices, m), m.cavity.triangles);
+  return s;
+}
+
+std::string summaryJson(const ModelSummary& s) {
+  nlohmann::ordered_json j;
+  j["bodies"] = s.bodies;
+  j["moving_bodies"] = s.movingBodies;
+  j["joints"] = s.joints;
+  j["nodes"] = s.nodes;
+  j["fixed_nodes"] = s.fixedNodes;
+  nlohmann::ordered_json e = nlohmann::ordered_json::object();
+  for (int g = 0; g < sim::kElementGroupCount; ++g) {
+    e[sim::groupName(static_cast<sim::ElementGroup>(g))] = s.elements[static_cast<std::size_t>(g)];
+  }
+  j["elements"] = e;
+  j["gut_volume_ml"] = std::round(s.gutVolume * kMlPerM3 * 10.0) / 10.0;
+  j["cavity_volume_ml"] = std::round(s.cavityVolume * kMlPerM3 * 10.0) / 10.0;
+  j["gut_wall_mass_kg"] = std::round(s.gutWallMass * 1e4) / 1e4;
+  j["bone_mass_kg"] = std::round(s.boneMass * 1e4) / 1e4;
+  return j.dump(2);
+}
+
+std::string summaryText(const ModelSummary& s) {
+  std::ostringstream o;
+  o << "bodies:          " << s.bodies << " (" << s.movingBodies << " moving)\n"
+    << "joints:          " << s.joints << "\n"
+    << "nodes:           " << s.nodes << " (" << s.fixedNodes << " fixed)\n"
+    << "elements:\n";
+  for (int g = 0; g < sim::kElementGroupCount; ++g) {
+    o << "  " << sim::groupName(static_cast<sim::ElementGroup>(g)) << ": " << s.elements[static_cast<std::size_t>(g)]
+      << "\n";
+  }
+  o.setf(std::ios::fixed);
+  o.precision(1);
+  o << "gut volume:      " << s.gutVolume * kMlPerM3 << " mL\n"
+    << "cavity volume:   " << s.cavityVolume * kMlPerM3 << " mL\n";
+  o.precision(3);
+  o << "gut wall mass:   " << s.gutWallMass << " kg\n"
+    << "bone mass:       " << s.boneMass << " kg\n";
+  return o.str();
+}
+
+}  // namespace pneuma::meshing

@@ -1,0 +1,238 @@
+#include "MuscleNetwork.h"
+
+#include "Anchors.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace pneuma::meshing {
+
+namespace {
+
+using sim::ElementGroup;
+
+constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib that makes intercostals oblique
+constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
+constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
+
+/// Appends elements to a model, converting endpoints and scaling the group gains by rest length.
+class ElementSink {
+ public:
+  ElementSink(const Gains& gains, sim::Model& model) : m_gains(gains), m_model(model) {}
+
+  void add(ElementGroup group, const Endpoint& a, const Endpoint& b) {
+    const double l0 = (a.world - b.world).norm();
+    if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
+    sim::Elements& e = m_model.elements;
+    e.group.push_back(group);
+    addEndpoint(e.endA, a, m_model.bodies);
+    addEndpoint(e.endB, b, m_model.bodies);
+    const GroupGains& g = m_gains.group[static_cast<std::size_t>(group)];
+    const double scale = m_gains.referenceLength / l0;
+    const Eigen::Index n = static_cast<Eigen::Index>(e.group.size());
+    for (Eigen::VectorXd* v : {&e.restLength, &e.kac, &e.kpe, &e.damping}) v->conservativeResize(n);
+    e.restLength(n - 1) = l0;
+    e.kac(n - 1) = g.kac * scale;
+    e.kpe(n - 1) = g.kpe * scale;
+    e.damping(n - 1) = g.damping * scale;
+  }
+
+ private:
+  const Gains& m_gains;
+  sim::Model& m_model;
+};
+
+/// Angle of `p` round the ribcage's vertical axis through (0, axisY), from the posterior midline
+/// toward the sternum on either side [rad].
+double aroundAxis(const Eigen::Vector3d& p, double axisY) { return std::atan2(std::abs(p.x()), axisY - p.y()); }
+
+/// Arc length of the point of `c` at the same angle round the ribcage axis as `p`.
+double sameAngleArc(const RibCurve& c, const Eigen::Vector3d& p, double axisY) {
+  const double target = aroundAxis(p, axisY);
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < c.centre.size(); ++i) {
+    if (std::abs(aroundAxis(c.centre[i], axisY) - target) < std::abs(aroundAxis(c.centre[best], axisY) - target)) best = i;
+  }
+  return c.arc[best];
+}
+
+/// External (down and forward) and internal (down and backward) intercostals between each rib pair.
+void addIntercostals(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
+  const int n = a.resolution.intercostalSamples;
+  // the ribcage axis: mean depth of all rib centrelines
+  double axisY = 0.0;
+  int count = 0;
+  for (const auto& pair : sk.ribCurve) {
+    for (const RibCurve& c : pair) {
+      for (const Eigen::Vector3d& p : c.centre) axisY += p.y();
+      count += static_cast<int>(c.centre.size());
+    }
+  }
+  axisY /= count;
+  for (int side : {kRight, kLeft}) {
+    for (int level = 1; level < 12; ++level) {
+      const RibCurve& up = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      const RibCurve& low = sk.ribCurve[static_cast<std::size_t>(level)][static_cast<std::size_t>(side)];
+      const int bUp = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      const int bLow = sk.rib[static_cast<std::size_t>(level)][static_cast<std::size_t>(side)];
+      // external layer: tubercle to costochondral junction, outside; internal: rib angle to the front, inside
+      for (const auto& [group, from, to, shift, inward] :
+           {std::tuple{ElementGroup::IntercostalExternal, 0.08, 0.92, kObliqueShift, -1.0},
+            std::tuple{ElementGroup::IntercostalInternal, 0.25, 0.99, -kObliqueShift, 1.0}}) {
+        for (int k = 0; k < n; ++k) {
+          const double s = up.length() * (from + (to - from) * (k + 0.5) / n);
+          const Eigen::Vector3d top = up.at(s, 0.5 * inward * up.thickness, -0.5 * up.height);
+          // the lower rib's point straight below, shifted forward (external) or backward (internal) along it
+          const double sLow = sameAngleArc(low, top, axisY);
+          if ((low.at(sLow) - top).norm() > kMaxIntercostalGap) continue;
+          sink.add(group, Endpoint::onBody(bUp, top),
+                   Endpoint::onBody(bLow, low.at(sLow + shift, 0.5 * inward * low.thickness, 0.5 * low.height)));
+        }
+      }
+    }
+  }
+}
+
+/// Candidate costal-margin attachments of the diaphragm: lower ribs 7-12, the xiphoid and the crura.
+std::vector<Endpoint> costalMargin(const Skeleton& sk) {
+  std::vector<Endpoint> c;
+  for (int level = 7; level <= 12; ++level) {
+    for (int side : {kRight, kLeft}) {
+      const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      const int b = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      for (double s = 0.3 * r.length(); s <= r.length(); s += kCostalSample) {
+        c.push_back(Endpoint::onBody(b, r.at(s, 0.5 * r.thickness, -0.3 * r.height)));
+      }
+    }
+  }
+  c.push_back(Endpoint::onBody(sk.sternum, sk.xiphoidTip));
+  for (const Eigen::Vector3d& p : sk.lumbarFront) c.push_back(Endpoint::onBody(sk.lumbar, p));
+  return c;
+}
+
+/// Radial diaphragm strands: from the apex through the central tendon and out to the costal margin.
+void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
+  // between consecutive dome rings: each outer node to the inner node nearest in angle
+  for (std::size_t r = 0; r < gut.domeRing.size(); ++r) {
+    const std::vector<int>& outer = gut.domeRing[r];
+    const bool isLast = r + 1 == gut.domeRing.size();
+    const std::size_t nIn = isLast ? 1 : gut.domeRing[r + 1].size();
+    for (std::size_t j = 0; j < outer.size(); ++j) {
+      const std::size_t jIn = static_cast<std::size_t>(std::lround(static_cast<double>(j) * nIn / outer.size())) % nIn;
+      const int inner = isLast ? gut.apex : gut.domeRing[r + 1][jIn];
+      sink.add(ElementGroup::Diaphragm, Endpoint::atNode(outer[j], gut.rest), Endpoint::atNode(inner, gut.rest));
+    }
+  }
+  // rim to the nearest point of the costal margin, xiphoid or crura
+  const std::vector<Endpoint> margin = costalMargin(sk);
+  for (int node : gut.domeRing.front()) {
+    const Eigen::Vector3d p = gut.rest.col(node);
+    const Endpoint* best = &margin.front();
+    for (const Endpoint& e : margin) {
+      if ((e.world - p).squaredNorm() < (best->world - p).squaredNorm()) best = &e;
+    }
+    sink.add(ElementGroup::Diaphragm, Endpoint::atNode(node, gut.rest), *best);
+  }
+}
+
+/// Rectus: vertical strands on the anterior wall from the pubis (floor ring) to the xiphoid and ribs 5-7.
+void addRectus(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
+  const int m = static_cast<int>(gut.wallRing.front().size());
+  for (int c = -3; c <= 3; ++c) {
+    const std::size_t j = static_cast<std::size_t>((c + m) % m);
+    for (std::size_t k = 0; k + 1 < gut.wallRing.size(); ++k) {
+      sink.add(ElementGroup::Rectus, Endpoint::atNode(gut.wallRing[k][j], gut.rest),
+               Endpoint::atNode(gut.wallRing[k + 1][j], gut.rest));
+    }
+    // top insertion: the xiphoid on the midline, costal cartilages 7, 6, 5 going outward
+    Endpoint top = Endpoint::onBody(sk.sternum, sk.xiphoidTip);
+    if (c != 0) {
+      const std::size_t level = static_cast<std::size_t>(7 - std::abs(c) + 1);
+      const std::size_t side = c > 0 ? kRight : kLeft;
+      const RibCurve& r = sk.ribCurve[level - 1][side];
+      top = Endpoint::onBody(sk.rib[level - 1][side], r.at(r.length()));
+    }
+    sink.add(ElementGroup::Rectus, Endpoint::atNode(gut.wallRing.back()[j], gut.rest), top);
+  }
+}
+
+/// Transversus (hoops round each wall ring) and obliques (diagonals between rings, alternating external
+/// oblique "down and forward" and internal oblique "up and forward"); only where the wall moves.
+void addTransversusObliques(const GutSurface& gut, ElementSink& sink) {
+  const int m = static_cast<int>(gut.wallRing.front().size());
+  auto moving = [&](int node) { return gut.region[static_cast<std::size_t>(node)] != sim::NodeRegion::Fixed; };
+  auto node = [&](std::size_t k, int j) { return gut.wallRing[k][static_cast<std::size_t>((j + m) % m)]; };
+  for (std::size_t k = 1; k < gut.wallRing.size(); ++k) {
+    for (int j = 0; j < m; ++j) {
+      if (moving(node(k, j)) || moving(node(k, j + 1))) {
+        sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(node(k, j), gut.rest),
+                 Endpoint::atNode(node(k, j + 1), gut.rest));
+      }
+    }
+  }
+  for (std::size_t k = 0; k + 1 < gut.wallRing.size(); ++k) {
+    const bool isExternal = k % 2 == 0;
+    for (int j = 0; j < m; ++j) {
+      const int q[4] = {node(k, j), node(k, j + 1), node(k + 1, j), node(k + 1, j + 1)};
+      if (!(moving(q[0]) || moving(q[1]) || moving(q[2]) || moving(q[3]))) continue;
+      // j grows from the anterior midline round the right side: "forward" is -j on the right, +j on the left
+      const bool isRight = std::sin(2.0 * M_PI * (j + 0.5) / m) > 0.0;
+      const bool lowerIsAtJ = isRight == isExternal;
+      const int upper = lowerIsAtJ ? q[3] : q[2];
+      const int lower = lowerIsAtJ ? q[0] : q[1];
+      sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(upper, gut.rest), Endpoint::atNode(lower, gut.rest));
+    }
+  }
+}
+
+/// Three attachment points around `p`: above and below along `up`, and one `back` from it.
+std::array<Eigen::Vector3d, 3> triad(const Eigen::Vector3d& p, const Eigen::Vector3d& up, const Eigen::Vector3d& back) {
+  return {p + 0.007 * up, p - 0.007 * up, p + 0.008 * back};
+}
+
+/// Costal cartilage: a 3 x 3 bipartite spring truss (structurally stable) from each rib tip to the
+/// sternum (ribs 1-7) or to the tip of the rib above (ribs 8-10).
+void addCartilage(const Skeleton& sk, ElementSink& sink) {
+  for (int level = 1; level <= 10; ++level) {
+    for (int side : {kRight, kLeft}) {
+      const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      const int b = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      const double s = r.length();
+      const auto ribPts = triad(r.at(s), r.normal.back(), -r.tangent(s));
+      int other = sk.sternum;
+      std::array<Eigen::Vector3d, 3> otherPts;
+      if (level <= 7) {
+        const Eigen::Vector3d notch = sk.costalNotch[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+        otherPts = triad(notch, -sk.sternumAxis, sk.sternumAxis.cross(Eigen::Vector3d::UnitX()).normalized());
+      } else {
+        const RibCurve& above = sk.ribCurve[static_cast<std::size_t>(level - 2)][static_cast<std::size_t>(side)];
+        other = sk.rib[static_cast<std::size_t>(level - 2)][static_cast<std::size_t>(side)];
+        const double sa = above.length() - 0.01;
+        otherPts = triad(above.at(sa), above.normal.back(), -above.tangent(sa));
+      }
+      for (const Eigen::Vector3d& p : ribPts) {
+        for (const Eigen::Vector3d& q : otherPts) {
+          sink.add(ElementGroup::Cartilage, Endpoint::onBody(b, p), Endpoint::onBody(other, q));
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface& gut, sim::Model& model) {
+  ElementSink sink(a.gains, model);
+  addIntercostals(a, sk, sink);
+  addDiaphragm(sk, gut, sink);
+  addRectus(sk, gut, sink);
+  addTransversusObliques(gut, sink);
+  addCartilage(sk, sink);
+}
+
+}  // namespace pneuma::meshing

@@ -1,0 +1,307 @@
+#include "Skeleton.h"
+
+#include "pneuma/meshing/Sweep.h"
+#include "pneuma/sim/Error.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace pneuma::meshing {
+
+namespace {
+
+constexpr int kAround = 10;       // cross-section points of bone sweeps (remeshing refines them)
+constexpr int kRibStations = 48;  // centreline samples per rib
+
+/// One vertebral body of the stacked column.
+struct Vertebra {
+  double zBottom = 0.0;  // [m]
+  double zTop = 0.0;     // [m]
+  double width = 0.0;    // [m]
+  double depth = 0.0;    // [m]
+  double y = 0.0;        // [m] centre
+};
+
+/// Vertebrae L5..L1 then T12..T1, stacked from z = 0; thoracic ones follow the kyphosis.
+std::vector<Vertebra> stackVertebrae(const SpineParams& s) {
+  std::vector<Vertebra> v;
+  double z = 0.0;
+  for (double h : s.lumbarHeights) {
+    v.push_back({z, z + h, s.lumbarBody[0], s.lumbarBody[1], 0.0});
+    z += h + s.lumbarDisc;
+  }
+  for (int i = 0; i < 12; ++i) {
+    const double f = i / 11.0;  // 0 at T12, 1 at T1
+    const double h = s.thoracicHeights[static_cast<std::size_t>(i)];
+    v.push_back({z, z + h, (1 - f) * s.thoracicBodyBottom[0] + f * s.thoracicBodyTop[0],
+                 (1 - f) * s.thoracicBodyBottom[1] + f * s.thoracicBodyTop[1], 0.0});
+    z += h + s.thoracicDisc;
+  }
+  // thoracic kyphosis: a half sine bulging backward between T12 and T1
+  const double z0 = v[5].zBottom;
+  const double z1 = v.back().zTop;
+  for (std::size_t i = 5; i < v.size(); ++i) {
+    const double zc = 0.5 * (v[i].zBottom + v[i].zTop);
+    v[i].y = -s.kyphosis * std::sin(M_PI * (zc - z0) / (z1 - z0));
+  }
+  return v;
+}
+
+/// The vertebral body as an elliptic cylinder and its spinous process as a separate small tube.
+TriangleMesh vertebraMesh(const Vertebra& v, double spinousLength) {
+  const double zc = 0.5 * (v.zBottom + v.zTop);
+  const double h = v.zTop - v.zBottom;
+  std::vector<SweepStation> body;
+  for (double z : {v.zBottom, zc, v.zTop}) {
+    body.push_back({Eigen::Vector3d(0, v.y, z), Eigen::Vector3d::UnitX(), 0.5 * v.width, 0.5 * v.depth});
+  }
+  TriangleMesh m = sweepTube(body, kAround, false);
+  // spinous process: backward and 30 degrees down, starting behind the vertebral arch gap
+  const Eigen::Vector3d start(0, v.y - 0.5 * v.depth - 0.012, zc);
+  const Eigen::Vector3d dir(0, -std::cos(M_PI / 6), -std::sin(M_PI / 6));
+  std::vector<SweepStation> spine;
+  for (double f : {0.0, 0.5, 1.0}) {
+    spine.push_back({start + f * spinousLength * dir, Eigen::Vector3d::UnitZ(), 0.3 * h, 0.004});
+  }
+  m.append(sweepTube(spine, kAround, false));
+  return m;
+}
+
+/// Centreline of a right rib in its plane (u lateral, v anterior): the "half-egg" curve of RibLevel.
+Eigen::Vector2d ribPlanar(const RibLevel& r, double lateral, double theta) {
+  const double b = (std::sin(theta) > 0 ? r.posteriorRatio : r.anteriorRatio) * lateral;
+  return {lateral * (1.0 - std::cos(theta)), -b * std::sin(theta)};
+}
+
+/// Builds the right rib `r` with its head at `head`; the centreline has the preset's arc length.
+RibCurve ribCurve(const RibLevel& r, const Eigen::Vector3d& head) {
+  // arc length of the unit-size curve, then the lateral semi-axis that gives the preset length
+  constexpr int kFine = 2000;
+  double unitLength = 0.0;
+  for (int i = 0; i < kFine; ++i) {
+    unitLength += (ribPlanar(r, 1.0, r.endAngle * (i + 1) / kFine) - ribPlanar(r, 1.0, r.endAngle * i / kFine)).norm();
+  }
+  const double lateral = r.arcLength / unitLength;
+
+  // rib plane: pitched down anteriorly, then tilted down laterally
+  const Eigen::Matrix3d rot = (Eigen::AngleAxisd(r.lateralTilt, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(-r.inclination, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
+  const Eigen::Vector3d normal = rot.col(2);
+
+  RibCurve c;
+  c.height = r.height;
+  c.thickness = r.thickness;
+  for (int i = 0; i < kRibStations; ++i) {
+    const double theta = r.endAngle * i / (kRibStations - 1);
+    const Eigen::Vector2d p = ribPlanar(r, lateral, theta);
+    c.centre.push_back(head + rot * Eigen::Vector3d(p.x(), p.y(), 0.0));
+    c.normal.push_back(normal);
+  }
+  c.arc.push_back(0.0);
+  for (int i = 1; i < kRibStations; ++i) {
+    c.arc.push_back(c.arc.back() + (c.centre[static_cast<std::size_t>(i)] - c.centre[static_cast<std::size_t>(i - 1)]).norm());
+  }
+  // the curve turns counter-clockwise about the plane normal: inward = normal x tangent
+  for (int i = 0; i < kRibStations; ++i) c.inward.push_back(normal.cross(c.tangent(c.arc[static_cast<std::size_t>(i)])).normalized());
+  return c;
+}
+
+RibCurve mirrored(const RibCurve& c) {
+  RibCurve m = c;
+  for (auto* pts : {&m.centre, &m.inward, &m.normal}) {
+    for (Eigen::Vector3d& p : *pts) p.x() = -p.x();
+  }
+  return m;
+}
+
+TriangleMesh ribMesh(const RibCurve& c) {
+  std::vector<SweepStation> st;
+  for (std::size_t i = 0; i < c.centre.size(); ++i) {
+    // the neck near the head is slimmer
+    const double taper = std::min(1.0, 0.6 + 0.4 * c.arc[i] / (0.12 * c.length()));
+    st.push_back({c.centre[i], c.normal[i], 0.5 * c.height * taper, 0.5 * c.thickness});
+  }
+  return sweepTube(st, kAround, false);
+}
+
+/// Smallest distance between two rib centrelines [m].
+double centrelineDistance(const RibCurve& a, const RibCurve& b) {
+  double d = 1e9;
+  for (const auto& p : a.centre) {
+    for (const auto& q : b.centre) d = std::min(d, (p - q).norm());
+  }
+  return d;
+}
+
+}  // namespace
+
+Eigen::Vector3d RibCurve::at(double s, double offsetIn, double offsetUp) const {
+  s = std::clamp(s, 0.0, length());
+  const std::size_t i = static_cast<std::size_t>(
+      std::clamp<long>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin() - 1, 0, static_cast<long>(arc.size()) - 2));
+  const double f = (s - arc[i]) / (arc[i + 1] - arc[i]);
+  const Eigen::Vector3d p = (1 - f) * centre[i] + f * centre[i + 1];
+  const Eigen::Vector3d in = ((1 - f) * inward[i] + f * inward[i + 1]).normalized();
+  return p + offsetIn * in + offsetUp * normal[i];
+}
+
+Eigen::Vector3d RibCurve::tangent(double s) const {
+  const double h = 0.25 * length() / static_cast<double>(centre.size());
+  const double a = std::clamp(s - h, 0.0, length() - 2 * h);
+  const std::size_t i = static_cast<std::size_t>(
+      std::clamp<long>(std::upper_bound(arc.begin(), arc.end(), a) - arc.begin() - 1, 0, static_cast<long>(arc.size()) - 2));
+  return (centre[i + 1] - centre[i]).normalized();
+}
+
+Skeleton buildSkeleton(const AnatomyParams& a) {
+  Skeleton sk;
+  const std::vector<Vertebra> vert = stackVertebrae(a.spine);
+  auto thoracic = [&](int t) -> const Vertebra& { return vert[static_cast<std::size_t>(4 + 13 - t)]; };  // T1..T12
+  auto addBone = [&](const std::string& name, bool isFixed, TriangleMesh mesh) {
+    sk.bones.push_back({name, isFixed, std::move(mesh)});
+    return static_cast<int>(sk.bones.size()) - 1;
+  };
+
+  // fixed lumbar spine L5..L1
+  TriangleMesh lumbar;
+  for (int i = 0; i < 5; ++i) lumbar.append(vertebraMesh(vert[static_cast<std::size_t>(i)], a.spine.spinousLength));
+  sk.lumbar = addBone("lumbar_spine", true, lumbar);
+  for (int i = 4; i >= 2; --i) {
+    const Vertebra& v = vert[static_cast<std::size_t>(i)];
+    sk.lumbarFront.emplace_back(0.0, v.y + 0.5 * v.depth, 0.5 * (v.zBottom + v.zTop));
+  }
+
+  // fixed pelvis: two iliac wings, the sacrum and the pubic arch (separate closed components)
+  {
+    const PelvisParams& p = a.pelvis;
+    const double zc = 0.5 * p.height - 0.03;  // wing centre: crest near L4
+    TriangleMesh pelvis;
+    std::vector<SweepStation> wing;
+    for (int i = 0; i <= 12; ++i) {
+      const double t = M_PI * i / 12.0;  // sacroiliac joint (t = 0) to anterior superior iliac spine (t = pi)
+      const Eigen::Vector3d c(0.055 + (0.5 * p.width - 0.07) * std::sin(t), -0.04 + 0.5 * (p.depth + 0.04) * (1 - std::cos(t)),
+                              zc - 0.02 * std::sin(t));
+      const Eigen::Vector3d up = Eigen::Vector3d(0.35 * std::sin(t), 0, 1).normalized();  // flared outward
+      wing.push_back({c, up, 0.5 * p.height * (0.6 + 0.4 * std::sin(t)), 0.006});
+    }
+    TriangleMesh right = sweepTube(wing, kAround, false);
+    pelvis.append(right);
+    pelvis.append(right.mirroredX());
+    std::vector<SweepStation> sacrum;
+    for (int i = 0; i <= 4; ++i) {
+      const double f = i / 4.0;
+      sacrum.push_back({Eigen::Vector3d(0, -0.015 - 0.05 * f * f, -0.012 - 0.10 * f), Eigen::Vector3d::UnitX(),
+                        0.05 * (1 - 0.7 * f), 0.012});
+    }
+    pelvis.append(sweepTube(sacrum, kAround, false));
+    std::vector<SweepStation> pubis;
+    for (int i = 0; i <= 8; ++i) {
+      const double t = -0.5 * M_PI + M_PI * i / 8.0;  // from the left ramus round the symphysis to the right one
+      pubis.push_back({Eigen::Vector3d(0.09 * std::sin(t), p.depth - 0.03 + 0.03 * std::cos(t), a.abdomen.floorLevel - 0.01 + 0.03 * std::abs(std::sin(t))),
+                       Eigen::Vector3d::UnitZ(), 0.012, 0.008});
+    }
+    pelvis.append(sweepTube(pubis, kAround, false));
+    sk.pelvis = addBone("pelvis", true, pelvis);
+  }
+
+  // articulated thoracic segments; each holds its vertebrae
+  sk.thoracicSegment.assign(12, -1);
+  for (std::size_t s = 0; s < a.spine.thoracicSegments.size(); ++s) {
+    const auto [first, last] = a.spine.thoracicSegments[s];
+    TriangleMesh mesh;
+    for (int t = first; t <= last; ++t) mesh.append(vertebraMesh(thoracic(t), a.spine.spinousLength));
+    const int b = addBone("thoracic_T" + std::to_string(first) + "_T" + std::to_string(last), false, mesh);
+    for (int t = first; t <= last; ++t) sk.thoracicSegment[static_cast<std::size_t>(t - 1)] = b;
+  }
+  for (int t = 1; t <= 12; ++t) {
+    sk.vertebraTop.push_back(thoracic(t).zTop);
+    sk.vertebraCentreY.push_back(thoracic(t).y);
+  }
+  // spine joints at the disc centres, from the lumbar spine upward
+  for (std::size_t s = a.spine.thoracicSegments.size(); s-- > 0;) {
+    const int last = a.spine.thoracicSegments[s][1];
+    const Vertebra& below = last == 12 ? vert[4] : thoracic(last + 1);
+    const Vertebra& above = thoracic(last);
+    const int parent = last == 12 ? sk.lumbar : sk.thoracicSegment[static_cast<std::size_t>(last)];
+    const int child = sk.thoracicSegment[static_cast<std::size_t>(last - 1)];
+    sk.joints.push_back({"spine_" + sk.bones[static_cast<std::size_t>(child)].name, parent, child,
+                         Eigen::Vector3d(0, 0.5 * (below.y + above.y), 0.5 * (below.zTop + above.zBottom)), true});
+  }
+
+  // sternum: manubrium, body and xiphoid swept down and forward from the jugular notch
+  {
+    const SternumParams& s = a.sternum;
+    const int lo = std::clamp(static_cast<int>(std::floor(s.notchLevel)), 1, 11);
+    const double f = s.notchLevel - lo;
+    auto zc = [&](int t) { return 0.5 * (thoracic(t).zBottom + thoracic(t).zTop); };
+    const Eigen::Vector3d notch(0, (1 - f) * thoracic(lo).y + f * thoracic(lo + 1).y + s.notchDepth,
+                                (1 - f) * zc(lo) + f * zc(lo + 1));
+    sk.sternumAxis = Eigen::Vector3d(0, std::sin(s.inclination), -std::cos(s.inclination));
+    const double total = s.manubriumLength + s.bodyLength + s.xiphoidLength;
+    auto widthAt = [&](double d) {
+      if (d < s.manubriumLength) return s.manubriumWidth + (s.bodyWidth - s.manubriumWidth) * d / s.manubriumLength;
+      if (d < s.manubriumLength + s.bodyLength) return s.bodyWidth;
+      return s.bodyWidth * (0.55 - 0.35 * (d - s.manubriumLength - s.bodyLength) / s.xiphoidLength);
+    };
+    std::vector<SweepStation> st;
+    constexpr int kStations = 24;
+    for (int i = 0; i <= kStations; ++i) {
+      const double d = total * i / kStations;
+      const double thick = d > s.manubriumLength + s.bodyLength ? 0.5 * s.thickness : s.thickness;
+      st.push_back({notch + d * sk.sternumAxis, Eigen::Vector3d::UnitX(), 0.5 * widthAt(d), 0.5 * thick});
+      const Eigen::Vector3d back = sk.sternumAxis.cross(Eigen::Vector3d::UnitX()).normalized();  // posterior
+      sk.sternumInner.push_back(notch + d * sk.sternumAxis + (0.5 * thick + 0.004) * back);
+    }
+    sk.sternum = addBone("sternum", false, sweepTube(st, kAround, false));
+    sk.xiphoidTip = notch + total * sk.sternumAxis;
+    // costal notches: rib 1 on the manubrium, rib 2 at the sternal angle, 3-6 along the body, 7 at the xiphisternal joint
+    for (int r = 1; r <= 7; ++r) {
+      const double d = r == 1 ? 0.35 * s.manubriumLength
+                              : s.manubriumLength + s.bodyLength * (r - 2) / 5.0;
+      const Eigen::Vector3d c = notch + d * sk.sternumAxis;
+      const double half = 0.5 * widthAt(d);
+      sk.costalNotch.push_back({c + Eigen::Vector3d(half, 0, 0), c - Eigen::Vector3d(half, 0, 0)});
+    }
+  }
+
+  // ribs: heads at the top of their thoracic vertebra, right side built, left side mirrored
+  for (int level = 1; level <= 12; ++level) {
+    const Vertebra& v = thoracic(level);
+    const Eigen::Vector3d head(0.5 * v.width + 0.004, v.y - 0.25 * v.depth, v.zTop);
+    const RibCurve right = ribCurve(a.ribs[static_cast<std::size_t>(level - 1)], head);
+    const RibCurve left = mirrored(right);
+    const bool isFixed = level > 10 && !a.areFloatingRibsMoving;
+    const TriangleMesh mesh = ribMesh(right);
+    const std::string n = "rib" + std::to_string(level);
+    const int br = addBone(n + "_right", isFixed, mesh);
+    const int bl = addBone(n + "_left", isFixed, mesh.mirroredX());
+    sk.rib.push_back({br, bl});
+    sk.ribCurve.push_back({right, left});
+    if (!isFixed) {
+      const int parent = sk.thoracicSegment[static_cast<std::size_t>(level - 1)];
+      sk.joints.push_back({"costovertebral_" + n + "_right", parent, br, right.centre.front(), false});
+      sk.joints.push_back({"costovertebral_" + n + "_left", parent, bl, left.centre.front(), false});
+    }
+  }
+
+  // neighbouring ribs must not touch
+  for (int level = 1; level < 12; ++level) {
+    const RibCurve& up = sk.ribCurve[static_cast<std::size_t>(level - 1)][kRight];
+    const RibCurve& down = sk.ribCurve[static_cast<std::size_t>(level)][kRight];
+    const double gap = centrelineDistance(up, down);
+    const double need = 0.5 * (up.height + down.height);
+    if (gap < need) {
+      std::ostringstream s;
+      s << a.source << ": ribs[" << level - 1 << "] and ribs[" << level << "] overlap: their centrelines come within "
+        << gap * 1e3 << " mm, less than the mean rib height " << need * 1e3 << " mm";
+      throw sim::Error(s.str());
+    }
+  }
+  return sk;
+}
+
+}  // namespace pneuma::meshing

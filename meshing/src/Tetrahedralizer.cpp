@@ -1,0 +1,63 @@
+// All TetGen code of pneuma::meshing.
+#include "pneuma/meshing/Tetrahedralizer.h"
+
+#include "pneuma/sim/Error.h"
+
+#include <Eigen/Geometry>
+
+#include <tetgen.h>
+
+#include <cmath>
+
+namespace pneuma::meshing {
+
+TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
+  // the surface as a piecewise-linear complex of triangular facets (tetgenio frees these arrays)
+  tetgenio in;
+  in.firstnumber = 0;
+  in.numberofpoints = surface.vertexCount();
+  in.pointlist = new REAL[static_cast<std::size_t>(3 * in.numberofpoints)];
+  for (int i = 0; i < in.numberofpoints; ++i) {
+    for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = surface.vertices(k, i);
+  }
+  in.numberoffacets = surface.triangleCount();
+  in.facetlist = new tetgenio::facet[static_cast<std::size_t>(in.numberoffacets)];
+  for (int f = 0; f < in.numberoffacets; ++f) {
+    tetgenio::facet& facet = in.facetlist[f];
+    facet.numberofpolygons = 1;
+    facet.polygonlist = new tetgenio::polygon[1];
+    facet.numberofholes = 0;
+    facet.holelist = nullptr;
+    facet.polygonlist[0].numberofvertices = 3;
+    facet.polygonlist[0].vertexlist = new int[3];
+    for (int k = 0; k < 3; ++k) facet.polygonlist[0].vertexlist[k] = surface.triangles(k, f);
+  }
+
+  tetgenio out;
+  char switches[] = "pq1.5YQ";
+  try {
+    ::tetrahedralize(switches, &in, &out);
+  } catch (int code) {
+    throw sim::Error(part + ": TetGen failed to tetrahedralise the surface (error " + std::to_string(code) + ")");
+  }
+
+  // copy the result and sum the tetrahedra volumes
+  TetMesh t;
+  t.vertices.resize(3, out.numberofpoints);
+  for (int i = 0; i < out.numberofpoints; ++i) {
+    for (int k = 0; k < 3; ++k) t.vertices(k, i) = out.pointlist[3 * i + k];
+  }
+  t.tets.resize(4, out.numberoftetrahedra);
+  for (int e = 0; e < out.numberoftetrahedra; ++e) {
+    for (int k = 0; k < 4; ++k) t.tets(k, e) = out.tetrahedronlist[e * out.numberofcorners + k];
+    const Eigen::Vector3d a = t.vertices.col(t.tets(0, e));
+    t.volume += std::abs((t.vertices.col(t.tets(1, e)) - a)
+                             .dot((t.vertices.col(t.tets(2, e)) - a).cross(t.vertices.col(t.tets(3, e)) - a))) /
+                6.0;
+  }
+  t.boundaryTriangles = out.numberoftrifaces;
+  if (out.numberoftetrahedra == 0) throw sim::Error(part + ": TetGen produced no tetrahedra");
+  return t;
+}
+
+}  // namespace pneuma::meshing

@@ -1,0 +1,264 @@
+#include "pneuma/meshing/ModelBuilder.h"
+
+#include "pneuma/meshing/MeshTools.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+#include <map>
+
+namespace pneuma::meshing {
+namespace {
+
+using sim::ElementGroup;
+
+/// Physiological ranges (resources/anatomy/README.md, "Volume targets").
+constexpr double kCavityMinMl = 3000.0, kCavityMaxMl = 6500.0;  // thoracic cavity at FRC
+constexpr double kGutMinMl = 4500.0, kGutMaxMl = 11000.0;      // abdominopelvic cavity
+
+/// Both presets are built once for the whole suite.
+class BuiltPresets : public ::testing::TestWithParam<std::string> {
+ protected:
+  static void SetUpTestSuite() {
+    for (const char* name : {"male", "female"}) {
+      s_built[name] = buildModel(loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" + name + ".json"));
+    }
+  }
+  static void TearDownTestSuite() { s_built.clear(); }
+  const BuiltModel& built() const { return s_built.at(GetParam()); }
+  const sim::Model& model() const { return built().model; }
+
+  static std::map<std::string, BuiltModel> s_built;
+};
+std::map<std::string, BuiltModel> BuiltPresets::s_built;
+
+int bodyIndex(const sim::Model& m, const std::string& name) {
+  for (int b = 0; b < m.bodies.size(); ++b) {
+    if (m.bodies.name[static_cast<std::size_t>(b)] == name) return b;
+  }
+  return -1;
+}
+
+TEST_P(BuiltPresets, EveryBoneIsClosedAndFreeOfSelfIntersections) {
+  for (std::size_t b = 0; b < built().bodyMeshes.size(); ++b) {
+    const MeshCheck c = checkMesh(built().bodyMeshes[b]);
+    EXPECT_TRUE(c.isValid()) << model().bodies.name[b] << " closed " << c.isClosed << " self-intersecting "
+                             << c.isSelfIntersecting << " outward " << c.isOutward;
+  }
+}
+
+TEST_P(BuiltPresets, ArticulationMatchesSection5) {
+  const sim::Model& m = model();
+  // ribs 1-10 on each side and the sternum move; the lumbar spine and pelvis are fixed
+  for (int level = 1; level <= 10; ++level) {
+    for (const char* side : {"_left", "_right"}) {
+      const int b = bodyIndex(m, "rib" + std::to_string(level) + side);
+      ASSERT_GE(b, 0);
+      EXPECT_FALSE(m.bodies.isFixed[static_cast<std::size_t>(b)]);
+    }
+  }
+  EXPECT_FALSE(m.bodies.isFixed[static_cast<std::size_t>(bodyIndex(m, "sternum"))]);
+  EXPECT_TRUE(m.bodies.isFixed[static_cast<std::size_t>(bodyIndex(m, "lumbar_spine"))]);
+  EXPECT_TRUE(m.bodies.isFixed[static_cast<std::size_t>(bodyIndex(m, "pelvis"))]);
+  // at least 3 articulated thoracic segments, each on a ball joint
+  int segments = 0;
+  for (int j = 0; j < m.joints.size(); ++j) {
+    if (m.joints.name[static_cast<std::size_t>(j)].rfind("spine_", 0) == 0) ++segments;
+  }
+  EXPECT_GE(segments, 3);
+  // every moving rib hangs on one costovertebral joint; the sternum hangs on cartilage springs only
+  for (int b = 0; b < m.bodies.size(); ++b) {
+    int joints = 0;
+    for (int j = 0; j < m.joints.size(); ++j) joints += m.joints.child[static_cast<std::size_t>(j)] == b ? 1 : 0;
+    const std::string& n = m.bodies.name[static_cast<std::size_t>(b)];
+    if (n.rfind("rib", 0) == 0) {
+      EXPECT_EQ(joints, m.bodies.isFixed[static_cast<std::size_t>(b)] ? 0 : 1) << n;
+    }
+    if (n == "sternum") {
+      EXPECT_EQ(joints, 0);
+    }
+  }
+}
+
+TEST_P(BuiltPresets, LeftAndRightAreMirrorSymmetricWithin1mm) {
+  const sim::Model& m = model();
+  constexpr double kTol = 1e-3;  // [m]
+  auto mirror = [](Eigen::Vector3d p) {
+    p.x() = -p.x();
+    return p;
+  };
+  for (int b = 0; b < m.bodies.size(); ++b) {
+    const std::string& n = m.bodies.name[static_cast<std::size_t>(b)];
+    const std::size_t at = n.find("_left");
+    if (at == std::string::npos) {
+      if (n.find("_right") == std::string::npos) {
+        EXPECT_LT(std::abs(m.bodies.com(0, b)), kTol) << n;  // midline bone
+      }
+      continue;
+    }
+    const int r = bodyIndex(m, n.substr(0, at) + "_right");
+    ASSERT_GE(r, 0) << n;
+    EXPECT_LT((mirror(m.bodies.com.col(b)) - m.bodies.com.col(r)).norm(), kTol) << n;
+    EXPECT_NEAR(m.bodies.mass(b), m.bodies.mass(r), 1e-3 * m.bodies.mass(r)) << n;
+  }
+  // every gut node has a mirror node
+  for (int i = 0; i < m.nodes.size(); ++i) {
+    double best = 1e9;
+    for (int k = 0; k < m.nodes.size(); ++k) best = std::min(best, (mirror(m.nodes.rest.col(i)) - m.nodes.rest.col(k)).norm());
+    EXPECT_LT(best, kTol) << "node " << i;
+  }
+  const int l = m.landmarks.find("rib8_lateral_left"), r = m.landmarks.find("rib8_lateral_right");
+  const Eigen::Matrix3Xd lm = restPoints(m.landmarks.points, m);
+  EXPECT_LT((mirror(lm.col(l)) - lm.col(r)).norm(), kTol);
+}
+
+TEST_P(BuiltPresets, ExternalAndInternalIntercostalsHaveOppositeObliquity) {
+  // angle round the ribcage's vertical axis, from the posterior midline toward the sternum on either side
+  const sim::Model& m = model();
+  const Eigen::Matrix3Xd a = restPoints(m.elements.endA, m);
+  const Eigen::Matrix3Xd b = restPoints(m.elements.endB, m);
+  // the ribcage's vertical axis passes through the mean rib centre of mass
+  double axisY = 0.0;
+  int ribs = 0;
+  for (int r = 0; r < m.bodies.size(); ++r) {
+    if (m.bodies.name[static_cast<std::size_t>(r)].rfind("rib", 0) != 0) continue;
+    axisY += m.bodies.com(1, r);
+    ++ribs;
+  }
+  axisY /= ribs;
+  auto around = [&](const Eigen::Vector3d& p) { return std::atan2(std::abs(p.x()), axisY - p.y()); };
+  std::map<ElementGroup, std::array<int, 2>> forwardBackward;
+  int down = 0, total = 0;
+  for (int e = 0; e < m.elements.size(); ++e) {
+    const ElementGroup g = m.elements.group[static_cast<std::size_t>(e)];
+    if (g != ElementGroup::IntercostalExternal && g != ElementGroup::IntercostalInternal) continue;
+    down += b(2, e) < a(2, e) ? 1 : 0;
+    ++total;
+    ++forwardBackward[g][around(b.col(e)) > around(a.col(e)) ? 0 : 1];
+  }
+  // they run from the rib above down to the rib below (except a few where the cartilage ends curl up)
+  EXPECT_GT(down, 0.9 * total);
+  // external: down and forward; internal: down and backward (all but a few at the rib ends)
+  const auto ext = forwardBackward[ElementGroup::IntercostalExternal];
+  const auto in = forwardBackward[ElementGroup::IntercostalInternal];
+  EXPECT_GT(ext[0], 9 * ext[1]) << ext[0] << " forward, " << ext[1] << " backward";
+  EXPECT_GT(in[1], 9 * in[0]) << in[0] << " forward, " << in[1] << " backward";
+}
+
+TEST_P(BuiltPresets, GroupCountsFollowTable1Within25Percent) {
+  const ModelSummary& s = built().report.summary;
+  auto count = [&](ElementGroup g) { return s.elements[static_cast<std::size_t>(g)]; };
+  auto expectNear = [](int n, double guide, const char* what) {
+    EXPECT_GE(n, 0.75 * guide) << what;
+    EXPECT_LE(n, 1.25 * guide) << what;
+  };
+  expectNear(count(ElementGroup::IntercostalExternal) + count(ElementGroup::IntercostalInternal), 516, "intercostals");
+  expectNear(count(ElementGroup::IntercostalExternal), 258, "external intercostals");
+  expectNear(count(ElementGroup::IntercostalInternal), 258, "internal intercostals");
+  expectNear(count(ElementGroup::Diaphragm), 464, "diaphragm");
+  expectNear(count(ElementGroup::Rectus), 85, "rectus");
+  expectNear(count(ElementGroup::TransversusObliques), 350, "transversus and obliques");
+  EXPECT_GE(count(ElementGroup::Cartilage), 6 * 20);  // at least 6 springs per cartilage, ribs 1-10 both sides
+}
+
+TEST_P(BuiltPresets, VolumesAreWithinPhysiologicalRanges) {
+  const ModelSummary& s = built().report.summary;
+  EXPECT_GT(s.cavityVolume * 1e6, kCavityMinMl);
+  EXPECT_LT(s.cavityVolume * 1e6, kCavityMaxMl);
+  EXPECT_GT(s.gutVolume * 1e6, kGutMinMl);
+  EXPECT_LT(s.gutVolume * 1e6, kGutMaxMl);
+}
+
+TEST_P(BuiltPresets, TetGenVolumeEqualsSurfaceVolumeAndSurfaceHasNoSlivers) {
+  const BuildReport& r = built().report;
+  EXPECT_NEAR(r.tetVolume, r.summary.gutVolume, 1e-3 * r.summary.gutVolume);
+  EXPECT_GT(r.tetrahedra, 0);
+  EXPECT_GT(r.gutQualityMin, 0.2);  // no slivers
+  EXPECT_GT(r.gutQualityMean, 0.65);
+}
+
+TEST_P(BuiltPresets, MovingWallMassesAddUpTo8kg) {
+  const sim::Model& m = model();
+  double moving = 0.0;
+  for (int i = 0; i < m.nodes.size(); ++i) moving += m.nodes.isFixed(i) ? 0.0 : m.nodes.mass(i);
+  EXPECT_NEAR(moving, 8.0, 1e-9);
+  EXPECT_GE(m.nodes.size(), 300);
+  EXPECT_LE(m.nodes.size(), 800);
+}
+
+TEST_P(BuiltPresets, GutSurfaceIsSealedAndHasItsRegions) {
+  const sim::Model& m = model();
+  TriangleMesh gut{m.nodes.rest, m.gut.triangles};
+  EXPECT_TRUE(checkMesh(gut).isValid());
+  // the diaphragm is the top of the gut and is meshed finer than the wall
+  std::array<double, 3> zMean{}, count{};
+  for (int i = 0; i < m.nodes.size(); ++i) {
+    const auto r = static_cast<std::size_t>(m.nodes.region[static_cast<std::size_t>(i)]);
+    zMean[r] += m.nodes.rest(2, i);
+    count[r] += 1;
+  }
+  for (std::size_t r = 0; r < 3; ++r) ASSERT_GT(count[r], 0) << "region " << r;
+  EXPECT_GT(zMean[1] / count[1], zMean[0] / count[0]);
+  const int apex = m.landmarks.find("diaphragm_apex");
+  const int navel = m.landmarks.find("umbilicus");
+  EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, apex))], sim::NodeRegion::Diaphragm);
+  EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, navel))], sim::NodeRegion::Wall);
+  for (int i = 0; i < m.nodes.size(); ++i) EXPECT_LE(m.nodes.rest(2, i), m.nodes.rest(2, m.landmarks.points.nodes(0, apex)) + 1e-12);
+}
+
+TEST_P(BuiltPresets, RoundTripsThroughModelJson) {
+  const std::string text = sim::serializeModel(model());
+  const sim::Model back = sim::parseModel(text);
+  EXPECT_TRUE(sim::serializeModel(back) == text) << "model.json does not round-trip";
+  const ModelSummary a = summarizeModel(back);
+  EXPECT_EQ(summaryJson(a), summaryJson(built().report.summary));
+}
+
+TEST(ModelBuilder, BuildIsDeterministicAndDirectoryIsReplacedWhole) {
+  namespace fs = std::filesystem;
+  const AnatomyParams a = loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/female.json");
+  const BuiltModel one = buildModel(a);
+  const BuiltModel two = buildModel(a);
+  // bodies, joints, nodes, gut, elements and landmarks are bit-identical; the cavity's triangulation
+  // comes from CGAL corefinement, whose tie-breaking follows heap addresses inside one process (separate
+  // processes, as at build time, give identical bytes), so it is compared by its volume
+  EXPECT_NEAR(two.report.summary.cavityVolume, one.report.summary.cavityVolume, 1e-9 * one.report.summary.cavityVolume);
+  sim::Model a1 = one.model, a2 = two.model;
+  a2.cavity = a1.cavity;
+  EXPECT_TRUE(sim::serializeModel(a1) == sim::serializeModel(a2)) << "two builds differ";
+
+  const fs::path dir = fs::temp_directory_path() / ("pneuma_mesh_test_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  { std::ofstream(dir / "stale.txt") << "old"; }
+  writeModelDirectory(one, dir.string());
+  EXPECT_FALSE(fs::exists(dir / "stale.txt"));
+  EXPECT_FALSE(fs::exists(dir.string() + ".tmp"));
+  EXPECT_TRUE(fs::exists(dir / "meshes" / "sternum.vtp"));
+  const sim::Model loaded = sim::loadModel(dir.string());
+  EXPECT_TRUE(sim::serializeModel(loaded) == sim::serializeModel(one.model)) << "model.json does not round-trip";
+  fs::remove_all(dir);
+}
+
+TEST_P(BuiltPresets, CorruptedModelJsonIsRejected) {
+  // a built model written out, then one rest length zeroed in the file
+  nlohmann::json j = nlohmann::json::parse(sim::serializeModel(model()));
+  j["elements"][3]["rest_length"] = 0.0;
+  try {
+    sim::parseModel(j.dump());
+    FAIL() << "zero rest length accepted";
+  } catch (const sim::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("elements[3].rest_length: must be > 0"), std::string::npos) << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Presets, BuiltPresets, ::testing::Values("male", "female"));
+
+}  // namespace
+}  // namespace pneuma::meshing
