@@ -22,6 +22,7 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
+#include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QJsonDocument>
@@ -34,6 +35,7 @@
 #include <QPainter>
 #include <QPdfWriter>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QSlider>
 #include <QStatusBar>
 #include <QStyle>
@@ -91,6 +93,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
   centreLayout->setSpacing(0);
   m_view = new QVTKOpenGLNativeWidget(centre);
   vtkNew<vtkGenericOpenGLRenderWindow> window;
+  window->SetMultiSamples(0);  // multisampling costs more than it gives in software GL
   m_view->setRenderWindow(window);
   window->AddRenderer(m_scene->renderer());
   m_scene->installOrientationMarker(m_view->interactor());
@@ -268,20 +271,11 @@ void MainWindow::buildActions() {
   push->setToolTip("Push the affect's respiration layers onto the pattern stack");
   connect(push, &QAction::triggered, this,
           [this] { pushAffect(m_affectCombo->currentText(), m_affectMode->currentIndex() == 1); });
-  tools->addSeparator();
-  tools->addWidget(new QLabel(" Camera ", this));
-  const std::vector<std::pair<QString, viz::CameraPreset>> cameras{{"Anterior", viz::CameraPreset::Anterior},
-                                                                   {"Lateral", viz::CameraPreset::Lateral},
-                                                                   {"Superior", viz::CameraPreset::Superior},
-                                                                   {"Oblique", viz::CameraPreset::Oblique}};
+  // camera presets: the View menu and the buttons above the display options
   QMenu* view = menuBar()->addMenu("&View");
-  for (const auto& [name, preset] : cameras) {
-    QAction* a = tools->addAction(name);
-    view->addAction(a);
-    connect(a, &QAction::triggered, this, [this, preset = preset] {
-      m_scene->setCamera(preset);
-      m_view->renderWindow()->Render();
-    });
+  for (QPushButton* button : m_cameraButtons) {
+    QAction* a = view->addAction(button->text());
+    connect(a, &QAction::triggered, button, &QPushButton::click);
   }
   QMenu* simMenu = menuBar()->addMenu("&Simulation");
   simMenu->addAction(m_playAction);
@@ -308,6 +302,24 @@ void MainWindow::buildDocks() {
   // left: display options and parameters
   auto* display = new QWidget(this);
   auto* displayLayout = new QVBoxLayout(display);
+  auto* camera = new QGroupBox("Camera", display);
+  auto* cameraLayout = new QGridLayout(camera);
+  const std::vector<std::pair<QString, viz::CameraPreset>> presets{{"Anterior", viz::CameraPreset::Anterior},
+                                                                   {"Lateral", viz::CameraPreset::Lateral},
+                                                                   {"Superior", viz::CameraPreset::Superior},
+                                                                   {"Oblique", viz::CameraPreset::Oblique}};
+  for (const auto& [name, preset] : presets) {
+    auto* button = new QPushButton(name, camera);
+    connect(button, &QPushButton::clicked, this, [this, preset = preset] {
+      m_scene->setCamera(preset);
+      m_view->renderWindow()->Render();
+    });
+    cameraLayout->addWidget(button, static_cast<int>(m_cameraButtons.size()) / 2,
+                            static_cast<int>(m_cameraButtons.size()) % 2);
+    m_cameraButtons.push_back(button);
+  }
+  displayLayout->addWidget(camera);
+
   auto* colouring = new QGroupBox("Colouring", display);
   auto* colourForm = new QFormLayout(colouring);
   m_muscleColour = new QComboBox(colouring);
@@ -382,14 +394,19 @@ void MainWindow::buildDocks() {
   });
 
   auto* tabs = new QTabWidget(this);
-  tabs->addTab(display, "Display");
+  auto* displayScroll = new QScrollArea(this);
+  displayScroll->setWidget(display);
+  displayScroll->setWidgetResizable(true);
+  displayScroll->setFrameShape(QFrame::NoFrame);
+  displayScroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  tabs->addTab(displayScroll, "Display");
   tabs->addTab(m_params, "Parameters");
   auto* leftDock = new QDockWidget("Controls", this);
   leftDock->setObjectName("controls");
   leftDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
   leftDock->setWidget(tabs);
   addDockWidget(Qt::LeftDockWidgetArea, leftDock);
-  resizeDocks({leftDock, plotDock}, {230, 400}, Qt::Horizontal);
+  resizeDocks({leftDock, plotDock}, {262, 400}, Qt::Horizontal);
 }
 
 void MainWindow::syncDisplayWidgets() {
@@ -583,6 +600,12 @@ void MainWindow::pushAffect(const QString& name, bool isImmediate) {
 
 void MainWindow::play() { m_playAction->setChecked(true); }
 
+void MainWindow::setSpeed(double speed) {
+  const int i = m_speedCombo->findData(speed);
+  if (i >= 0) m_speedCombo->setCurrentIndex(i);
+  else if (m_worker) m_worker->setSpeed(speed);
+}
+
 void MainWindow::pause() { m_playAction->setChecked(false); }
 
 bool MainWindow::runUntil(double time, int timeoutMs) {
@@ -645,8 +668,11 @@ void MainWindow::refresh() {
 void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   m_shown = std::move(snapshot);
   const Snapshot& s = *m_shown;
+  QElapsedTimer clock;
+  clock.start();
   if (s.model == m_model) m_scene->update(s.state, s.metrics);
   m_view->renderWindow()->Render();
+  m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
   ++m_framesRendered;
 
   m_plots->setCursor(s.isScrubbed ? s.metrics.time : std::numeric_limits<double>::quiet_NaN());

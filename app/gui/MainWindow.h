@@ -19,6 +19,7 @@ class QAction;
 class QCheckBox;
 class QComboBox;
 class QLabel;
+class QPushButton;
 class QSlider;
 class QTimer;
 class QVTKOpenGLNativeWidget;
@@ -85,6 +86,12 @@ class MainWindow : public QMainWindow {
   void setDisplayOptions(const viz::DisplayOptions& options);
   /// Selects what is under view pixel (x, y) (Qt widget coordinates), as a click would.
   void pickAt(const QPoint& viewPos);
+  /// Render frames per second over the last full second.
+  double renderFps() const { return m_fps; }
+  /// Wall time [ms] of one scene update and render, smoothed.
+  double renderMilliseconds() const { return m_renderMs; }
+  /// Sets the simulation speed: simulated seconds per wall second, 0 = as fast as possible.
+  void setSpeed(double speed);
   /// The last error reported to the user (model, scenario, export or simulation).
   QString lastError() const { return m_lastError; }
 
@@ -132,6 +139,7 @@ class MainWindow : public QMainWindow {
   QComboBox* m_gutColour = nullptr;
   std::vector<QCheckBox*> m_structureChecks;  // bones, gut, translucent gut, cavity, landmarks, labels
   std::vector<QCheckBox*> m_groupChecks;
+  std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique
   QLabel* m_selection = nullptr;
   QSlider* m_timeline = nullptr;
   QLabel* m_timeLabel = nullptr;
@@ -144,6 +152,7 @@ class MainWindow : public QMainWindow {
   QPoint m_pressPos;
   int m_framesRendered = 0;
   double m_fps = 0.0;
+  double m_renderMs = 0.0;  // [ms]
   qint64 m_fpsWindowStart = 0;  // [ms]
   QString m_lastError;
 };

@@ -135,7 +135,12 @@ void PlotView::paintEvent(QPaintEvent*) {
     QRect box;
   };
   std::vector<Entry> legend;
-  int lx = 8, ly = 6 + lineH;
+  QFont bold = font();
+  bold.setBold(true);
+  const bool isNoteOwnRow =
+      QFontMetrics(bold).horizontalAdvance(m_title) + fm.horizontalAdvance(m_note) + 24 > width();
+  const int noteY = isNoteOwnRow ? 4 + lineH : 4;
+  int lx = 8, ly = 6 + lineH + (isNoteOwnRow ? lineH : 0);
   for (const Series& s : m_series) {
     if (s.legend.isEmpty()) continue;
     const int w = 22 + fm.horizontalAdvance(s.legend) + 12;
@@ -143,7 +148,7 @@ void PlotView::paintEvent(QPaintEvent*) {
     legend.push_back({&s, QRect(lx, ly, w, lineH)});
     lx += w;
   }
-  const int top = (legend.empty() ? 6 + lineH : ly + lineH) + 8;
+  const int top = (legend.empty() ? ly : ly + lineH) + 8;
   const QRect area(62, top, width() - 62 - 14, height() - top - lineH - 8);
   if (area.width() < 20 || area.height() < 20) return;
 
@@ -173,13 +178,11 @@ void PlotView::paintEvent(QPaintEvent*) {
 
   // title, note and legend
   p.setPen(QColor(30, 30, 36));
-  QFont bold = font();
-  bold.setBold(true);
   p.setFont(bold);
   p.drawText(QRect(8, 4, width() - 16, lineH), Qt::AlignLeft | Qt::AlignVCenter, m_title);
   p.setFont(font());
   p.setPen(QColor(20, 70, 140));
-  p.drawText(QRect(8, 4, width() - 16, lineH), Qt::AlignRight | Qt::AlignVCenter, m_note);
+  p.drawText(QRect(8, noteY, width() - 16, lineH), Qt::AlignRight | Qt::AlignVCenter, m_note);
   for (const Entry& e : legend) {
     p.setPen(QPen(e.series->colour, 2.5, e.series->isDashed ? Qt::DashLine : Qt::SolidLine));
     const double mid = e.box.center().y() + 0.5;
@@ -220,17 +223,34 @@ void PlotView::paintEvent(QPaintEvent*) {
     p.drawLine(QPointF(area.left(), py(r.y)), QPointF(area.right(), py(r.y)));
   }
   for (const Series& s : m_series) {
+    // at most the first, lowest, highest and last sample per pixel column: the same picture, far fewer segments
     QPainterPath path;
     bool isDrawing = false;
-    for (std::size_t k = first; k < s.y.size() && k < m_time.size(); ++k) {
-      if (!std::isfinite(s.y[k])) {
-        isDrawing = false;
-        continue;
-      }
+    auto add = [&](std::size_t k) {
       const QPointF at(px(m_time[k]), py(s.y[k]));
       if (isDrawing) path.lineTo(at);
       else path.moveTo(at);
       isDrawing = true;
+    };
+    const std::size_t end = std::min(s.y.size(), m_time.size());
+    for (std::size_t k = first; k < end;) {
+      if (!std::isfinite(s.y[k])) {
+        isDrawing = false;
+        ++k;
+        continue;
+      }
+      const int column = static_cast<int>(px(m_time[k]));
+      std::size_t lo = k, hi = k, last = k;
+      while (last + 1 < end && std::isfinite(s.y[last + 1]) && static_cast<int>(px(m_time[last + 1])) == column) {
+        ++last;
+        if (s.y[last] < s.y[lo]) lo = last;
+        if (s.y[last] > s.y[hi]) hi = last;
+      }
+      add(k);
+      if (std::min(lo, hi) != k) add(std::min(lo, hi));
+      if (std::max(lo, hi) != k && std::max(lo, hi) != last) add(std::max(lo, hi));
+      if (last != k) add(last);
+      k = last + 1;
     }
     p.setPen(QPen(s.colour, 1.8, s.isDashed ? Qt::DashLine : Qt::SolidLine));
     p.drawPath(path);

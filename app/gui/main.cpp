@@ -7,6 +7,7 @@
 #include <QCommandLineParser>
 #include <QImage>
 #include <QSurfaceFormat>
+#include <QTimer>
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <cstdio>
@@ -27,7 +28,11 @@ int main(int argc, char** argv) {
   const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.", "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
-  parser.addOptions({model, style, screenshot, after});
+  const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X", "1");
+  const QCommandLineOption measure("measure",
+                                   "Run for SECONDS of wall time, print render fps and real-time factor, exit.",
+                                   "SECONDS");
+  parser.addOptions({model, style, speed, screenshot, after, measure});
   if (!parser.parse(QApplication::arguments())) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -46,7 +51,20 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  const double speedValue = parser.value(speed) == "max" ? 0.0 : parser.value(speed).toDouble(&isNumber);
+  if (parser.value(speed) != "max" && (!isNumber || !(speedValue > 0.0))) {
+    std::fprintf(stderr, "pneuma: --speed: expected a positive number or 'max', got '%s'\n",
+                 qPrintable(parser.value(speed)));
+    return 2;
+  }
+  const double measureSeconds = parser.isSet(measure) ? parser.value(measure).toDouble(&isNumber) : 0.0;
+  if (parser.isSet(measure) && (!isNumber || !(measureSeconds > 0.0))) {
+    std::fprintf(stderr, "pneuma: --measure: expected seconds > 0, got '%s'\n", qPrintable(parser.value(measure)));
+    return 2;
+  }
+
   pneuma::app::MainWindow window;
+  window.setSpeed(speedValue);
   window.show();
   QApplication::processEvents();
   const bool isScripted = parser.isSet(screenshot);
@@ -71,5 +89,15 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (hasModel) window.play();
+  if (parser.isSet(measure)) {
+    // report what the status bar shows after the given wall time
+    QTimer::singleShot(static_cast<int>(1000.0 * measureSeconds), &window, [&window] {
+      const auto* shown = window.shown();
+      std::printf("render %.1f fps (%.1f ms per frame), real-time factor %.2f, simulated %.2f s\n",
+                  window.renderFps(), window.renderMilliseconds(), shown ? shown->realTimeFactor : 0.0,
+                  shown ? shown->state.time : 0.0);
+      QApplication::exit(shown ? 0 : 1);
+    });
+  }
   return QApplication::exec();
 }
