@@ -245,9 +245,20 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     const double ka = kScale * w.elementStiffness(e) + dScale * w.elementDamping(e);
     const double kg = kScale * w.elementGeometric(e);
     if (ka == 0.0 && kg == 0.0) continue;
+    const Vector3d d = w.elementDirection.col(e);
+    const int na = w.endpointNode(0, e), nb = w.endpointNode(1, e);
+    if (na >= 0 && nb >= 0) {
+      // fast path: both ends are single nodes (most gut strands)
+      const Eigen::Index oa = nodeOffset(model, na), ob = nodeOffset(model, nb);
+      const Vector3d du = Eigen::Map<const Vector3d>(u.data() + ob) - Eigen::Map<const Vector3d>(u.data() + oa);
+      const double along = d.dot(du);
+      const Vector3d y = ka * along * d + kg * (du - along * d);
+      Eigen::Map<Vector3d>(out.data() + oa) -= y;
+      Eigen::Map<Vector3d>(out.data() + ob) += y;
+      continue;
+    }
     const Vector3d ra = w.leverA.col(e), rb = w.leverB.col(e);
     const Vector3d du = anchorVelocity(model, w, 1, e, rb, u) - anchorVelocity(model, w, 0, e, ra, u);
-    const Vector3d d = w.elementDirection.col(e);
     const double along = d.dot(du);
     const Vector3d y = ka * along * d + kg * (du - along * d);
     addAnchorGeneralized(model, w, 0, e, ra, -y, out);

@@ -58,7 +58,7 @@ struct StepOptions {
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
   int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
   int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the body-block preconditioner every n steps
-  double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (M^-1 norm)
+  double cgTolerance = 1e-3;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
 };
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
