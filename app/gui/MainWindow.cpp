@@ -837,7 +837,7 @@ QString MainWindow::exportAnimation(const QString& path, double from, double to,
     if (!m_worker || !(to > from) || !(fps > 0.0)) throw std::runtime_error("nothing recorded to export");
     vtkNew<vtkImageData> image;
     vtkNew<vtkOggTheoraWriter> movie;
-    const int frames = static_cast<int>(std::floor((to - from) * fps)) + 1;
+    const int frames = static_cast<int>(std::floor((to - from) * fps + 1e-6)) + 1;
     for (int k = 0; k < frames; ++k) {
       if (!scrubTo(from + k / fps)) throw std::runtime_error("the recording did not answer");
       const QImage shot = grabView();

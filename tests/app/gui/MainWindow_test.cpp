@@ -300,3 +300,21 @@ TEST(MainWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   EXPECT_TRUE(std::isfinite(volume->series()[1].y.back()));
   EXPECT_GT(volume->series()[1].y.back(), 0.0);
 }
+
+TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(1.0));
+  QTemporaryDir out;
+  // 0.2 s at 25 fps: 6 frames
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("breath.png"), 0.4, 0.6, 25.0), QString());
+  const QStringList frames = QDir(out.path()).entryList({"breath_*.png"}, QDir::Files, QDir::Name);
+  ASSERT_EQ(frames.size(), 6);
+  EXPECT_FALSE(QImage(out.filePath(frames.front())).isNull());
+
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("breath.ogv"), 0.4, 0.6, 25.0), QString());
+  QFile movie(out.filePath("breath.ogv"));
+  ASSERT_TRUE(movie.open(QIODevice::ReadOnly));
+  EXPECT_TRUE(movie.read(4) == "OggS");  // an Ogg container
+  EXPECT_GT(movie.size(), 1000);
+  EXPECT_TRUE(QDir(out.path()).entryList({"*.tmp-*"}, QDir::Files).isEmpty());
+}
