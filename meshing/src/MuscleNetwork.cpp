@@ -19,13 +19,15 @@ using sim::ElementGroup;
 constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib that makes intercostals oblique
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
 constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
+constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
 
 /// Appends elements to a model, converting endpoints and scaling the group gains by rest length.
 class ElementSink {
  public:
   ElementSink(const Gains& gains, sim::Model& model) : m_gains(gains), m_model(model) {}
 
-  void add(ElementGroup group, const Endpoint& a, const Endpoint& b) {
+  /// Adds one element; a passive one (`isActive` false) gets kac = 0.
+  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, bool isActive = true) {
     const double l0 = (a.world - b.world).norm();
     if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
     sim::Elements& e = m_model.elements;
@@ -37,7 +39,7 @@ class ElementSink {
     const Eigen::Index n = static_cast<Eigen::Index>(e.group.size());
     for (Eigen::VectorXd* v : {&e.restLength, &e.kac, &e.kpe, &e.damping}) v->conservativeResize(n);
     e.restLength(n - 1) = l0;
-    e.kac(n - 1) = g.kac * scale;
+    e.kac(n - 1) = isActive ? g.kac * scale : 0.0;
     e.kpe(n - 1) = g.kpe * scale;
     e.damping(n - 1) = g.damping * scale;
   }
@@ -115,7 +117,8 @@ std::vector<Endpoint> costalMargin(const Skeleton& sk) {
   return c;
 }
 
-/// Radial diaphragm strands: from the apex through the central tendon and out to the costal margin.
+/// Radial diaphragm strands: from the apex through the central tendon and out to the costal margin,
+/// tied together by passive hoops.
 void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
   // between consecutive dome rings: each outer node to the inner node nearest in angle
   for (std::size_t r = 0; r < gut.domeRing.size(); ++r) {
@@ -126,6 +129,14 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
       const std::size_t jIn = static_cast<std::size_t>(std::lround(static_cast<double>(j) * nIn / outer.size())) % nIn;
       const int inner = isLast ? gut.apex : gut.domeRing[r + 1][jIn];
       sink.add(ElementGroup::Diaphragm, Endpoint::atNode(outer[j], gut.rest), Endpoint::atNode(inner, gut.rest));
+    }
+  }
+  // passive hoops round every inner ring keep neighbouring strands together (connective tissue, kac = 0)
+  for (std::size_t r = 1; r < gut.domeRing.size(); ++r) {
+    const std::vector<int>& ring = gut.domeRing[r];
+    for (std::size_t j = 0; j < ring.size(); ++j) {
+      sink.add(ElementGroup::Diaphragm, Endpoint::atNode(ring[j], gut.rest),
+               Endpoint::atNode(ring[(j + 1) % ring.size()], gut.rest), false);
     }
   }
   // rim to the nearest point of the costal margin, xiphoid or crura
@@ -143,16 +154,16 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
 /// Rectus: vertical strands on the anterior wall from the pubis (floor ring) to the xiphoid and ribs 5-7.
 void addRectus(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
   const int m = static_cast<int>(gut.wallRing.front().size());
-  for (int c = -3; c <= 3; ++c) {
+  for (int c = -kRectusHalfColumns; c <= kRectusHalfColumns; ++c) {
     const std::size_t j = static_cast<std::size_t>((c + m) % m);
     for (std::size_t k = 0; k + 1 < gut.wallRing.size(); ++k) {
       sink.add(ElementGroup::Rectus, Endpoint::atNode(gut.wallRing[k][j], gut.rest),
                Endpoint::atNode(gut.wallRing[k + 1][j], gut.rest));
     }
-    // top insertion: the xiphoid on the midline, costal cartilages 7, 6, 5 going outward
+    // top insertion: the xiphoid on the midline, costal cartilages 7, 6 and 5 going outward
     Endpoint top = Endpoint::onBody(sk.sternum, sk.xiphoidTip);
     if (c != 0) {
-      const std::size_t level = static_cast<std::size_t>(7 - std::abs(c) + 1);
+      const std::size_t level = static_cast<std::size_t>(std::max(5, 8 - std::abs(c)));
       const std::size_t side = c > 0 ? kRight : kLeft;
       const RibCurve& r = sk.ribCurve[level - 1][side];
       top = Endpoint::onBody(sk.rib[level - 1][side], r.at(r.length()));
@@ -162,7 +173,8 @@ void addRectus(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
 }
 
 /// Transversus (hoops round each wall ring) and obliques (diagonals between rings, alternating external
-/// oblique "down and forward" and internal oblique "up and forward"); only where the wall moves.
+/// oblique "down and forward" and internal oblique "up and forward", and from the top ring up to the
+/// costal margin); only where the wall moves.
 void addTransversusObliques(const GutSurface& gut, ElementSink& sink) {
   const int m = static_cast<int>(gut.wallRing.front().size());
   auto moving = [&](int node) { return gut.region[static_cast<std::size_t>(node)] != sim::NodeRegion::Fixed; };
@@ -187,6 +199,14 @@ void addTransversusObliques(const GutSurface& gut, ElementSink& sink) {
       const int lower = lowerIsAtJ ? q[0] : q[1];
       sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(upper, gut.rest), Endpoint::atNode(lower, gut.rest));
     }
+  }
+  const std::vector<int>& rim = gut.domeRing.front();
+  const std::size_t nRim = rim.size();
+  for (int j = 0; j < m; ++j) {
+    const int top = node(gut.wallRing.size() - 1, j);
+    if (!moving(top)) continue;
+    const std::size_t jRim = static_cast<std::size_t>(std::lround(static_cast<double>(j) * nRim / m)) % nRim;
+    sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(top, gut.rest), Endpoint::atNode(rim[jRim], gut.rest));
   }
 }
 
