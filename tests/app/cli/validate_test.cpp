@@ -12,7 +12,7 @@ using pneuma::test::toyModelDir;
 
 TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   const std::string out = freshOutDir("validate");
-  auto r = runCli({"validate", "--quick", "--model", toyModelDir(), "--out", out});
+  auto r = runCli({"validate", "--quick", "--dt", "0.002", "--model", toyModelDir(), "--out", out});
   ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 1) << r.err;
 
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/report.json"));
