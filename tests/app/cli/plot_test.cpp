@@ -7,6 +7,8 @@
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
 #include <vtkSmartPointer.h>
+#include <vtkXMLDataElement.h>
+#include <vtkXMLUtilities.h>
 
 #include <cmath>
 #include <cstdio>
@@ -68,10 +70,17 @@ TEST(Plot, PngDecodesWithRequestedSizeAndShowsBothSeriesColours) {
   EXPECT_GT(white, 800 * 450 / 2);
 }
 
-TEST(Plot, SvgHasOnePolylinePerSeriesAndEscapedLabels) {
+TEST(Plot, SvgIsWellFormedXmlWithEscapedLabels) {
   Plot plot("a < b & c", "time [s]", "tension [N]");
   plot.addSeries("x", {0.0, 1.0, 2.0}, {0.0, 1.0, 0.0});
   const std::string svg = plot.toSvg();
+  // well-formed XML (expat); the document element is <svg>
+  vtkSmartPointer<vtkXMLDataElement> root;
+  root.TakeReference(vtkXMLUtilities::ReadElementFromString(svg.c_str()));
+  ASSERT_NE(root, nullptr);
+  EXPECT_EQ(vtkXMLUtilities::ReadElementFromString("<svg><g></svg>"), nullptr);  // the parser does reject bad XML
+  EXPECT_STREQ(root->GetName(), "svg");
+  EXPECT_STREQ(root->GetAttribute("width"), "960");
   EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
   EXPECT_NE(svg.find("a &lt; b &amp; c"), std::string::npos);
   EXPECT_NE(svg.find(">tension [N]</text>"), std::string::npos);
