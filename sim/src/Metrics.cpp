@@ -52,14 +52,15 @@ Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNa
   }
   s.meanGutVolumeError = sumError / static_cast<double>(trace.size() - i0);
 
-  // cycles: upward crossings of the mean volume, re-armed only after dropping 10 % of the range below it
+  // cycles: upward crossings of the mean volume, re-armed only after dropping 25 % of the range below it
+  // (so ringing smaller than a quarter of the breath is not counted as breaths)
   const auto begin = trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(i0);
   const double lo = *std::min_element(begin, trace.lungVolume.end());
   const double hi = *std::max_element(begin, trace.lungVolume.end());
   double mean = 0.0;
   for (std::size_t i = i0; i < trace.size(); ++i) mean += trace.lungVolume[i];
   mean /= static_cast<double>(trace.size() - i0);
-  const double hysteresis = 0.1 * (hi - lo);
+  const double hysteresis = 0.25 * (hi - lo);
   std::vector<std::size_t> up;     // frame index of each upward crossing
   std::vector<double> upTime;      // [s] interpolated crossing time
   bool armed = false;

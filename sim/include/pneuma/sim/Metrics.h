@@ -64,7 +64,7 @@ struct Summary {
 };
 
 /// Analyses `trace` from time `from` [s] on: cycles are delimited by successive upward crossings of
-/// the mean lung volume (with a hysteresis of 10 % of the range); tidal volume is the mean
+/// the mean lung volume (with a hysteresis of 25 % of the range); tidal volume is the mean
 /// per-cycle peak-to-peak, the rate is 60 / mean period. Excursions are
 /// landmarkExcursion() of "diaphragm_apex", "xiphoid" and "umbilicus" (0 when a name is missing).
 /// Fills the volume, rate, gut-error and excursion fields; the caller sets rtf, steps and dt.
