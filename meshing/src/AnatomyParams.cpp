@@ -220,6 +220,7 @@ Gains readGains(const json& j, const std::string& source) {
   }
   g.gutKappa = r.positive("gut_kappa_pa", 1e9);
   g.wallMass = r.positive("gut_wall_mass_kg", 100.0);
+  g.diaphragmMass = r.positive("diaphragm_mass_kg", 10.0);
   const Reader joints = r.child("joints");
   g.costovertebralFriction = joints.number("costovertebral_friction", 0.0, 1e6);
   g.costovertebralStiffness = joints.number("costovertebral_stiffness", 0.0, 1e6);

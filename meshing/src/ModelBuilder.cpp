@@ -11,6 +11,7 @@
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -64,14 +65,19 @@ void buildJoints(const AnatomyParams& a, const Skeleton& sk, sim::Joints& j) {
   }
 }
 
-/// Gut nodes with equal point masses; the moving ones add up to the wall mass (Section 6.1).
+/// Gut nodes with equal point masses within a region: the moving wall nodes add up to the wall mass
+/// (8 kg, Section 6.1), the dome nodes to the diaphragm's mass; fixed nodes weigh as much as a wall node.
 void buildGutNodes(const AnatomyParams& a, const GutSurface& g, BuiltModel& out) {
   sim::Model& m = out.model;
   m.nodes.rest = g.rest;
   m.nodes.region = g.region;
-  int moving = 0;
-  for (sim::NodeRegion r : g.region) moving += r != sim::NodeRegion::Fixed ? 1 : 0;
-  m.nodes.mass = Eigen::VectorXd::Constant(g.rest.cols(), a.gains.wallMass / moving);
+  const auto count = [&](sim::NodeRegion region) { return std::count(g.region.begin(), g.region.end(), region); };
+  const double wallNode = a.gains.wallMass / static_cast<double>(count(sim::NodeRegion::Wall));
+  const double domeNode = a.gains.diaphragmMass / static_cast<double>(count(sim::NodeRegion::Diaphragm));
+  m.nodes.mass.resize(g.rest.cols());
+  for (Eigen::Index i = 0; i < g.rest.cols(); ++i) {
+    m.nodes.mass(i) = g.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Diaphragm ? domeNode : wallNode;
+  }
   m.gut.triangles = g.triangles;
   m.gut.kappa = a.gains.gutKappa;
 

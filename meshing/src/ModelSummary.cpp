@@ -41,11 +41,8 @@ ModelSummary summarizeModel(const sim::Model& m) {
   s.joints = m.joints.size();
   s.nodes = m.nodes.size();
   for (int i = 0; i < s.nodes; ++i) {
-    if (m.nodes.isFixed(i)) {
-      ++s.fixedNodes;
-    } else {
-      s.gutWallMass += m.nodes.mass(i);
-    }
+    if (m.nodes.isFixed(i)) ++s.fixedNodes;
+    if (m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Wall) s.gutWallMass += m.nodes.mass(i);
   }
   for (sim::ElementGroup g : m.elements.group) ++s.elements[static_cast<std::size_t>(g)];
   s.gutVolume = enclosedVolume(m.nodes.rest, m.gut.triangles);

@@ -183,11 +183,16 @@ TEST_P(BuiltPresets, TetGenVolumeEqualsSurfaceVolumeAndSurfaceHasNoSlivers) {
   EXPECT_GT(r.gutQualityMean, 0.65);
 }
 
-TEST_P(BuiltPresets, MovingWallMassesAddUpTo8kg) {
+TEST_P(BuiltPresets, WallMassesAddUpTo8kgAndDiaphragmToItsMass) {
   const sim::Model& m = model();
-  double moving = 0.0;
-  for (int i = 0; i < m.nodes.size(); ++i) moving += m.nodes.isFixed(i) ? 0.0 : m.nodes.mass(i);
-  EXPECT_NEAR(moving, 8.0, 1e-9);
+  double wall = 0.0, dome = 0.0;
+  for (int i = 0; i < m.nodes.size(); ++i) {
+    const sim::NodeRegion r = m.nodes.region[static_cast<std::size_t>(i)];
+    if (r == sim::NodeRegion::Wall) wall += m.nodes.mass(i);
+    if (r == sim::NodeRegion::Diaphragm) dome += m.nodes.mass(i);
+  }
+  EXPECT_NEAR(wall, 8.0, 1e-9);
+  EXPECT_NEAR(dome, 0.3, 1e-9);
   EXPECT_GE(m.nodes.size(), 300);
   EXPECT_LE(m.nodes.size(), 800);
 }

@@ -104,7 +104,8 @@ struct Gains {
   double costovertebralStiffness = 0.0; ///< [N m/rad]
   double spineFriction = 0.0;           ///< [N m s/rad]
   double spineStiffness = 0.0;          ///< [N m/rad]
-  double wallMass = 0.0;                ///< [kg] total mass of the moving gut nodes (8 kg, Section 6.1)
+  double wallMass = 0.0;                ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
+  double diaphragmMass = 0.0;           ///< [kg] total mass of the diaphragm dome nodes
 };
 
 /// A whole anatomy preset.

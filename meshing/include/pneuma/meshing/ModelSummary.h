@@ -19,7 +19,7 @@ struct ModelSummary {
   std::array<int, sim::kElementGroupCount> elements{};  ///< per sim::ElementGroup
   double gutVolume = 0.0;     ///< [m^3] enclosed by the gut surface at rest
   double cavityVolume = 0.0;  ///< [m^3] enclosed by the lung-cavity surface at rest
-  double gutWallMass = 0.0;   ///< [kg] mass of the moving gut nodes
+  double gutWallMass = 0.0;   ///< [kg] mass of the moving abdominal-wall nodes (region Wall)
   double boneMass = 0.0;      ///< [kg] mass of all bodies
 };
 
