@@ -193,12 +193,14 @@ Vector3d jointRotation(const State& s, int parent, int child) {
   return s.bodyOrientation[at(parent)] * (aa.angle() * aa.axis());
 }
 
-// joint friction tau = -mu (w_child - w_parent) (Eq. 3) and passive rotational stiffness tau = -k theta
+// joint friction tau = -mu (w_child - w_parent) (Eq. 3) and passive rotational stiffness tau = -k theta;
+// the friction is left out for symplectic Euler, which integrates it implicitly (integrateJointFriction)
 void accumulateJointTorques(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
+  const double frictionScale = o.integrator == IntegratorKind::ImplicitEuler ? o.jointFrictionScale : 0.0;
   for (int i = 0; i < j.size(); ++i) {
     const int p = j.parent[at(i)], c = j.child[at(i)];
-    const double mu = j.friction(i) * o.jointFrictionScale;
+    const double mu = j.friction(i) * frictionScale;
     Vector3d tau = -mu * (s.bodyAngularVelocity.col(c) - s.bodyAngularVelocity.col(p));
     if (j.stiffness(i) > 0.0) tau -= j.stiffness(i) * jointRotation(s, p, c);
     w.bodyTorque.col(c) += tau;
@@ -233,6 +235,23 @@ void explicitVelocityUpdate(const Model& model, State& s, double dt, StepWork& w
   for (int n = 0; n < model.nodes.size(); ++n) {
     if (model.nodes.isFixed(n)) continue;
     s.nodeVelocity.col(n) += (dt / model.nodes.mass(n)) * w.nodeForce.col(n);
+  }
+}
+
+// joint friction (Eq. 3) for symplectic Euler, backward Euler per joint: the relative angular velocity
+// w_rel decays as (1 + dt mu W) w_rel' = w_rel with W = I_c^-1 + I_p^-1 (world), so any mu / I is stable
+void integrateJointFriction(const Model& model, State& s, double dt, const StepOptions& o, const StepWork& w) {
+  const Joints& j = model.joints;
+  for (int i = 0; i < j.size(); ++i) {
+    const double mu = j.friction(i) * o.jointFrictionScale;
+    if (mu == 0.0) continue;
+    const int p = j.parent[at(i)], c = j.child[at(i)];
+    const Matrix3d inv = w.inverseInertiaWorld[at(c)] + w.inverseInertiaWorld[at(p)];
+    const Vector3d rel = s.bodyAngularVelocity.col(c) - s.bodyAngularVelocity.col(p);
+    const Vector3d relNew = (Matrix3d::Identity() + dt * mu * inv).inverse() * rel;
+    const Vector3d impulse = -dt * mu * relNew;  // [N m s] angular impulse on the child
+    s.bodyAngularVelocity.col(c) += w.inverseInertiaWorld[at(c)] * impulse;
+    s.bodyAngularVelocity.col(p) -= w.inverseInertiaWorld[at(p)] * impulse;
   }
 }
 
@@ -676,9 +695,10 @@ void step(const Model& model, State& state, double dt, const Activations& act, c
   computeForces(model, state, act, options, work);
 
   // integrate velocities
-  if (options.integrator == IntegratorKind::SymplecticEuler)
+  if (options.integrator == IntegratorKind::SymplecticEuler) {
     explicitVelocityUpdate(model, state, dt, work);
-  else
+    integrateJointFriction(model, state, dt, options, work);
+  } else
     implicitVelocityUpdate(model, state, dt, options, work);
 
   // joints: remove relative velocity at every ball joint

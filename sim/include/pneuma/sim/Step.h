@@ -110,6 +110,8 @@ StepWork makeStepWork(const Model& model);
 /// Stage 1 alone: clears and accumulates work.bodyForce [N], bodyTorque [N m] (world, about each com) and
 /// nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3)
 /// and stiffness, gravity and the gyroscopic term; also fills the per-element and gut by-products.
+/// Joint friction is included for ImplicitEuler only; SymplecticEuler integrates it implicitly per joint
+/// right after the velocity update (unconditionally stable for light bones).
 void computeForces(const Model& model, const State& state, const Activations& act, const StepOptions& options,
                    StepWork& work);
 
