@@ -216,11 +216,10 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_option("--model", args->model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
   auto* style = cmd->add_option("--style", args->style, "Breath style preset (calm, deep, panting, forced-exhale)");
   auto* affect = cmd->add_option("--affect", args->affect, "Affect preset (neutral, startle, ... see docs/cli.md)");
-  auto* scenario = cmd->add_option("--scenario", args->scenario, "Scenario file (JSON); other options override it");
+  cmd->add_option("--scenario", args->scenario, "Scenario file (JSON); other options override it");
   auto* pattern = cmd->add_option("--pattern", args->pattern, "Pattern file (JSON, docs/patterns.md)");
   style->excludes(affect)->excludes(pattern);
   affect->excludes(pattern);
-  (void)scenario;
   cmd->add_option("--duration", args->duration, "Simulated seconds after the settling phase (> 0)");
   cmd->add_option("--out", args->out, "Output directory (created if missing)")->required();
   cmd->add_option("--output-rate", args->outputRate, "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
