@@ -5,6 +5,7 @@
 /// 2 bad usage or bad input (unknown option, missing model, unwritable output, invalid scenario).
 
 #include "Commands.h"
+#include "ModelCommand.h"
 
 #include <CLI/CLI.hpp>
 
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   pneuma::app::addScenarioCommand(app);
   pneuma::app::addValidateCommand(app);
   pneuma::app::addBenchCommand(app);
+  pneuma::app::addModelCommand(app);
   app.footer("Run 'pneuma-cli SUBCOMMAND --help' for the options of a subcommand. Docs: docs/cli.md");
 
   try {
