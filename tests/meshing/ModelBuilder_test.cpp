@@ -22,16 +22,18 @@ using sim::ElementGroup;
 constexpr double kCavityMinMl = 3000.0, kCavityMaxMl = 6500.0;  // thoracic cavity at FRC
 constexpr double kGutMinMl = 4500.0, kGutMaxMl = 11000.0;      // abdominopelvic cavity
 
-/// Both presets are built once for the whole suite.
+/// Each preset is built once per test process, when a test first needs it.
 class BuiltPresets : public ::testing::TestWithParam<std::string> {
  protected:
-  static void SetUpTestSuite() {
-    for (const char* name : {"male", "female"}) {
-      s_built[name] = buildModel(loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" + name + ".json"));
-    }
-  }
   static void TearDownTestSuite() { s_built.clear(); }
-  const BuiltModel& built() const { return s_built.at(GetParam()); }
+  const BuiltModel& built() const {
+    auto it = s_built.find(GetParam());
+    if (it == s_built.end()) {
+      it = s_built.emplace(GetParam(), buildModel(loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" +
+                                                              GetParam() + ".json"))).first;
+    }
+    return it->second;
+  }
   const sim::Model& model() const { return built().model; }
 
   static std::map<std::string, BuiltModel> s_built;
