@@ -100,8 +100,8 @@ double LivePlots::tidalVolume() const {
   return hi - lo;
 }
 
-void LivePlots::refresh() {
-  if (!m_isDirty) return;
+bool LivePlots::refresh() {
+  if (!m_isDirty) return false;
   m_isDirty = false;
 
   // only the shown window is handed to the plots
@@ -171,6 +171,7 @@ void LivePlots::refresh() {
                        t.name});
   }
   m_plots[3]->setData(time, std::move(tension));
+  return true;
 }
 
 }  // namespace pneuma::app

@@ -33,8 +33,9 @@ class LivePlots : public QWidget {
   void clear();
   /// Appends output frames (oldest first).
   void append(std::vector<PlotSample> samples);
-  /// Redraws every plot from the history (call at the display rate).
-  void refresh();
+  /// Redraws every plot from the history when new samples arrived (call at the display rate).
+  /// @return true when the plots were redrawn
+  bool refresh();
   /// Time span shown [s].
   void setWindow(double seconds);
   /// Breath period [s] over which the tidal volume is measured.

@@ -10,6 +10,7 @@
 #include "gui/SimWorker.h"
 #include "viz/ModelScene.h"
 
+#include <QElapsedTimer>
 #include <QMainWindow>
 #include <QThread>
 
@@ -88,6 +89,8 @@ class MainWindow : public QMainWindow {
   void pickAt(const QPoint& viewPos);
   /// Render frames per second over the last full second.
   double renderFps() const { return m_fps; }
+  /// Plot refreshes per second over the last full second.
+  double plotRate() const { return m_plotHz; }
   /// Wall time [ms] of one scene update and render, smoothed.
   double renderMilliseconds() const { return m_renderMs; }
   /// Sets the simulation speed: simulated seconds per wall second, 0 = as fast as possible.
@@ -153,6 +156,9 @@ class MainWindow : public QMainWindow {
   int m_framesRendered = 0;
   double m_fps = 0.0;
   double m_renderMs = 0.0;  // [ms]
+  double m_plotHz = 0.0;    // [1/s] plot refreshes
+  int m_plotFrames = 0;
+  QElapsedTimer m_sinceRender;
   qint64 m_fpsWindowStart = 0;  // [ms]
   QString m_lastError;
 };

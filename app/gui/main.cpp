@@ -93,9 +93,9 @@ int main(int argc, char** argv) {
     // report what the status bar shows after the given wall time
     QTimer::singleShot(static_cast<int>(1000.0 * measureSeconds), &window, [&window] {
       const auto* shown = window.shown();
-      std::printf("render %.1f fps (%.1f ms per frame), real-time factor %.2f, simulated %.2f s\n",
-                  window.renderFps(), window.renderMilliseconds(), shown ? shown->realTimeFactor : 0.0,
-                  shown ? shown->state.time : 0.0);
+      std::printf("3D view %.1f fps (%.1f ms per render), plots %.1f Hz, real-time factor %.2f, simulated %.2f s\n",
+                  window.renderFps(), window.renderMilliseconds(), window.plotRate(),
+                  shown ? shown->realTimeFactor : 0.0, shown ? shown->state.time : 0.0);
       QApplication::exit(shown ? 0 : 1);
     });
   }

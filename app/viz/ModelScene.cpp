@@ -81,13 +81,13 @@ vtkSmartPointer<vtkScalarBarActor> makeScalarBar(vtkLookupTable* table, const ch
   bar->SetTitle(title);
   bar->SetNumberOfLabels(5);
   bar->SetLabelFormat("%-#6.3g");
-  bar->SetPosition(0.875, y);
-  bar->SetWidth(0.115);
+  bar->SetPosition(0.855, y);
+  bar->SetWidth(0.14);
   bar->SetHeight(0.4);
   bar->SetBarRatio(0.28);
   bar->UnconstrainedFontSizeOn();
   for (vtkTextProperty* text : {bar->GetTitleTextProperty(), bar->GetLabelTextProperty()}) {
-    text->SetFontSize(13);
+    text->SetFontSize(12);
     text->ShadowOff();
     text->ItalicOff();
     text->SetColor(0.93, 0.93, 0.93);
@@ -171,7 +171,7 @@ struct ModelScene::Impl {
 
   sim::Model model;
   double maxForceSeen = 0.0;  // [N]
-  double maxDisplacementSeen = 0.0;  // [m]
+  double maxDisplacementSeen = 0.0;  // [m] of the current frame
 
   // muscle elements, one actor per group (points 2k, 2k+1 are the ends of the group's k-th element)
   struct Group {
@@ -535,7 +535,8 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
       s.gutScalar->SetValue(n, static_cast<float>(value));
     }
     s.gutScalar->Modified();
-    s.maxDisplacementSeen = std::max(s.maxDisplacementSeen, maxDisp);
+    // the displacement scale follows the current largest displacement (rounded to a nice number)
+    s.maxDisplacementSeen = maxDisp;
     if (s.options.gutColouring == GutColouring::Pressure) {
       const double p = niceCeil(std::max(std::abs(metrics.gutPressure), 1.0));
       s.gutTable->SetTableRange(-p, p);

@@ -36,13 +36,21 @@ struct ToyWindow {
   }
 };
 
-// the breathing rate [1/min] measured from the lung volume the volume plot holds, from time `from` [s]
+// the breathing rate [1/min] measured from the lung volume the volume plot holds, from time `from` [s]:
+// the volume low-passed by a centred 0.4 s moving average (it removes the few-hertz wobble of the
+// ribcage, far above any breathing rate), then the sim's own cycle analysis (sim::summarize)
 double plottedRate(const app::PlotView& plot, double from) {
+  const std::vector<double>& t = plot.time();
+  const std::vector<double>& v = plot.series()[0].y;
   sim::Trace trace;
-  for (std::size_t k = 0; k < plot.time().size(); ++k) {
+  std::size_t lo = 0, hi = 0;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    while (hi < t.size() && t[hi] <= t[k] + 0.2) sum += v[hi++];
+    while (t[lo] < t[k] - 0.2) sum -= v[lo++];
     sim::Metrics m;
-    m.time = plot.time()[k];
-    m.lungVolume = plot.series()[0].y[k];
+    m.time = t[k];
+    m.lungVolume = sum / static_cast<double>(hi - lo);
     trace.append(m);
   }
   return sim::summarize(trace, {}, from).breathsPerMinute;
