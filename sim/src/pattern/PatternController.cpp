@@ -65,8 +65,8 @@ double meanVolume(const Trace& trace, double from, double to) {
 
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options,
                                 double contractionR) {
-  // each group alone at half activation: rest window, then the held window once the volume has settled
-  constexpr double kAlpha = 0.5;   // [-]
+  // each group alone at a small activation: rest window, then the held window once the volume has settled
+  constexpr double kAlpha = 0.05;  // [-] small: the local gain near rest, where breathing happens
   constexpr double kHold = 2.5;    // [s] activation held
   constexpr double kWindow = 0.5;  // [s] averaging window at the end of each phase
   DriveCalibration c;

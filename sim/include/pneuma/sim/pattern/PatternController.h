@@ -47,10 +47,10 @@ struct DriveCalibration {
 
 /// Feedback settings.
 struct PatternControllerOptions {
-  double kp = 4.0;                ///< [-] proportional gain on the fraction error
-  double ki = 8.0;                ///< [1/s] integral gain
+  double kp = 2.0;                ///< [-] proportional gain on the fraction error
+  double ki = 4.0;                ///< [1/s] integral gain
   double integralLimit = 0.2;     ///< [-] clamp of ki * integral (anti-windup), in fraction units
-  double lead = 0.05;             ///< [s] T_lead, feed-forward on the target's rate of change
+  double lead = 0.1;              ///< [s] T_lead, feed-forward on the target's rate of change
   double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
 };
 
@@ -65,7 +65,9 @@ struct TrackingStats {
 };
 
 /// Measures each muscle group's static gain on `model`: a relaxed run gives V_rest, then each group alone
-/// is held at alpha = 0.5 (r = contractionR) until the volume settles. Takes a few simulated seconds per group.
+/// is held at alpha = 0.05 (r = contractionR) for 2.5 s. The small activation measures the local gain near
+/// rest, where breathing happens (the muscle response is strongly non-linear: on the default model the
+/// external intercostals add 0.6 L at alpha = 0.02 but only 2.2 L at alpha = 1). About 3 s of wall time.
 /// @param options  simulation options (integrator, dt, settleTime) to use for the runs
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options = {},
                                 double contractionR = 0.6);
