@@ -217,7 +217,8 @@ Activations PatternController::distribute(double drive, double balance) const {
 
 std::string PatternController::describe() const {
   std::ostringstream os;
-  os << "pattern '" << m_description << "' (layer '" << m_stack.currentLayerName() << "')";
+  os << "pattern '" << m_description << "'";
+  if (!m_stack.currentLayerName().empty()) os << " (playing '" << m_stack.currentLayerName() << "')";
   return os.str();
 }
 
