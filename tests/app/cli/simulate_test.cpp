@@ -277,3 +277,24 @@ TEST(CliSimulate, BadInputIsOneLineErrorAndExit2) {
     EXPECT_EQ(pneuma::test::lineCount(r.err), 1) << r.err;
   }
 }
+
+TEST(CliScenario, CheckAcceptsTheExamplesAndNamesTheFailingPath) {
+  std::vector<std::string> args{"scenario", "check"};
+  for (const auto& e : fs::directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios")) args.push_back(e.path().string());
+  auto r = runCli(args);
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(pneuma::test::lineCount(r.out), static_cast<int>(args.size()) - 2) << r.out;  // one "ok" line per file
+
+  const std::string dir = freshOutDir("scenario_check");
+  fs::create_directories(dir);
+  std::ofstream(dir + "/bad.json") << R"({"format": "pneuma-scenario", "version": 1, "duration_s": 3,
+      "controller": {"style": "calm"}, "overrides": {"active_gain_scale": {"diaphram": 2}}})";
+  r = runCli({"scenario", "check", dir + "/bad.json"});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("bad.json: overrides.active_gain_scale.diaphram: unknown muscle group"), std::string::npos) << r.err;
+
+  // show prints a scenario that parses back to itself
+  r = runCli({"scenario", "show", std::string(PNEUMA_RESOURCE_DIR) + "/scenarios/calm.json"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("\"format\": \"pneuma-scenario\""), std::string::npos) << r.out;
+}
