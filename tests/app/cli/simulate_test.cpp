@@ -298,3 +298,17 @@ TEST(CliScenario, CheckAcceptsTheExamplesAndNamesTheFailingPath) {
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("\"format\": \"pneuma-scenario\""), std::string::npos) << r.out;
 }
+
+TEST(CliSimulate, BlowUpIsReportedWritesPartialOutputsAndExits1) {
+  const std::string out = freshOutDir("blowup");
+  // explicit Euler far above its stability limit on the stiff cartilage springs
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "5", "--integrator",
+                   "symplectic-euler", "--dt", "0.01", "--out", out});
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("blew up"), std::string::npos) << r.err;
+  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  EXPECT_TRUE(s["partial"].get<bool>());
+  EXPECT_FALSE(s["interrupted"].get<bool>());
+  EXPECT_NE(s["error"].get<std::string>().find("dt"), std::string::npos);
+  EXPECT_LT(s["simulated_time_s"].get<double>(), 7.0);
+}
