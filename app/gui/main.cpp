@@ -11,6 +11,7 @@
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <cstdio>
+#include <map>
 
 int main(int argc, char** argv) {
   QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
@@ -28,11 +29,14 @@ int main(int argc, char** argv) {
   const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.", "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
+  const QCommandLineOption camera("camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME",
+                                  "oblique");
+  const QCommandLineOption labels("labels", "Show the anatomical labels and the lung cavity (teaching view).");
   const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X", "1");
   const QCommandLineOption measure("measure",
                                    "Run for SECONDS of wall time, print render fps and real-time factor, exit.",
                                    "SECONDS");
-  parser.addOptions({model, style, speed, screenshot, after, measure});
+  parser.addOptions({model, style, camera, labels, speed, screenshot, after, measure});
   if (!parser.parse(QApplication::arguments())) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -63,6 +67,17 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  const std::map<QString, pneuma::viz::CameraPreset> presets{{"anterior", pneuma::viz::CameraPreset::Anterior},
+                                                             {"lateral", pneuma::viz::CameraPreset::Lateral},
+                                                             {"superior", pneuma::viz::CameraPreset::Superior},
+                                                             {"oblique", pneuma::viz::CameraPreset::Oblique}};
+  const auto preset = presets.find(parser.value(camera));
+  if (preset == presets.end()) {
+    std::fprintf(stderr, "pneuma: --camera: unknown preset '%s' (valid: anterior, lateral, superior, oblique)\n",
+                 qPrintable(parser.value(camera)));
+    return 2;
+  }
+
   pneuma::app::MainWindow window;
   window.setSpeed(speedValue);
   window.show();
@@ -71,6 +86,13 @@ int main(int argc, char** argv) {
   if (parser.isSet(style) && !window.setBreathStyle(parser.value(style)).isEmpty() && isScripted) return 2;
   const QString modelDir = parser.isSet(model) ? parser.value(model) : pneuma::app::MainWindow::defaultModelDir();
   const bool hasModel = window.openModel(modelDir).isEmpty();
+  window.scene().setCamera(preset->second);
+  if (parser.isSet(labels)) {
+    pneuma::viz::DisplayOptions options = window.scene().options();
+    options.showLabels = true;
+    options.showCavity = true;
+    window.setDisplayOptions(options);
+  }
 
   if (isScripted) {
     // simulate, show that instant, grab what the user would see

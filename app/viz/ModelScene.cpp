@@ -4,7 +4,6 @@
 
 #include <vtkActor.h>
 #include <vtkAxesActor.h>
-#include <vtkBillboardTextActor3D.h>
 #include <vtkCamera.h>
 #include <vtkCaptionActor2D.h>
 #include <vtkCellArray.h>
@@ -21,6 +20,7 @@
 #include <vtkPolyDataMapper.h>
 #include <vtkPolyDataNormals.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkPropCollection.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
@@ -29,6 +29,7 @@
 #include <vtkTextProperty.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -120,14 +121,24 @@ vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::st
   return normals->GetOutput();
 }
 
-vtkSmartPointer<vtkBillboardTextActor3D> makeLabel(const std::string& text) {
-  auto label = vtkSmartPointer<vtkBillboardTextActor3D>::New();
-  label->SetInput(text.c_str());
-  label->GetTextProperty()->SetFontSize(15);
-  label->GetTextProperty()->SetColor(1.0, 1.0, 0.85);
-  label->GetTextProperty()->SetBackgroundColor(0.08, 0.09, 0.12);
-  label->GetTextProperty()->SetBackgroundOpacity(0.6);
-  label->GetTextProperty()->SetJustificationToCentered();
+// a teaching label: a caption drawn over the scene (never hidden by it) with a leader to its point
+vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
+  auto label = vtkSmartPointer<vtkCaptionActor2D>::New();
+  label->SetCaption(text.c_str());
+  label->BorderOff();
+  label->LeaderOn();
+  label->ThreeDimensionalLeaderOff();
+  label->SetPadding(2);
+  label->SetWidth(0.022 + 0.0105 * static_cast<double>(text.size()));
+  label->SetHeight(0.034);
+  label->GetProperty()->SetColor(1.0, 1.0, 0.8);
+  vtkTextProperty* t = label->GetCaptionTextProperty();
+  t->SetColor(1.0, 1.0, 0.85);
+  t->SetBackgroundColor(0.08, 0.09, 0.12);
+  t->SetBackgroundOpacity(0.7);
+  t->ShadowOff();
+  t->ItalicOff();
+  t->BoldOff();
   label->PickableOff();
   return label;
 }
@@ -199,7 +210,7 @@ struct ModelScene::Impl {
 
   // teaching labels: landmarks, group centres, and a few named bones
   struct Label {
-    vtkSmartPointer<vtkBillboardTextActor3D> actor;
+    vtkSmartPointer<vtkCaptionActor2D> actor;
     int landmark = -1, group = -1, body = -1;
   };
   std::vector<Label> labels;
@@ -359,7 +370,9 @@ struct ModelScene::Impl {
 
     // labels
     for (std::size_t l = 0; l < model.landmarks.name.size(); ++l) {
-      Label label{makeLabel(model.landmarks.name[l]), static_cast<int>(l), -1, -1};
+      std::string name = model.landmarks.name[l];
+      std::replace(name.begin(), name.end(), '_', ' ');
+      Label label{makeLabel(name), static_cast<int>(l), -1, -1};
       labels.push_back(label);
     }
     for (int gi = 0; gi < kGroups; ++gi)
@@ -367,7 +380,7 @@ struct ModelScene::Impl {
         labels.push_back(Label{makeLabel(groupLabel(static_cast<sim::ElementGroup>(gi))), -1, gi, -1});
     for (int b = 0; b < model.bodies.size(); ++b) {
       const std::string& name = model.bodies.name[static_cast<std::size_t>(b)];
-      if (name == "sternum" || name == "pelvis") labels.push_back(Label{makeLabel(name), -1, -1, b});
+      if (name == "sternum") labels.push_back(Label{makeLabel(name), -1, -1, b});
     }
 
     // selection highlight: one bright line
@@ -558,15 +571,22 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
   for (const Impl::Label& l : s.labels) {
     Eigen::Vector3d at = Eigen::Vector3d::Zero();
     if (l.landmark >= 0) {
-      at = lm.col(l.landmark) + Eigen::Vector3d(0.0, 0.0, 0.012);
+      at = lm.col(l.landmark);
     } else if (l.body >= 0) {
       at = state.bodyPosition.col(l.body);
     } else {
-      const auto& elems = s.groups[static_cast<std::size_t>(l.group)].element;
-      for (int e : elems) at += 0.5 * (s.endA.col(e) + s.endB.col(e));
-      at /= static_cast<double>(std::max<std::size_t>(elems.size(), 1));
+      // a group is labelled at its element furthest to the subject's right, clear of the midline
+      at = Eigen::Vector3d::Constant(-1e9);
+      for (int e : s.groups[static_cast<std::size_t>(l.group)].element) {
+        const Eigen::Vector3d mid = 0.5 * (s.endA.col(e) + s.endB.col(e));
+        if (mid.x() > at.x()) at = mid;
+      }
     }
-    l.actor->SetPosition(at.x(), at.y(), at.z());
+    l.actor->SetAttachmentPoint(at.x(), at.y(), at.z());
+    // captions beside their point: the subject's right (x > 0) to one side, the rest to the other;
+    // group captions stacked by group so that neighbours do not overlap
+    if (l.group >= 0) l.actor->SetPosition(-165.0, 60.0 - 30.0 * l.group);
+    else l.actor->SetPosition(at.x() > 0.01 ? -150.0 : 40.0, 14.0);
   }
 
   // selection highlight
