@@ -326,3 +326,19 @@ TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
   EXPECT_GT(movie.size(), 1000);
   EXPECT_TRUE(QDir(out.path()).entryList({"*.tmp-*"}, QDir::Files).isEmpty());
 }
+
+TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {
+  ToyWindow w;
+  // gut kappa far beyond what the time step can integrate
+  auto fields = w.window.parameters()->findChildren<QLineEdit*>();
+  QLineEdit* kappa = nullptr;
+  for (QLineEdit* f : fields)
+    if (f->property("label").toString().contains("kPa")) kappa = f;
+  ASSERT_NE(kappa, nullptr);
+  kappa->setText("1e9");
+  emit kappa->editingFinished();
+  EXPECT_FALSE(w.window.runUntil(5.0));
+  EXPECT_TRUE(w.window.lastError().contains("blew up")) << w.window.lastError().toStdString();
+  ASSERT_NE(w.window.shown(), nullptr);
+  EXPECT_FALSE(w.window.shown()->isRunning);
+}
