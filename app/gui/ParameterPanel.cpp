@@ -12,6 +12,8 @@ namespace pneuma::app {
 
 namespace {
 
+constexpr std::size_t kKappaField = 6;  // index of the gut kappa field in m_fields
+
 // scales applied to every muscle group at once (cartilage keeps its own gains)
 double muscleScale(const std::array<double, sim::kElementGroupCount>& scales) { return scales[0]; }
 void setMuscleScale(std::array<double, sim::kElementGroupCount>& scales, double v) {
@@ -114,6 +116,10 @@ void ParameterPanel::edited(const Field& field) {
     field.edit->setStyleSheet(QString());
     return;
   }
+
+  // kappa < 0 would mean "the model's own" to the sim: a typed value must be a real modulus
+  if (field.edit == m_fields[kKappaField].edit && !(value > 0.0))
+    return refuse(field.edit, QString("%1 = %2 refused: must be > 0").arg(name, field.edit->text()));
 
   // check the candidate with the sim's validators; apply nothing unless it passes
   RunSettings candidate = m_settings;

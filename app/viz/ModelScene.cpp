@@ -183,6 +183,7 @@ struct ModelScene::Impl {
   sim::Model model;
   double maxForceSeen = 0.0;  // [N]
   double maxDisplacementSeen = 0.0;  // [m] of the current frame
+  double maxPressureSeen = 0.0;      // [Pa] largest |P| since the model was set
 
   // muscle elements, one actor per group (points 2k, 2k+1 are the ends of the group's k-th element)
   struct Group {
@@ -227,7 +228,7 @@ struct ModelScene::Impl {
     labels.clear();
     gutActor = cavityActor = landmarkActor = highlightActor = nullptr;
     highlight = Pick{};
-    maxForceSeen = maxDisplacementSeen = 0.0;
+    maxForceSeen = maxDisplacementSeen = maxPressureSeen = 0.0;
   }
 
   std::vector<vtkProp*> ownedProps() const {
@@ -551,7 +552,9 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     // the displacement scale follows the current largest displacement (rounded to a nice number)
     s.maxDisplacementSeen = maxDisp;
     if (s.options.gutColouring == GutColouring::Pressure) {
-      const double p = niceCeil(std::max(std::abs(metrics.gutPressure), 1.0));
+      // the pressure is uniform (Eq. 4): its colour moves over a symmetric scale of the largest |P| seen
+      s.maxPressureSeen = std::max(s.maxPressureSeen, std::abs(metrics.gutPressure));
+      const double p = niceCeil(std::max(s.maxPressureSeen, 1.0));
       s.gutTable->SetTableRange(-p, p);
     } else {
       s.gutTable->SetTableRange(0.0, niceCeil(std::max(1000.0 * s.maxDisplacementSeen, 1.0)));

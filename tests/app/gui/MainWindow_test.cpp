@@ -167,6 +167,16 @@ TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
   emit panel->frequencyField()->editingFinished();
   EXPECT_TRUE(panel->refusal().contains("not a number"));
   EXPECT_EQ(panel->settings().style.breathsPerMinute, before);
+
+  // a non-positive gut kappa is refused too (the sim would read it as "use the model's")
+  const double kappaBefore = panel->settings().options.step.kappa;
+  for (QLineEdit* f : panel->findChildren<QLineEdit*>())
+    if (f->property("label").toString().contains("kPa")) {
+      f->setText("-1");
+      emit f->editingFinished();
+    }
+  EXPECT_TRUE(panel->refusal().contains("must be > 0")) << panel->refusal().toStdString();
+  EXPECT_EQ(panel->settings().options.step.kappa, kappaBefore);
 }
 
 // the toy torso is not calibrated to breathe cleanly, so the rate is measured on the default model
