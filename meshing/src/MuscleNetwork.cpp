@@ -20,6 +20,7 @@ constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib t
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
 constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
 constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
+constexpr double kScaleneLength = 0.06;  // [m] rib 1 to the scalene anchors above it (cervical spine)
 
 /// Appends elements to a model, converting endpoints and scaling the group gains by rest length.
 class ElementSink {
@@ -244,6 +245,23 @@ void addCartilage(const Skeleton& sk, ElementSink& sink) {
   }
 }
 
+/// Scalenes: rib 1 hangs from the cervical spine (scalenus anterior, medius, posterior), which holds it
+/// while the intercostals act; without this reference the external intercostals crowd the free ribs
+/// together instead of lifting them (Hamberger's lever needs rib 1 held; De Troyer et al. 2005,
+/// Physiol Rev 85:717). The model has no cervical spine, so three passive structural springs per side
+/// run from rib 1 up by kScaleneLength to anchors on the fixed lumbar-spine body (a fixed world point).
+void addScalenes(const Skeleton& sk, ElementSink& sink) {
+  for (int side : {kRight, kLeft}) {
+    const RibCurve& r = sk.ribCurve[0][static_cast<std::size_t>(side)];
+    const int b = sk.rib[0][static_cast<std::size_t>(side)];
+    for (double f : {0.3, 0.5, 0.7}) {
+      const Eigen::Vector3d p = r.at(f * r.length());
+      sink.add(ElementGroup::Cartilage, Endpoint::onBody(sk.lumbar, p + kScaleneLength * Eigen::Vector3d::UnitZ()),
+               Endpoint::onBody(b, p));
+    }
+  }
+}
+
 }  // namespace
 
 void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface& gut, sim::Model& model) {
@@ -253,6 +271,7 @@ void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   addRectus(sk, gut, sink);
   addTransversusObliques(gut, sink);
   addCartilage(sk, sink);
+  addScalenes(sk, sink);
 }
 
 }  // namespace pneuma::meshing
