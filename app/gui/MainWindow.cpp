@@ -25,8 +25,6 @@
 #include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
-#include <QJsonDocument>
-#include <QJsonObject>
 #include <QLabel>
 #include <QMenu>
 #include <QMenuBar>
@@ -542,29 +540,20 @@ QString MainWindow::saveScenario(const QString& path) {
     // an edited style travels as its own preset file next to the scenario
     const sim::BreathStyle& s = m_settings.style;
     scenario.controllerName = s.name;
+    // compare everything but the note: an unedited preset is referenced by name
     bool isPreset = false;
     try {
-      const sim::BreathStyle preset = sim::loadBreathStyle(s.name);
-      isPreset = preset.breathsPerMinute == s.breathsPerMinute && preset.diaphragmR == s.diaphragmR &&
-                 preset.intercostalMean == s.intercostalMean && preset.intercostalAmplitude == s.intercostalAmplitude &&
-                 preset.inhaleFraction == s.inhaleFraction && preset.rectusActive == s.rectusActive &&
-                 preset.rectusR == s.rectusR && preset.cycles == s.cycles;
+      sim::BreathStyle preset = sim::loadBreathStyle(s.name);
+      preset.note = s.note;
+      isPreset = sim::serializeBreathStyle(preset) == sim::serializeBreathStyle(s);
     } catch (const sim::Error&) {
     }
     if (!isPreset) {
-      QJsonObject json{{"name", QString::fromStdString(s.name)},
-                       {"note", "Edited in the Pneuma desktop app"},
-                       {"breaths_per_minute", s.breathsPerMinute},
-                       {"inhale_fraction", s.inhaleFraction},
-                       {"diaphragm_r", s.diaphragmR},
-                       {"intercostal_mean", s.intercostalMean},
-                       {"intercostal_amplitude", s.intercostalAmplitude},
-                       {"rectus_active", s.rectusActive},
-                       {"rectus_r", s.rectusR},
-                       {"cycles", s.cycles}};
+      sim::BreathStyle edited = s;
+      edited.note = "Edited in the Pneuma desktop app";
       const QFileInfo info(path);
       const QString stylePath = info.absoluteDir().absoluteFilePath(info.completeBaseName() + ".style.json");
-      viz::writeFileAtomically(stylePath.toStdString(), QJsonDocument(json).toJson().toStdString());
+      viz::writeFileAtomically(stylePath.toStdString(), sim::serializeBreathStyle(edited));
       scenario.controllerName = stylePath.toStdString();
     }
     sim::saveScenario(scenario, path.toStdString());

@@ -151,12 +151,8 @@ void SimWorker::sync() {
 
 void SimWorker::applySettings(const RunSettings& settings) {
   m_sim->setOptions(settings.options);
-  if (settings.style.breathsPerMinute != m_settings.style.breathsPerMinute ||
-      settings.style.name != m_settings.style.name || settings.style.diaphragmR != m_settings.style.diaphragmR ||
-      settings.style.intercostalMean != m_settings.style.intercostalMean ||
-      settings.style.intercostalAmplitude != m_settings.style.intercostalAmplitude ||
-      settings.style.inhaleFraction != m_settings.style.inhaleFraction ||
-      settings.style.rectusActive != m_settings.style.rectusActive || settings.style.rectusR != m_settings.style.rectusR) {
+  // a changed style restarts the open-loop controller
+  if (sim::serializeBreathStyle(settings.style) != sim::serializeBreathStyle(m_settings.style)) {
     m_sim->setController(std::make_unique<sim::BreathStyleController>(settings.style));
     m_pattern = nullptr;
   }

@@ -36,6 +36,8 @@ void validateBreathStyle(const BreathStyle& s) {
     requireRange(p + "breaths_per_minute", s.breathsPerMinute, 0.0, 600.0, true);
   requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
   requireRange(p + "diaphragm_r", s.diaphragmR, 0.0, 1.5, true);
+  requireRange(p + "diaphragm_alpha", s.diaphragmAlpha, 0.0, 1.0, true);
+  requireRange(p + "intercostal_alpha", s.intercostalAlpha, 0.0, 1.0, true);
   requireRange(p + "intercostal_amplitude", s.intercostalAmplitude, 0.0, 1.5, false);
   requireRange(p + "intercostal_mean - intercostal_amplitude", s.intercostalMean - s.intercostalAmplitude, 0.0, 1.5,
                true);
@@ -69,8 +71,10 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
     number("breaths_per_minute", s.breathsPerMinute, true);
     number("inhale_fraction", s.inhaleFraction, false);
     number("diaphragm_r", s.diaphragmR, true);
+    number("diaphragm_alpha", s.diaphragmAlpha, false);
     number("intercostal_mean", s.intercostalMean, true);
     number("intercostal_amplitude", s.intercostalAmplitude, true);
+    number("intercostal_alpha", s.intercostalAlpha, false);
     number("rectus_r", s.rectusR, false);
     if (j.contains("rectus_active")) {
       if (!j["rectus_active"].is_boolean()) throw Error(source + ": rectus_active: must be true or false");
@@ -89,6 +93,22 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
     throw Error(source + ": " + e.what());
   }
   return s;
+}
+
+std::string serializeBreathStyle(const BreathStyle& s) {
+  const nlohmann::json j = {{"name", s.name},
+                            {"note", s.note},
+                            {"breaths_per_minute", s.breathsPerMinute},
+                            {"inhale_fraction", s.inhaleFraction},
+                            {"diaphragm_r", s.diaphragmR},
+                            {"diaphragm_alpha", s.diaphragmAlpha},
+                            {"intercostal_mean", s.intercostalMean},
+                            {"intercostal_amplitude", s.intercostalAmplitude},
+                            {"intercostal_alpha", s.intercostalAlpha},
+                            {"rectus_active", s.rectusActive},
+                            {"rectus_r", s.rectusR},
+                            {"cycles", s.cycles}};
+  return j.dump(2) + "\n";
 }
 
 std::string defaultPresetDir() {
@@ -137,10 +157,10 @@ Activations BreathStyleController::activations(double t, const Metrics& /*latest
 
   Activations a = relaxedActivations();
   // diaphragm: step function, on during inhale
-  slot(a, ElementGroup::Diaphragm) = inhale ? GroupActivation{s.diaphragmR, 1.0} : GroupActivation{1.0, 0.0};
+  slot(a, ElementGroup::Diaphragm) = inhale ? GroupActivation{s.diaphragmR, s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
   // intercostals: out-of-phase sinusoids, outer contract (r drops) on inhale, inner on exhale
-  slot(a, ElementGroup::IntercostalExternal) = {s.intercostalMean + s.intercostalAmplitude * c, 1.0};
-  slot(a, ElementGroup::IntercostalInternal) = {s.intercostalMean - s.intercostalAmplitude * c, 1.0};
+  slot(a, ElementGroup::IntercostalExternal) = {s.intercostalMean + s.intercostalAmplitude * c, s.intercostalAlpha};
+  slot(a, ElementGroup::IntercostalInternal) = {s.intercostalMean - s.intercostalAmplitude * c, s.intercostalAlpha};
   // rectus: forced exhale only, during the exhale part
   if (s.rectusActive && !inhale) slot(a, ElementGroup::Rectus) = {s.rectusR, 1.0};
   return a;

@@ -123,6 +123,22 @@ TEST(BreathStyle, PresetsLoadWithTable2Rates) {
   for (const auto& n : breathStyleNames()) EXPECT_FALSE(loadBreathStyle(n).note.empty()) << n;
 }
 
+// partial activation levels (panting) reach the muscles, and a preset survives serialisation
+TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
+  const BreathStyle panting = loadBreathStyle("panting");
+  BreathStyleController c(panting);
+  const Metrics none;
+  const Activations a = c.activations(0.1, none);  // inhale
+  EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha, panting.diaphragmAlpha);
+  EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha);
+  EXPECT_LT(panting.intercostalAlpha, 1.0);
+  const std::string text = serializeBreathStyle(panting);
+  EXPECT_EQ(serializeBreathStyle(parseBreathStyle(text, "panting.json")), text);
+  BreathStyle bad = panting;
+  bad.intercostalAlpha = 1.5;
+  EXPECT_THROW(validateBreathStyle(bad), Error);
+}
+
 // Summary: a pure sine of amplitude A at f gives tidal volume 2 A and 60 f b/m
 TEST(Summary, CycleAnalysisOfASine) {
   Trace t;

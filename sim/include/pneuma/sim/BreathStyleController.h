@@ -4,11 +4,12 @@
 /// controller that plays them.
 ///
 /// One breath cycle of period T = 60 / breathsPerMinute starts at the beginning of inhale:
-///  - diaphragm: a step function (the "pump"), alpha = 1 and r = diaphragmR during the inhale part
-///    [0, inhaleFraction T), alpha = 0 and r = 1 otherwise;
-///  - outer intercostals: r(t) = mean + amplitude cos(2 pi t / T), alpha = 1: r drops smoothly during
-///    the first half-cycle (inhale) and rises again during exhale;
-///  - inner intercostals: out of phase, r(t) = mean - amplitude cos(2 pi t / T), alpha = 1;
+///  - diaphragm: a step function (the "pump"), alpha = diaphragmAlpha and r = diaphragmR during the
+///    inhale part [0, inhaleFraction T), alpha = 0 and r = 1 otherwise. The paper switches alpha
+///    between 0 and 1; a partial level (panting) is our calibration choice, see the preset notes;
+///  - outer intercostals: r(t) = mean + amplitude cos(2 pi t / T), alpha = intercostalAlpha: r drops
+///    smoothly during the first half-cycle (inhale) and rises again during exhale;
+///  - inner intercostals: out of phase, r(t) = mean - amplitude cos(2 pi t / T), alpha = intercostalAlpha;
 ///  - rectus: only when rectusActive (forced exhale): alpha = 1 and r = rectusR during exhale;
 ///  - transversus/obliques and cartilage stay passive (alpha = 0, r = 1).
 /// When cycles > 0 the style plays that many cycles and then holds the cycle-start activations.
@@ -27,8 +28,10 @@ struct BreathStyle {
   double breathsPerMinute = 15.0;     ///< [1/min] > 0
   double inhaleFraction = 0.4;        ///< [-] part of the cycle with the diaphragm on, in (0, 1)
   double diaphragmR = 0.85;           ///< [-] diaphragm contraction ratio during inhale, (0, 1.5]
+  double diaphragmAlpha = 1.0;        ///< [-] diaphragm activation level during inhale, (0, 1]
   double intercostalMean = 0.92;      ///< [-] mean r of the intercostal sinusoids
   double intercostalAmplitude = 0.08; ///< [-] amplitude of the intercostal sinusoids (Table 2 "±")
+  double intercostalAlpha = 1.0;      ///< [-] intercostal activation level, (0, 1]
   bool rectusActive = false;          ///< rectus contracts during exhale (forced exhale only)
   double rectusR = 1.0;               ///< [-] rectus contraction ratio when active
   int cycles = 0;                     ///< [-] 0 = periodic; n > 0 = n cycles, then hold
@@ -39,9 +42,13 @@ struct BreathStyle {
 void validateBreathStyle(const BreathStyle& s);
 
 /// Parses a preset from JSON text (fields: name, note, breaths_per_minute, inhale_fraction,
-/// diaphragm_r, intercostal_mean, intercostal_amplitude, rectus_active, rectus_r, cycles).
+/// diaphragm_r, diaphragm_alpha (optional, default 1), intercostal_mean,
+/// intercostal_alpha (optional, default 1), intercostal_amplitude, rectus_active, rectus_r, cycles).
 /// @throws Error naming `source` and the field.
 BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& source);
+
+/// Serialises a preset to JSON text with the fields parseBreathStyle() reads (round-trips exactly).
+std::string serializeBreathStyle(const BreathStyle& s);
 
 /// Directory holding the breath-style presets: $PNEUMA_RESOURCE_DIR/presets when that variable is
 /// set, else the source tree's resources/presets.
