@@ -30,8 +30,10 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 
 namespace pneuma::viz {
@@ -40,12 +42,10 @@ namespace {
 
 constexpr int kGroups = sim::kElementGroupCount;
 
-// colour scale of contractive force: pale orange (weak) to deep red (strong), never grey or blue
-vtkSmartPointer<vtkLookupTable> makeForceTable() {
+// a 256-entry lookup table sampled from a piecewise-linear colour ramp of (value in [0, 1], r, g, b) points
+vtkSmartPointer<vtkLookupTable> makeRampTable(std::initializer_list<std::array<double, 4>> points) {
   vtkNew<vtkColorTransferFunction> ramp;
-  ramp->AddRGBPoint(0.0, 1.0, 0.78, 0.30);
-  ramp->AddRGBPoint(0.5, 0.95, 0.38, 0.08);
-  ramp->AddRGBPoint(1.0, 0.62, 0.0, 0.05);
+  for (const auto& p : points) ramp->AddRGBPoint(p[0], p[1], p[2], p[3]);
   auto table = vtkSmartPointer<vtkLookupTable>::New();
   table->SetNumberOfTableValues(256);
   for (int i = 0; i < 256; ++i) {
@@ -53,6 +53,12 @@ vtkSmartPointer<vtkLookupTable> makeForceTable() {
     ramp->GetColor(i / 255.0, rgb);
     table->SetTableValue(i, rgb[0], rgb[1], rgb[2], 1.0);
   }
+  return table;
+}
+
+// colour scale of contractive force: pale orange (weak) to deep red (strong), never grey or blue
+vtkSmartPointer<vtkLookupTable> makeForceTable() {
+  auto table = makeRampTable({{0.0, 1.0, 0.78, 0.30}, {0.5, 0.95, 0.38, 0.08}, {1.0, 0.62, 0.0, 0.05}});
   table->SetNanColor(0.62, 0.62, 0.62, 1.0);  // slack elements are grey (Figure 3)
   table->Build();
   return table;
@@ -60,17 +66,7 @@ vtkSmartPointer<vtkLookupTable> makeForceTable() {
 
 // colour scale of the gut: deep blue to cyan to white
 vtkSmartPointer<vtkLookupTable> makeGutTable() {
-  vtkNew<vtkColorTransferFunction> ramp;
-  ramp->AddRGBPoint(0.0, 0.17, 0.25, 0.62);
-  ramp->AddRGBPoint(0.6, 0.25, 0.72, 0.85);
-  ramp->AddRGBPoint(1.0, 0.88, 0.97, 1.0);
-  auto table = vtkSmartPointer<vtkLookupTable>::New();
-  table->SetNumberOfTableValues(256);
-  for (int i = 0; i < 256; ++i) {
-    double rgb[3];
-    ramp->GetColor(i / 255.0, rgb);
-    table->SetTableValue(i, rgb[0], rgb[1], rgb[2], 1.0);
-  }
+  auto table = makeRampTable({{0.0, 0.17, 0.25, 0.62}, {0.6, 0.25, 0.72, 0.85}, {1.0, 0.88, 0.97, 1.0}});
   table->Build();
   return table;
 }
@@ -106,20 +102,6 @@ double niceCeil(double v) {
   return 10.0 * p;
 }
 
-vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::string& bodyName) {
-  if (!std::filesystem::is_regular_file(path))
-    throw sim::Error("bodies." + bodyName + ".mesh: file not found: " + path);
-  vtkNew<vtkXMLPolyDataReader> reader;
-  reader->SetFileName(path.c_str());
-  reader->Update();
-  if (reader->GetErrorCode() != 0 || reader->GetOutput()->GetNumberOfPoints() == 0)
-    throw sim::Error("bodies." + bodyName + ".mesh: not a readable VTK polydata file: " + path);
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputConnection(reader->GetOutputPort());
-  normals->SetFeatureAngle(60.0);
-  normals->Update();
-  return normals->GetOutput();
-}
 
 // a teaching label: a caption drawn over the scene (never hidden by it) with a leader to its point
 vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
@@ -144,6 +126,21 @@ vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
 }
 
 }  // namespace
+
+vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::string& bodyName) {
+  if (!std::filesystem::is_regular_file(path))
+    throw sim::Error("bodies." + bodyName + ".mesh: file not found: " + path);
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0 || reader->GetOutput()->GetNumberOfPoints() == 0)
+    throw sim::Error("bodies." + bodyName + ".mesh: not a readable VTK polydata file: " + path);
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputConnection(reader->GetOutputPort());
+  normals->SetFeatureAngle(60.0);
+  normals->Update();
+  return normals->GetOutput();
+}
 
 const char* groupLabel(sim::ElementGroup g) {
   switch (g) {

@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 
+class vtkPolyData;
 class vtkRenderer;
 class vtkRenderWindowInteractor;
 
@@ -34,6 +35,10 @@ const char* groupLabel(sim::ElementGroup g);
 std::array<double, 3> groupColour(sim::ElementGroup g);
 
 /// What is drawn and how. Defaults: the teaching view of Figure 3 (force-coloured muscles, slack grey).
+/// Reads a body's render mesh (.vtp, body-frame coordinates [m]) with point normals for shading.
+/// @throws sim::Error naming the body ("bodies.<name>.mesh: ...") when the file is missing or unreadable.
+vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::string& bodyName);
+
 struct DisplayOptions {
   MuscleColouring muscleColouring = MuscleColouring::Force;
   GutColouring gutColouring = GutColouring::Displacement;

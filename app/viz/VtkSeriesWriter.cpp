@@ -1,6 +1,7 @@
 #include "viz/VtkSeriesWriter.h"
 
 #include "viz/AtomicFile.h"
+#include "viz/ModelScene.h"
 
 #include "pneuma/sim/Error.h"
 
@@ -16,7 +17,6 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnsignedCharArray.h>
-#include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include <cstdio>
@@ -98,11 +98,7 @@ struct VtkSeriesWriter::Impl {
         continue;
       }
       const std::string path = (fs::path(modelDir) / file).string();
-      vtkNew<vtkXMLPolyDataReader> reader;
-      reader->SetFileName(path.c_str());
-      if (!fs::is_regular_file(path) || (reader->Update(), reader->GetErrorCode() != 0))
-        throw sim::Error("bodies." + model.bodies.name[static_cast<std::size_t>(b)] + ".mesh: cannot read " + path);
-      vtkPolyData* mesh = reader->GetOutput();
+      const vtkSmartPointer<vtkPolyData> mesh = readBodyMesh(path, model.bodies.name[static_cast<std::size_t>(b)]);
       for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p) {
         double q[3];
         mesh->GetPoint(p, q);
