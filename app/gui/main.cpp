@@ -12,10 +12,29 @@
 
 #include <cstdio>
 #include <map>
+#include <string>
+#include <vector>
 
 int main(int argc, char** argv) {
+  // our --style names a breath style: parse the full command line ourselves and keep Qt from
+  // taking it as its widget style (QApplication would consume it and warn)
+  QStringList arguments;
+  std::vector<char*> qtArgv;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    arguments << QString::fromLocal8Bit(argv[i]);
+    if ((arg == "--style" || arg == "-style") && i + 1 < argc) {
+      arguments << QString::fromLocal8Bit(argv[++i]);
+      continue;
+    }
+    if (arg.rfind("--style=", 0) == 0 || arg.rfind("-style=", 0) == 0) continue;
+    qtArgv.push_back(argv[i]);
+  }
+  int qtArgc = static_cast<int>(qtArgv.size());
+  qtArgv.push_back(nullptr);
+
   QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
-  QApplication app(argc, argv);
+  QApplication app(qtArgc, qtArgv.data());
   QApplication::setApplicationName("Pneuma");
   QApplication::setApplicationVersion(PNEUMA_VERSION);
 
@@ -37,7 +56,7 @@ int main(int argc, char** argv) {
                                    "Run for SECONDS of wall time, print render fps and real-time factor, exit.",
                                    "SECONDS");
   parser.addOptions({model, style, camera, labels, speed, screenshot, after, measure});
-  if (!parser.parse(QApplication::arguments())) {
+  if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
   }
