@@ -1,5 +1,7 @@
 #include "pneuma/sim/ModelIO.h"
 
+#include "JsonField.h"
+
 #include "pneuma/sim/Error.h"
 
 #include <nlohmann/json.hpp>
@@ -34,65 +36,7 @@ const char* regionName(NodeRegion r) {
 // ---------------------------------------------------------------------------------------------
 // reading: every accessor carries the JSON path so that errors name the field
 
-class Reader {
- public:
-  Reader(const json& j, std::string path, const std::string& source)
-      : m_j(j), m_path(std::move(path)), m_source(source) {}
-
-  [[noreturn]] void fail(const std::string& why) const {
-    throw Error(m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
-  }
-  const std::string& path() const { return m_path; }
-
-  Reader at(const std::string& key) const {
-    if (!m_j.is_object()) fail("must be an object");
-    auto it = m_j.find(key);
-    if (it == m_j.end()) Reader(m_j, join(key), m_source).fail("missing");
-    return Reader(*it, join(key), m_source);
-  }
-  bool has(const std::string& key) const { return m_j.is_object() && m_j.contains(key); }
-
-  std::size_t size() const {
-    if (!m_j.is_array()) fail("must be an array");
-    return m_j.size();
-  }
-  Reader operator[](std::size_t i) const {
-    return Reader(m_j.at(i), m_path + "[" + std::to_string(i) + "]", m_source);
-  }
-
-  double number() const {
-    if (!m_j.is_number()) fail("must be a number");
-    const double v = m_j.get<double>();
-    if (!std::isfinite(v)) fail("must be finite");
-    return v;
-  }
-  int integer() const {
-    if (!m_j.is_number_integer()) fail("must be an integer");
-    return m_j.get<int>();
-  }
-  bool boolean() const {
-    if (!m_j.is_boolean()) fail("must be true or false");
-    return m_j.get<bool>();
-  }
-  std::string string() const {
-    if (!m_j.is_string()) fail("must be a string");
-    return m_j.get<std::string>();
-  }
-  Eigen::Vector3d vec3() const {
-    if (!m_j.is_array() || m_j.size() != 3) fail("must be an array of 3 numbers");
-    return {(*this)[0].number(), (*this)[1].number(), (*this)[2].number()};
-  }
-  Eigen::Vector3i index3() const {
-    if (!m_j.is_array() || m_j.size() != 3) fail("must be an array of 3 integers");
-    return {(*this)[0].integer(), (*this)[1].integer(), (*this)[2].integer()};
-  }
-
- private:
-  std::string join(const std::string& key) const { return m_path.empty() ? key : m_path + "." + key; }
-  const json& m_j;
-  std::string m_path;
-  const std::string& m_source;
-};
+using Reader = detail::JsonField;
 
 // anchor: {"body": i, "local": [x,y,z]} or {"nodes": [a(,b,c)], "weights": [wa(,wb,wc)]}
 void readAnchor(const Reader& r, AnchorSet& out) {

@@ -1,5 +1,7 @@
 #include "pneuma/sim/Scenario.h"
 
+#include "JsonField.h"
+
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/pattern/PatternController.h"
@@ -22,61 +24,7 @@ namespace {
 
 constexpr const char* kFormatName = "pneuma-scenario";
 
-// a JSON value with its path, so every error names the failing field
-class Field {
- public:
-  Field(const json& j, std::string path, const std::string& source) : m_j(j), m_path(std::move(path)), m_source(source) {}
-
-  [[noreturn]] void fail(const std::string& why) const {
-    throw Error(m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
-  }
-  // rejects keys outside `allowed` (typos must not be silently ignored)
-  void allowKeys(std::initializer_list<const char*> allowed) const {
-    if (!m_j.is_object()) fail("must be an object");
-    for (auto it = m_j.begin(); it != m_j.end(); ++it) {
-      bool isKnown = false;
-      for (const char* k : allowed) isKnown = isKnown || it.key() == k;
-      if (!isKnown) child(it.key()).fail("unknown field");
-    }
-  }
-  bool has(const char* key) const { return m_j.contains(key); }
-  Field child(const std::string& key) const { return Field(m_j.at(key), m_path.empty() ? key : m_path + "." + key, m_source); }
-  Field at(const char* key) const {
-    if (!has(key)) Field(m_j, m_path.empty() ? key : m_path + "." + key, m_source).fail("missing");
-    return child(key);
-  }
-  const json& raw() const { return m_j; }
-
-  double number() const {
-    if (!m_j.is_number()) fail("must be a number, got " + m_j.dump());
-    const double v = m_j.get<double>();
-    if (!std::isfinite(v)) fail("must be finite");
-    return v;
-  }
-  double positive() const {
-    const double v = number();
-    if (v <= 0.0) fail("must be > 0, got " + m_j.dump());
-    return v;
-  }
-  double nonNegative() const {
-    const double v = number();
-    if (v < 0.0) fail("must be >= 0, got " + m_j.dump());
-    return v;
-  }
-  std::string string() const {
-    if (!m_j.is_string()) fail("must be a string, got " + m_j.dump());
-    return m_j.get<std::string>();
-  }
-  bool boolean() const {
-    if (!m_j.is_boolean()) fail("must be true or false, got " + m_j.dump());
-    return m_j.get<bool>();
-  }
-
- private:
-  const json& m_j;
-  std::string m_path;
-  const std::string& m_source;
-};
+using Field = detail::JsonField;
 
 std::string resolve(const std::string& path, const std::string& baseDir) {
   if (path.empty() || fs::path(path).is_absolute() || baseDir.empty()) return path;

@@ -1,5 +1,7 @@
 #include "pneuma/sim/pattern/Pattern.h"
 
+#include "../JsonField.h"
+
 #include "pneuma/sim/Error.h"
 
 #include <nlohmann/json.hpp>
@@ -18,63 +20,7 @@ namespace {
 
 constexpr const char* kFormatName = "pneuma-pattern";
 
-// a JSON node with its path, so every error names the field
-class Node {
- public:
-  Node(const json& j, std::string path, const std::string& source) : m_j(j), m_path(std::move(path)), m_source(source) {}
-
-  [[noreturn]] void fail(const std::string& why) const {
-    throw Error(m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
-  }
-  const std::string& path() const { return m_path; }
-  const json& raw() const { return m_j; }
-
-  // object access; `allowed` lists every accepted key so that typos are rejected
-  void requireKeys(std::initializer_list<const char*> allowed) const {
-    if (!m_j.is_object()) fail("must be an object");
-    for (auto it = m_j.begin(); it != m_j.end(); ++it) {
-      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; }))
-        child(it.key(), *it).fail("unknown field");
-    }
-  }
-  bool has(const char* key) const { return m_j.is_object() && m_j.contains(key); }
-  Node at(const char* key) const {
-    if (!has(key)) child(key, m_j).fail("missing");
-    return child(key, m_j.at(key));
-  }
-  Node operator[](std::size_t i) const { return Node(m_j.at(i), m_path + "[" + std::to_string(i) + "]", m_source); }
-  std::size_t size() const {
-    if (!m_j.is_array()) fail("must be an array");
-    return m_j.size();
-  }
-
-  double number() const {
-    if (!m_j.is_number()) fail("must be a number");
-    const double x = m_j.get<double>();
-    if (!std::isfinite(x)) fail("must be finite");
-    return x;
-  }
-  std::string string() const {
-    if (!m_j.is_string()) fail("must be a string");
-    return m_j.get<std::string>();
-  }
-  // rethrows a validation message "field: reason" of a child of this node with its full path
-  [[noreturn]] void failBelow(const std::string& fieldAndReason) const {
-    throw Error(m_source + ": " + (m_path.empty() ? "" : m_path + ".") + fieldAndReason);
-  }
-  double numberOr(const char* key, double fallback) const { return has(key) ? at(key).number() : fallback; }
-  std::string stringOr(const char* key, const std::string& fallback) const {
-    return has(key) ? at(key).string() : fallback;
-  }
-
- private:
-  Node child(const std::string& key, const json& j) const {
-    return Node(j, m_path.empty() ? key : m_path + "." + key, m_source);
-  }
-  const json& m_j;
-  std::string m_path;
-  const std::string& m_source;
-};
+using Node = sim::detail::JsonField;
 
 CycleKind parseKind(const Node& n) {
   const std::string k = n.string();
@@ -84,7 +30,7 @@ CycleKind parseKind(const Node& n) {
 }
 
 CycleSpec parseCycle(const Node& n) {
-  n.requireKeys({"kind", "time", "rate_bpm", "depth", "ie_ratio", "post_inspiratory_pause_s",
+  n.allowKeys({"kind", "time", "rate_bpm", "depth", "ie_ratio", "post_inspiratory_pause_s",
                  "post_expiratory_pause_s", "irregularity", "balance", "keyframes"});
   CycleSpec c;
   c.kind = parseKind(n.at("kind"));
@@ -109,7 +55,7 @@ CycleSpec parseCycle(const Node& n) {
   c.postExpiratoryPause = n.numberOr("post_expiratory_pause_s", 0.0);
   if (n.has("irregularity")) {
     const Node irr = n.at("irregularity");
-    irr.requireKeys({"rate", "depth"});
+    irr.allowKeys({"rate", "depth"});
     c.rateIrregularity = irr.numberOr("rate", 0.0);
     c.depthIrregularity = irr.numberOr("depth", 0.0);
   }
@@ -135,7 +81,7 @@ CycleSpec parseCycle(const Node& n) {
 }
 
 Layer parseLayer(const Node& n) {
-  n.requireKeys({"name", "repeat", "cycle"});
+  n.allowKeys({"name", "repeat", "cycle"});
   Layer l;
   l.name = n.at("name").string();
   const Node repeat = n.at("repeat");
@@ -200,7 +146,7 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
     throw Error(sourceName + ": invalid JSON: " + e.what());
   }
   const Node root(j, "", sourceName);
-  root.requireKeys({"format", "version", "name", "description", "layers", "affect", "timeline"});
+  root.allowKeys({"format", "version", "name", "description", "layers", "affect", "timeline"});
 
   // header
   const Node format = root.at("format");
@@ -219,7 +165,7 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
     const Node events = root.at("timeline");
     for (std::size_t i = 0; i < events.size(); ++i) {
       const Node e = events[i];
-      e.requireKeys({"time_s", "switch", "label", "layers", "affect"});
+      e.allowKeys({"time_s", "switch", "label", "layers", "affect"});
       TimelineEvent ev;
       const Node time = e.at("time_s");
       ev.time = time.number();
