@@ -91,8 +91,7 @@ void runBench(const BenchArgs& args) {
   sim::SimulationOptions options;
   options.settleTime = 0.0;
   options.recordSeconds = 1.0;
-  if (!args.integrator.empty() && !sim::integratorFromName(args.integrator, options.step.integrator))
-    fail(kExitBadInput, "--integrator: unknown integrator '" + args.integrator + "' (valid: symplectic-euler, implicit-euler)");
+  applyIntegrator(args.integrator, options.step.integrator);
   std::shared_ptr<const sim::Model> model;
   std::vector<sim::BreathStyle> styles;
   try {
@@ -146,10 +145,10 @@ void runBench(const BenchArgs& args) {
 void addBenchCommand(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand("bench", "Real-time factor per breath style and step time per element count");
-  cmd->add_option("--model", args->model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+  addModelOption(*cmd, args->model);
   cmd->add_option("--out", args->out, "Also write bench.json into this directory");
   cmd->add_option("--seconds", args->seconds, "Simulated seconds per measurement (default 4)");
-  cmd->add_option("--integrator", args->integrator, "symplectic-euler or implicit-euler (default implicit-euler)");
+  addIntegratorOption(*cmd, args->integrator);
   cmd->callback([args] { runBench(*args); });
 }
 

@@ -64,4 +64,17 @@ std::string formatNumber(double v) {
   return buf;
 }
 
+void addModelOption(CLI::App& cmd, std::string& model) {
+  cmd.add_option("--model", model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+}
+
+void addIntegratorOption(CLI::App& cmd, std::string& name) {
+  cmd.add_option("--integrator", name, "symplectic-euler or implicit-euler (default implicit-euler)");
+}
+
+void applyIntegrator(const std::string& name, sim::IntegratorKind& kind) {
+  if (!name.empty() && !sim::integratorFromName(name, kind))
+    fail(kExitBadInput, "--integrator: unknown integrator '" + name + "' (valid: symplectic-euler, implicit-euler)");
+}
+
 }  // namespace pneuma::app

@@ -3,7 +3,13 @@
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
 /// resources, preparing output directories, number formatting for JSON/CSV.
 
+#include "pneuma/sim/Step.h"
+
 #include <string>
+
+namespace CLI {
+class App;
+}
 
 namespace pneuma::app {
 
@@ -22,6 +28,15 @@ enum ExitCode : int {
 /// The model directory to use: `requested` when given, else $PNEUMA_MODEL_DIR, else
 /// <directory of pneuma-cli>/../models/default. Fails with kExitBadInput when it has no model.json.
 std::string resolveModelDir(const std::string& requested);
+
+/// Adds `--model DIR` to `cmd` (resolved later by resolveModelDir()).
+void addModelOption(CLI::App& cmd, std::string& model);
+
+/// Adds `--integrator NAME` to `cmd`; applyIntegrator() reads it.
+void addIntegratorOption(CLI::App& cmd, std::string& name);
+
+/// Sets `kind` from an --integrator value ("" keeps it); an unknown name fails with kExitBadInput and the valid names.
+void applyIntegrator(const std::string& name, sim::IntegratorKind& kind);
 
 /// The resource directory (presets, scenarios): $PNEUMA_RESOURCE_DIR when set, else the source tree's resources/.
 std::string resourceDir();

@@ -76,8 +76,7 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   }
   if (a.vtk) s.outputs.vtk = true;
   if (a.isGiven("--seed")) s.seed = a.seed;
-  if (!a.integrator.empty() && !sim::integratorFromName(a.integrator, s.options.step.integrator))
-    fail(kExitBadInput, "--integrator: unknown integrator '" + a.integrator + "' (valid: symplectic-euler, implicit-euler)");
+  applyIntegrator(a.integrator, s.options.step.integrator);
   if (a.isGiven("--dt")) {
     if (!(a.dt > 0.0)) fail(kExitBadInput, "--dt: must be > 0 s, got " + formatNumber(a.dt));
     s.options.dt = a.dt;
@@ -213,7 +212,7 @@ void runSimulate(const SimulateArgs& args) {
 void addSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulate breathing; write timeseries.csv, summary.json and plots");
-  cmd->add_option("--model", args->model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+  addModelOption(*cmd, args->model);
   auto* style = cmd->add_option("--style", args->style, "Breath style preset (calm, deep, panting, forced-exhale)");
   auto* affect = cmd->add_option("--affect", args->affect, "Affect preset (neutral, startle, ... see docs/cli.md)");
   cmd->add_option("--scenario", args->scenario, "Scenario file (JSON); other options override it");
@@ -225,7 +224,7 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_option("--output-rate", args->outputRate, "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
   cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
   cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams (default 0)");
-  cmd->add_option("--integrator", args->integrator, "symplectic-euler or implicit-euler (default implicit-euler)");
+  addIntegratorOption(*cmd, args->integrator);
   cmd->add_option("--dt", args->dt, "Time step [s] (default: the integrator's default)");
   cmd->add_option("--settle", args->settle, "Settling time before the controller starts [s] (default 2)");
   args->isGiven = [cmd](const char* flag) { return cmd->count(flag) > 0; };

@@ -99,8 +99,7 @@ void runValidate(const ValidateArgs& args) {
     settings.impactSettle = 1.0;
     settings.impactDuration = 0.5;
   }
-  if (!args.integrator.empty() && !sim::integratorFromName(args.integrator, settings.simulation.step.integrator))
-    fail(kExitBadInput, "--integrator: unknown integrator '" + args.integrator + "' (valid: symplectic-euler, implicit-euler)");
+  applyIntegrator(args.integrator, settings.simulation.step.integrator);
   if (args.dt < 0.0 || args.dt > 0.05) fail(kExitBadInput, "--dt: must be in (0, 0.05] s, got " + formatNumber(args.dt));
   settings.simulation.dt = args.dt;
   std::shared_ptr<const sim::Model> model;
@@ -260,10 +259,10 @@ void runValidate(const ValidateArgs& args) {
 void addValidateCommand(CLI::App& app) {
   auto args = std::make_shared<ValidateArgs>();
   CLI::App* cmd = app.add_subcommand("validate", "Rerun the papers' experiments; write report.html, report.md, report.json");
-  cmd->add_option("--model", args->model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+  addModelOption(*cmd, args->model);
   cmd->add_option("--out", args->out, "Output directory (default: ./validation)");
   cmd->add_flag("--quick", args->isQuick, "Shorter runs (same checks), for tests and quick looks");
-  cmd->add_option("--integrator", args->integrator, "symplectic-euler or implicit-euler (default implicit-euler)");
+  addIntegratorOption(*cmd, args->integrator);
   cmd->add_option("--dt", args->dt, "Time step [s] (default: the integrator's default)");
   cmd->callback([args] { runValidate(*args); });
 }
