@@ -80,16 +80,8 @@ void applyAnchorForce(const AnchorSet& a, int i, const Vector3d& lever, const Ve
 
 Eigen::Index nodeOffset(const Model& m, int n) { return 6 * static_cast<Eigen::Index>(m.bodies.size()) + 3 * n; }
 
-// velocity of endpoint `side` (0 = A, 1 = B) of element e under generalized velocity u, using the
-// per-element endpoint classification of StepWork (body, single node, or weighted nodes)
-Vector3d anchorVelocity(const Model& m, const StepWork& w, int side, int e, const Vector3d& lever,
-                        const Eigen::VectorXd& u) {
-  const double* x = u.data();
-  const int b = w.endpointBody(side, e);
-  if (b >= 0) return Eigen::Map<const Vector3d>(x + 6 * b) + Eigen::Map<const Vector3d>(x + 6 * b + 3).cross(lever);
-  const int n = w.endpointNode(side, e);
-  if (n >= 0) return Eigen::Map<const Vector3d>(x + nodeOffset(m, n));
-  const AnchorSet& a = side == 0 ? m.elements.endA : m.elements.endB;
+// velocity of a weighted-node endpoint (the rare case of anchorVelocity)
+Vector3d weightedNodeVelocity(const Model& m, const AnchorSet& a, int e, const double* x) {
   Vector3d v = Vector3d::Zero();
   for (int k = 0; k < 3; ++k) {
     const int nk = a.nodes(k, e);
@@ -98,9 +90,29 @@ Vector3d anchorVelocity(const Model& m, const StepWork& w, int side, int e, cons
   return v;
 }
 
+// velocity of endpoint `side` (0 = A, 1 = B) of element e under generalized velocity u, using the
+// per-element endpoint classification of StepWork (body, single node, or weighted nodes)
+inline Vector3d anchorVelocity(const Model& m, const StepWork& w, int side, int e, const Vector3d& lever,
+                               const Eigen::VectorXd& u) {
+  const double* x = u.data();
+  const int b = w.endpointBody(side, e);
+  if (b >= 0) return Eigen::Map<const Vector3d>(x + 6 * b) + Eigen::Map<const Vector3d>(x + 6 * b + 3).cross(lever);
+  const int n = w.endpointNode(side, e);
+  if (n >= 0) return Eigen::Map<const Vector3d>(x + nodeOffset(m, n));
+  return weightedNodeVelocity(m, side == 0 ? m.elements.endA : m.elements.endB, e, x);
+}
+
+// adds a point force f at a weighted-node endpoint to the generalized force out (the rare case of addAnchorGeneralized)
+void addWeightedNodeForce(const Model& m, const AnchorSet& a, int e, const Vector3d& f, double* out) {
+  for (int k = 0; k < 3; ++k) {
+    const int nk = a.nodes(k, e);
+    if (nk >= 0) Eigen::Map<Vector3d>(out + nodeOffset(m, nk)) += a.weights(k, e) * f;
+  }
+}
+
 // adds the generalized force of a point force f at endpoint `side` of element e to out
-void addAnchorGeneralized(const Model& m, const StepWork& w, int side, int e, const Vector3d& lever, const Vector3d& f,
-                          Eigen::VectorXd& out) {
+inline void addAnchorGeneralized(const Model& m, const StepWork& w, int side, int e, const Vector3d& lever,
+                                 const Vector3d& f, Eigen::VectorXd& out) {
   double* x = out.data();
   const int b = w.endpointBody(side, e);
   if (b >= 0) {
@@ -113,11 +125,7 @@ void addAnchorGeneralized(const Model& m, const StepWork& w, int side, int e, co
     Eigen::Map<Vector3d>(x + nodeOffset(m, n)) += f;
     return;
   }
-  const AnchorSet& a = side == 0 ? m.elements.endA : m.elements.endB;
-  for (int k = 0; k < 3; ++k) {
-    const int nk = a.nodes(k, e);
-    if (nk >= 0) Eigen::Map<Vector3d>(x + nodeOffset(m, nk)) += a.weights(k, e) * f;
-  }
+  addWeightedNodeForce(m, side == 0 ? m.elements.endA : m.elements.endB, e, f, x);
 }
 
 // zero the entries of fixed bodies and nodes
