@@ -322,42 +322,24 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
     out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
 }
 
-// Jacobi preconditioner: diagonal of M + dt D + dt^2 K (element terms on translations and, through the
-// lever arm, rotations; joint friction and stiffness on rotations)
-void buildPreconditioner(const Model& model, const StepOptions& o, const StepWork& w, double dt, Eigen::VectorXd& diag) {
-  for (int b = 0; b < model.bodies.size(); ++b) {
-    const Matrix3d& r = w.rotation[at(b)];
-    const Matrix3d iw = r * model.bodies.inertia[at(b)] * r.transpose();
-    diag.segment<3>(6 * b).setConstant(model.bodies.mass(b));
-    diag.segment<3>(6 * b + 3) = iw.diagonal();
-  }
+// Jacobi preconditioner of the gut nodes: inverse diagonal of M + dt D + dt^2 K on node entries (element
+// terms with the squared barycentric weights); body entries are left zero (the factored body block covers them)
+void buildPreconditioner(const Model& model, const StepWork& w, double dt, Eigen::VectorXd& diag) {
+  diag.setZero();
   for (int n = 0; n < model.nodes.size(); ++n) diag.segment<3>(nodeOffset(model, n)).setConstant(model.nodes.mass(n));
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
     const double k = dt * dt * (w.elementStiffness(e) + w.elementGeometric(e)) + dt * w.elementDamping(e);
     if (k == 0.0) continue;
-    const Vector3d d = w.elementDirection.col(e);
-    const Vector3d d2 = d.cwiseAbs2();
+    const Vector3d d2 = w.elementDirection.col(e).cwiseAbs2();
     for (int side = 0; side < 2; ++side) {
-      const int b = w.endpointBody(side, e);
-      if (b >= 0) {
-        const Vector3d lever = side == 0 ? w.leverA.col(e) : w.leverB.col(e);
-        diag.segment<3>(6 * b) += k * d2;
-        diag.segment<3>(6 * b + 3) += k * lever.cross(d).cwiseAbs2();
-        continue;
-      }
+      if (w.endpointBody(side, e) >= 0) continue;
       const AnchorSet& a = side == 0 ? el.endA : el.endB;
       for (int i = 0; i < 3; ++i) {
         const int n = a.nodes(i, e);
         if (n >= 0) diag.segment<3>(nodeOffset(model, n)) += (k * a.weights(i, e) * a.weights(i, e)) * d2;
       }
     }
-  }
-  const Joints& j = model.joints;
-  for (int i = 0; i < j.size(); ++i) {
-    const double kj = dt * dt * j.stiffness(i) + dt * j.friction(i) * o.jointFrictionScale;
-    diag.segment<3>(6 * j.parent[at(i)] + 3).array() += kj;
-    diag.segment<3>(6 * j.child[at(i)] + 3).array() += kj;
   }
   for (Eigen::Index i = 0; i < diag.size(); ++i) diag(i) = diag(i) > 0.0 ? 1.0 / diag(i) : 0.0;
 }
@@ -415,7 +397,7 @@ void factorBodyBlock(const Model& model, const StepOptions& o, StepWork& w, doub
 // z = P^-1 r: the factored body block for bodies, Jacobi for nodes
 void applyPreconditioner(const StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
   const Eigen::Index nb6 = w.bodyBlock.rows();
-  z = w.cgDiag.cwiseProduct(r);
+  z.tail(z.size() - nb6) = w.cgDiag.tail(z.size() - nb6).cwiseProduct(r.tail(r.size() - nb6));
   if (nb6 > 0) z.head(nb6) = w.bodyFactor.solve(r.head(nb6));
 }
 
@@ -440,7 +422,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   maskFixed(w, rhs);
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
-  buildPreconditioner(model, o, w, dt, w.cgDiag);
+  buildPreconditioner(model, w, dt, w.cgDiag);
   if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, w, dt);
   maskFixed(w, x);
   applyStiffnessDamping(model, o, w, x, dt * dt, dt, q);

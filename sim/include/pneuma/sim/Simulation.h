@@ -89,7 +89,7 @@ class Simulation {
   Trace m_trace;
   Recorder m_recorder;
   double m_nextFrameTime = 0.0; // [s]
-  double m_wallSeconds = 0.0;   // [s] wall-clock time spent stepping
+  double m_wallSeconds = 0.0;   // [s] wall-clock time spent stepping, measuring and recording
   double m_simulatedSeconds = 0.0;  // [s] simulated while timed
 };
 
