@@ -67,6 +67,8 @@ class Simulation {
   const Activations& currentActivations() const { return m_activations; }
   const Trace& trace() const { return m_trace; }
   const Recorder& recorder() const { return m_recorder; }
+  /// Solver by-products of the latest step (CG iterations, joint error, element forces).
+  const StepWork& stepWork() const { return m_work; }
   /// Summary over the run so far (see summarize()), with real-time factor, steps and dt.
   Summary summary() const;
   /// [-] simulated seconds per wall-clock second spent inside advance()/stepOnce().
