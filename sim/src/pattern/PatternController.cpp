@@ -16,39 +16,76 @@ constexpr ElementGroup kDrivenGroups[] = {ElementGroup::IntercostalExternal, Ele
                                           ElementGroup::Diaphragm, ElementGroup::Rectus,
                                           ElementGroup::TransversusObliques};
 
-// split a volume-fraction demand >= 0 between two muscles with useful gains gA, gB >= 0 (0: the muscle
-// cannot help): A takes `shareA` of it, and a muscle saturating at alpha = 1 (or unable to help) hands its
-// remainder to the other one
-std::pair<double, double> splitDemand(double demand, double shareA, double gA, double gB) {
-  if (gA <= 0.0) shareA = 0.0;
-  if (gB <= 0.0) shareA = 1.0;
-  double a = gA > 0.0 ? demand * shareA / gA : 0.0, b = gB > 0.0 ? demand * (1.0 - shareA) / gB : 0.0;
-  if (a > 1.0 && gB > 0.0) b += (a - 1.0) * gA / gB, a = 1.0;
-  if (b > 1.0 && gA > 0.0) a += (b - 1.0) * gB / gA, b = 1.0;
-  return {std::min(a, 1.0), std::min(b, 1.0)};
+// the useful part of a response curve in direction `sign` (+1 raises, -1 lowers the volume), made
+// monotone: reach[k] = max over j <= k of max(sign R[j], 0); reach.back() is the group's capacity
+GroupResponse reach(const GroupResponse& response, double sign) {
+  GroupResponse r{};
+  for (std::size_t k = 1; k < r.size(); ++k) r[k] = std::max(r[k - 1], sign * response[k]);
+  return r;
 }
 
-// useful gains: how much each group raises (inspiratory) or lowers (expiratory) the volume fraction per
-// unit alpha; a group acting the other way on this model gets 0 and is not used
-double raises(const DriveCalibration& c, ElementGroup g) { return std::max(c.gain[idx(g)], 0.0); }
-double lowers(const DriveCalibration& c, ElementGroup g) { return std::max(-c.gain[idx(g)], 0.0); }
+// the activation whose reach is `demand` (linear between levels; 1 beyond the capacity)
+double invert(const GroupResponse& reach, double demand) {
+  for (std::size_t k = 1; k < reach.size(); ++k)
+    if (reach[k] >= demand && reach[k] > reach[k - 1])
+      return kCalibrationAlphas[k - 1] +
+             (demand - reach[k - 1]) / (reach[k] - reach[k - 1]) * (kCalibrationAlphas[k] - kCalibrationAlphas[k - 1]);
+  return 1.0;
+}
 
-// holds one group at a constant activation during [start, end) of control time, relaxed otherwise
-class StepController : public Controller {
+// split a demand >= 0 between a chest and a belly lever: chest takes `share` of it, and a lever that
+// cannot give its part (capacity reached, or no capacity at all) hands the rest to the other one;
+// returns the two activations
+std::pair<double, double> splitDemand(double demand, double share, const GroupResponse& chest,
+                                      const GroupResponse& belly) {
+  const double capChest = chest.back(), capBelly = belly.back();
+  if (capChest <= 0.0) share = 0.0;
+  if (capBelly <= 0.0) share = 1.0;
+  double dChest = demand * share, dBelly = demand - dChest;
+  if (dBelly > capBelly) dChest += dBelly - capBelly, dBelly = capBelly;
+  if (dChest > capChest) dBelly = std::min(dBelly + dChest - capChest, capBelly), dChest = capChest;
+  return {capChest > 0.0 ? invert(chest, dChest) : 0.0, capBelly > 0.0 ? invert(belly, dBelly) : 0.0};
+}
+
+// the four levers of the drive: inspiratory chest and belly, expiratory chest and belly (abdominal wall:
+// rectus and transversus/obliques at one activation, their useful reaches added)
+struct Levers {
+  GroupResponse chestIn, bellyIn, chestOut, bellyOut;
+};
+Levers levers(const DriveCalibration& c) {
+  Levers l;
+  l.chestIn = reach(c.response[idx(ElementGroup::IntercostalExternal)], 1.0);
+  l.bellyIn = reach(c.response[idx(ElementGroup::Diaphragm)], 1.0);
+  l.chestOut = reach(c.response[idx(ElementGroup::IntercostalInternal)], -1.0);
+  const GroupResponse rectus = reach(c.response[idx(ElementGroup::Rectus)], -1.0);
+  const GroupResponse obliques = reach(c.response[idx(ElementGroup::TransversusObliques)], -1.0);
+  for (std::size_t k = 0; k < l.bellyOut.size(); ++k) l.bellyOut[k] = rectus[k] + obliques[k];
+  return l;
+}
+
+// calibration run: each driven group in turn rests for kRest, then steps through the non-zero levels of
+// kCalibrationAlphas, kLevel at each (r fixed); control time t
+constexpr double kRest = 0.6;   // [s]
+constexpr double kLevel = 0.8;  // [s]
+constexpr double kGroupTime = kRest + kLevel * (kCalibrationAlphas.size() - 1);  // [s] per group
+class StaircaseController : public Controller {
  public:
-  StepController(ElementGroup group, double alpha, double r, double start, double end)
-      : m_group(group), m_alpha(alpha), m_r(r), m_start(start), m_end(end) {}
+  explicit StaircaseController(double r) : m_r(r) {}
   Activations activations(double t, const Metrics&) override {
     Activations a = relaxedActivations();
-    if (t >= m_start && t < m_end) a[idx(m_group)] = {m_r, m_alpha};
+    const auto group = static_cast<std::size_t>(t / kGroupTime);
+    const double tGroup = t - group * kGroupTime;
+    if (group < std::size(kDrivenGroups) && tGroup >= kRest) {
+      const auto level = std::min(1 + static_cast<std::size_t>((tGroup - kRest) / kLevel), kCalibrationAlphas.size() - 1);
+      a[idx(kDrivenGroups[group])] = {m_r, kCalibrationAlphas[level]};
+    }
     return a;
   }
-  std::string describe() const override { return std::string("calibration step of ") + groupName(m_group); }
-  std::unique_ptr<Controller> clone() const override { return std::make_unique<StepController>(*this); }
+  std::string describe() const override { return "drive calibration staircase"; }
+  std::unique_ptr<Controller> clone() const override { return std::make_unique<StaircaseController>(*this); }
 
  private:
-  ElementGroup m_group;
-  double m_alpha, m_r, m_start, m_end;
+  double m_r;
 };
 
 // mean lung volume [m^3] of the trace frames with time in [from, to)
@@ -63,22 +100,33 @@ double meanVolume(const Trace& trace, double from, double to) {
 
 }  // namespace
 
+double groupResponse(const DriveCalibration& c, ElementGroup g, double alpha) {
+  const GroupResponse& r = c.response[idx(g)];
+  alpha = std::clamp(alpha, 0.0, 1.0);
+  std::size_t k = 1;
+  while (k + 1 < r.size() && kCalibrationAlphas[k] < alpha) ++k;
+  const double w = (alpha - kCalibrationAlphas[k - 1]) / (kCalibrationAlphas[k] - kCalibrationAlphas[k - 1]);
+  return r[k - 1] + w * (r[k] - r[k - 1]);
+}
+
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options,
                                 double contractionR) {
-  // each group alone at a small activation: rest window, then the held window once the volume has settled
-  constexpr double kAlpha = 0.05;  // [-] small: the local gain near rest, where breathing happens
-  constexpr double kHold = 2.5;    // [s] activation held
-  constexpr double kWindow = 0.5;  // [s] averaging window at the end of each phase
+  constexpr double kRestWindow = 0.3;   // [s] baseline: end of each rest
+  constexpr double kLevelWindow = 0.4;  // [s] response: end of each level
   DriveCalibration c;
   c.contractionR = contractionR;
   const double t0 = options.settleTime;
-  for (ElementGroup g : kDrivenGroups) {
-    Simulation sim(model, std::make_unique<StepController>(g, kAlpha, contractionR, kWindow, kWindow + kHold), options);
-    sim.advance(t0 + kWindow + kHold);
-    const double rest = meanVolume(sim.trace(), t0, t0 + kWindow);
-    const double held = meanVolume(sim.trace(), t0 + kWindow + kHold - kWindow, t0 + kWindow + kHold);
-    c.restVolume = rest;
-    c.gain[idx(g)] = (held - rest) / (c.volumePerFraction * kAlpha);
+  Simulation sim(std::move(model), std::make_unique<StaircaseController>(contractionR), options);
+  sim.advance(t0 + kGroupTime * std::size(kDrivenGroups));
+  for (std::size_t n = 0; n < std::size(kDrivenGroups); ++n) {
+    const double start = t0 + n * kGroupTime;
+    const double rest = meanVolume(sim.trace(), start + kRest - kRestWindow, start + kRest);
+    if (n == 0) c.restVolume = rest;
+    GroupResponse& r = c.response[idx(kDrivenGroups[n])];
+    for (std::size_t k = 1; k < r.size(); ++k) {
+      const double end = start + kRest + k * kLevel;
+      r[k] = (meanVolume(sim.trace(), end - kLevelWindow, end) - rest) / c.volumePerFraction;
+    }
   }
   return c;
 }
@@ -98,19 +146,19 @@ PatternController::PatternController(LayerStack stack, DriveCalibration calibrat
       m_description(std::move(description)) {
   const DriveCalibration& c = m_calibration;
   for (ElementGroup g : kDrivenGroups)
-    if (!std::isfinite(c.gain[idx(g)]))
-      throw Error(std::string("calibration.gain.") + groupName(g) + ": must be finite, got " +
-                  std::to_string(c.gain[idx(g)]));
-  if (raises(c, ElementGroup::IntercostalExternal) + raises(c, ElementGroup::Diaphragm) <= 0.0)
-    throw Error("calibration.gain: neither intercostal_external nor diaphragm raises the lung volume");
-  if (lowers(c, ElementGroup::IntercostalInternal) + lowers(c, ElementGroup::Rectus) +
-          lowers(c, ElementGroup::TransversusObliques) <= 0.0)
-    throw Error("calibration.gain: none of intercostal_internal, rectus, transversus_obliques lowers the lung volume");
+    for (std::size_t k = 0; k < kCalibrationAlphas.size(); ++k)
+      if (!std::isfinite(c.response[idx(g)][k]))
+        throw Error(std::string("calibration.response.") + groupName(g) + "[" + std::to_string(k) +
+                    "]: must be finite, got " + std::to_string(c.response[idx(g)][k]));
+  const Levers l = levers(c);
+  if (l.chestIn.back() + l.bellyIn.back() <= 0.0)
+    throw Error("calibration.response: neither intercostal_external nor diaphragm raises the lung volume");
+  if (l.chestOut.back() + l.bellyOut.back() <= 0.0)
+    throw Error("calibration.response: none of intercostal_internal, rectus, transversus_obliques lowers the lung volume");
   if (!(c.volumePerFraction > 0.0)) throw Error("calibration.volumePerFraction: must be > 0");
   if (!(c.restVolume >= 0.0)) throw Error("calibration.restVolume: must be >= 0");
   if (!(c.contractionR > 0.0 && c.contractionR <= 1.5)) throw Error("calibration.contractionR: must be in (0, 1.5]");
-  if (!(options.kp >= 0.0 && options.ki >= 0.0 && options.integralLimit >= 0.0 && options.lead >= 0.0 &&
-        options.balanceTimeConstant > 0.0))
+  if (!(options.kp >= 0.0 && options.ki >= 0.0 && options.integralLimit >= 0.0 && options.balanceTimeConstant > 0.0))
     throw Error("pattern controller options: gains and times must be >= 0 (balanceTimeConstant > 0)");
   m_balance = m_stack.balance();
 }
@@ -163,17 +211,22 @@ Activations PatternController::activations(double t, const Metrics& latest) {
   const double dt = t - m_lastTime;
   m_lastTime = t;
 
-  // target and its rate of change
-  const double previous = m_target;
+  // target, and the feed-forward demand: its distance from rest
   m_target = m_stack.sample(t - m_startTime);
-  const double targetRate = dt > 0.0 ? (m_target - previous) / dt : 0.0;  // [1/s]
+  const double feedForward = m_target - m_calibration.restFraction;
 
   // feedback: a new frame was measured at this very control time
   if (latest.time > m_lastFrameTime && m_calibration.restVolume > 0.0) {
     m_measured = volumeToFraction(latest.lungVolume);
     m_error = m_target - m_measured;
-    m_integral = std::clamp(m_integral + m_options.ki * m_error * (t - m_lastFrameControlTime),
-                            -m_options.integralLimit, m_options.integralLimit);
+    // anti-windup: integrate only while the muscles can still give what the error asks for
+    const double demand = feedForward + m_options.kp * m_error + m_integral;
+    const Levers l = levers(m_calibration);
+    const bool isSaturated = m_error > 0.0 ? demand >= l.chestIn.back() + l.bellyIn.back()
+                                           : -demand >= l.chestOut.back() + l.bellyOut.back();
+    if (!isSaturated)
+      m_integral = std::clamp(m_integral + m_options.ki * m_error * (t - m_lastFrameControlTime),
+                              -m_options.integralLimit, m_options.integralLimit);
     m_lastFrameTime = latest.time;
     m_lastFrameControlTime = t;
     // statistics
@@ -186,31 +239,25 @@ Activations PatternController::activations(double t, const Metrics& latest) {
   // smooth balance changes between layers
   m_balance += (m_stack.balance() - m_balance) * (1.0 - std::exp(-dt / m_options.balanceTimeConstant));
 
-  // feed-forward plus feedback, in volume-fraction units
-  const double drive = (m_target - m_calibration.restFraction) + m_options.lead * targetRate +
-                       m_options.kp * m_error + m_integral;
-  return distribute(drive, m_balance);
+  // feed-forward plus PI feedback, in volume-fraction units
+  return distribute(feedForward + m_options.kp * m_error + m_integral, m_balance);
 }
 
-Activations PatternController::distribute(double drive, double balance) const {
-  const DriveCalibration& c = m_calibration;
+Activations PatternController::distribute(double demand, double balance) const {
   Activations a = relaxedActivations();
-  for (ElementGroup group : kDrivenGroups) a[idx(group)].r = c.contractionR;
-
-  if (drive >= 0.0) {
+  for (ElementGroup group : kDrivenGroups) a[idx(group)].r = m_calibration.contractionR;
+  const Levers l = levers(m_calibration);
+  if (demand >= 0.0) {
     // inspiration: external intercostals (chest, share b) and diaphragm (belly, 1 - b)
-    const auto [chest, belly] = splitDemand(drive, balance, raises(c, ElementGroup::IntercostalExternal),
-                                            raises(c, ElementGroup::Diaphragm));
+    const auto [chest, belly] = splitDemand(demand, balance, l.chestIn, l.bellyIn);
     a[idx(ElementGroup::IntercostalExternal)].alpha = chest;
     a[idx(ElementGroup::Diaphragm)].alpha = belly;
   } else {
     // expiration below rest: internal intercostals (chest) and the abdominal wall (belly), forced
-    const double rectus = lowers(c, ElementGroup::Rectus), obliques = lowers(c, ElementGroup::TransversusObliques);
-    const auto [chest, belly] =
-        splitDemand(-drive, balance, lowers(c, ElementGroup::IntercostalInternal), rectus + obliques);
+    const auto [chest, belly] = splitDemand(-demand, balance, l.chestOut, l.bellyOut);
     a[idx(ElementGroup::IntercostalInternal)].alpha = chest;
-    a[idx(ElementGroup::Rectus)].alpha = rectus > 0.0 ? belly : 0.0;
-    a[idx(ElementGroup::TransversusObliques)].alpha = obliques > 0.0 ? belly : 0.0;
+    for (ElementGroup wall : {ElementGroup::Rectus, ElementGroup::TransversusObliques})
+      a[idx(wall)].alpha = reach(m_calibration.response[idx(wall)], -1.0).back() > 0.0 ? belly : 0.0;
   }
   return a;
 }
