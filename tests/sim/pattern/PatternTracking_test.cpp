@@ -92,8 +92,8 @@ INSTANTIATE_TEST_SUITE_P(GainScales, PatternTrackingRobustness, ::testing::Value
                            return info.param < 1.0 ? std::string("Weaker") : std::string("Stronger");
                          });
 
-// suspensions: the volume stays within 5 % of the target's peak-to-peak for the whole hold, i.e. every
-// frame at which the target sits at the first breath's peak
+// suspensions (and pain's post-inspiratory pause): the volume stays within 5 % of the target's peak-to-peak
+// for the whole hold, i.e. every frame at which the target sits at the first breath's peak
 class PatternSuspension : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(PatternSuspension, HoldsTheVolumeForTheWholeSuspension) {
@@ -116,10 +116,12 @@ TEST_P(PatternSuspension, HoldsTheVolumeForTheWholeSuspension) {
     tmin = std::min(tmin, live->targetFraction()), tmax = std::max(tmax, live->targetFraction());
     return true;
   });
-  EXPECT_GT(holdEnd - holdStart, 0.95) << "the suspension lasts 1 s (frames fall on 10 ms steps)";
+  // frames fall on 10 ms steps, and the start cross-fade (0.4 s) covers the first 50 ms of startle's hold
+  EXPECT_GT(holdEnd - holdStart, 0.9) << "the suspension lasts 1 s";
   const double held = (hi - lo) / (tmax - tmin);
   RecordProperty("hold_pct", std::to_string(100.0 * held));
   EXPECT_LT(held, 0.05) << "held between " << lo << " and " << hi << " from " << holdStart << " to " << holdEnd << " s";
 }
 
-INSTANTIATE_TEST_SUITE_P(Presets, PatternSuspension, ::testing::Values("disgust", "surprise"), presetName);
+INSTANTIATE_TEST_SUITE_P(Presets, PatternSuspension, ::testing::Values("disgust", "surprise", "startle", "pain"),
+                         presetName);
