@@ -24,8 +24,9 @@ GroupResponse reach(const GroupResponse& response, double sign) {
   return r;
 }
 
-// the activation whose reach is `demand` (linear between levels; 1 beyond the capacity)
+// the activation whose reach is `demand` (linear between levels; 0 for no demand, 1 beyond the capacity)
 double invert(const GroupResponse& reach, double demand) {
+  if (demand <= 0.0) return 0.0;
   for (std::size_t k = 1; k < reach.size(); ++k)
     if (reach[k] >= demand && reach[k] > reach[k - 1])
       return kCalibrationAlphas[k - 1] +
