@@ -69,12 +69,12 @@ void addModelOption(CLI::App& cmd, std::string& model) {
 }
 
 void addIntegratorOption(CLI::App& cmd, std::string& name) {
-  cmd.add_option("--integrator", name, "symplectic-euler or implicit-euler (default implicit-euler)");
+  cmd.add_option("--integrator", name, "One of " + sim::integratorNames() + " (default implicit-euler)");
 }
 
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind) {
   if (!name.empty() && !sim::integratorFromName(name, kind))
-    fail(kExitBadInput, "--integrator: unknown integrator '" + name + "' (valid: symplectic-euler, implicit-euler)");
+    fail(kExitBadInput, "--integrator: unknown integrator '" + name + "' (valid: " + sim::integratorNames() + ")");
 }
 
 }  // namespace pneuma::app

@@ -133,6 +133,37 @@ void maskFixed(const StepWork& w, Eigen::VectorXd& x) {
   for (Eigen::Index i = 0; i < w.fixedDofs.size(); ++i) x(w.fixedDofs(i)) = 0.0;
 }
 
+// zero what is not a coordinate of the joint tree: fixed entries and the linear velocities of jointed bodies
+void maskReduced(const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& x) {
+  maskFixed(w, x);
+  for (int j : tree) x.segment<3>(6 * w.treeChild[at(j)]).setZero();
+}
+
+// u <- J u: the linear velocity of each body hanging on a tree joint follows from its parent's motion and
+// its own spin, so the anchor points move together: v_c = v_p + w_p x r_p - w_c x r_c (parents first)
+template <typename Vec>
+void expandJointVelocities(const StepWork& w, const std::vector<int>& tree, Vec&& u) {
+  for (int j : tree) {
+    const int p = w.treeParent[at(j)], c = w.treeChild[at(j)];
+    u.template segment<3>(6 * c) = u.template segment<3>(6 * p) +
+                                   u.template segment<3>(6 * p + 3).cross(w.treeLeverParent.col(j)) -
+                                   u.template segment<3>(6 * c + 3).cross(w.treeLeverChild.col(j));
+  }
+}
+
+// f <- J^T f: a force on a dependent linear velocity acts on the parent's com and, through the levers,
+// as torques r_p x f on the parent and -r_c x f on the child (children first)
+void gatherJointForces(const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& f) {
+  for (auto it = tree.rbegin(); it != tree.rend(); ++it) {
+    const int j = *it, p = w.treeParent[at(j)], c = w.treeChild[at(j)];
+    const Vector3d fc = f.segment<3>(6 * c);
+    f.segment<3>(6 * p) += fc;
+    f.segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
+    f.segment<3>(6 * c + 3) -= w.treeLeverChild.col(j).cross(fc);
+    f.segment<3>(6 * c).setZero();
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // stage 1: forces
 
@@ -205,7 +236,7 @@ Vector3d jointRotation(const State& s, int parent, int child) {
 // the friction is left out for symplectic Euler, which integrates it implicitly (integrateJointFriction)
 void accumulateJointTorques(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
-  const double frictionScale = o.integrator == IntegratorKind::ImplicitEuler ? o.jointFrictionScale : 0.0;
+  const double frictionScale = o.integrator != IntegratorKind::SymplecticEuler ? o.jointFrictionScale : 0.0;
   for (int i = 0; i < j.size(); ++i) {
     const int p = j.parent[at(i)], c = j.child[at(i)];
     const double mu = j.friction(i) * frictionScale;
@@ -346,7 +377,7 @@ void buildPreconditioner(const Model& model, const StepWork& w, double dt, Eigen
 
 // the dense body block of M + dt D + dt^2 K (6 #B square), factored: the preconditioner of the stiff,
 // light ribcage; fixed bodies get identity rows
-void factorBodyBlock(const Model& model, const StepOptions& o, StepWork& w, double dt) {
+void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
   const int nb = model.bodies.size();
   Eigen::MatrixXd& a = w.bodyBlock;
   a.setZero();
@@ -385,11 +416,25 @@ void factorBodyBlock(const Model& model, const StepOptions& o, StepWork& w, doub
     a.block<3, 3>(6 * c + 3, 6 * p + 3).diagonal().array() -= kj;
     a.block<3, 3>(6 * p + 3, 6 * c + 3).diagonal().array() -= kj;
   }
+  // restrict to the joint tree's coordinates: J^T A J, with J the body part of expandJointVelocities
+  if (!tree.empty()) {
+    Eigen::MatrixXd& jt = w.bodyTreeMap;
+    jt.setIdentity();
+    for (Eigen::Index k = 0; k < jt.cols(); ++k) expandJointVelocities(w, tree, jt.col(k));
+    a = (jt.transpose() * a * jt).eval();
+  }
+  // fixed bodies and dependent linear velocities get identity rows
   for (int b = 0; b < nb; ++b) {
     if (!model.bodies.isFixed[at(b)]) continue;
     a.middleRows(6 * b, 6).setZero();
     a.middleCols(6 * b, 6).setZero();
     a.block<6, 6>(6 * b, 6 * b).setIdentity();
+  }
+  for (int jj : tree) {
+    const int c = w.treeChild[at(jj)];
+    a.middleRows(6 * c, 3).setZero();
+    a.middleCols(6 * c, 3).setZero();
+    a.block<3, 3>(6 * c, 6 * c).setIdentity();
   }
   w.bodyFactor.compute(a);
 }
@@ -401,10 +446,31 @@ void applyPreconditioner(const StepWork& w, const Eigen::VectorXd& r, Eigen::Vec
   if (nb6 > 0) z.head(nb6) = w.bodyFactor.solve(r.head(nb6));
 }
 
-// linearly implicit Euler (Baraff & Witkin 1998): (M + dt D + dt^2 K) dv = dt (f - dt K v), by PCG
+// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates (t: scratch)
+void applySystem(const Model& model, const StepOptions& o, const StepWork& w, const std::vector<int>& tree, double dt,
+                 const Eigen::VectorXd& u,
+                 Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
+  t = u;
+  expandJointVelocities(w, tree, t);
+  applyStiffnessDamping(model, o, w, t, dt * dt, dt, out);
+  applyMass(model, w, t, z);
+  out += z;
+  gatherJointForces(w, tree, out);
+  maskReduced(w, tree, out);
+}
+
+// linearly implicit Euler (Baraff & Witkin 1998): (M + dt D + dt^2 K) dv = dt (f - dt K v), by PCG, in the
+// coordinates of the joint tree (dv = J dv': the tree joints hold exactly in the linearised step)
 void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepOptions& o, StepWork& w) {
   const int nb = model.bodies.size(), nn = model.nodes.size();
-  Eigen::VectorXd &x = w.cgX, &r = w.cgR, &z = w.cgZ, &p = w.cgP, &q = w.cgQ, &rhs = w.cgB;
+  Eigen::VectorXd &x = w.cgX, &r = w.cgR, &z = w.cgZ, &p = w.cgP, &q = w.cgQ, &rhs = w.cgB, &t = w.cgT;
+  // implicit-euler-joints: the joint tree's coordinates; implicit-euler: the full space (joints in stage 3 only)
+  static const std::vector<int> kNoJoints;
+  const std::vector<int>& tree = o.integrator == IntegratorKind::ImplicitEulerJoints ? w.treeJoints : kNoJoints;
+  for (int j : tree) {
+    w.treeLeverParent.col(j) = w.rotation[at(w.treeParent[at(j)])] * w.jointLocalParent.col(j);
+    w.treeLeverChild.col(j) = w.rotation[at(w.treeChild[at(j)])] * w.jointLocalChild.col(j);
+  }
 
   // current generalized velocity and forces
   for (int b = 0; b < nb; ++b) {
@@ -419,16 +485,15 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   }
   applyStiffnessDamping(model, o, w, p, dt * dt, 0.0, q);
   rhs = dt * rhs - q;
-  maskFixed(w, rhs);
+  gatherJointForces(w, tree, rhs);
+  maskReduced(w, tree, rhs);
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
   buildPreconditioner(model, w, dt, w.cgDiag);
-  if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, w, dt);
-  maskFixed(w, x);
-  applyStiffnessDamping(model, o, w, x, dt * dt, dt, q);
-  applyMass(model, w, x, z);
-  r = rhs - q - z;
-  maskFixed(w, r);
+  if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, tree, w, dt);
+  maskReduced(w, tree, x);
+  applySystem(model, o, w, tree, dt, x, t, z, q);
+  r = rhs - q;
   applyPreconditioner(w, r, z);
   p = z;
   double rz = r.dot(z);
@@ -437,10 +502,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(q), 1e-24);
   int it = 0;
   for (; it < o.cgMaxIterations && rz > stop; ++it) {
-    applyStiffnessDamping(model, o, w, p, dt * dt, dt, q);
-    applyMass(model, w, p, z);
-    q += z;
-    maskFixed(w, q);
+    applySystem(model, o, w, tree, dt, p, t, z, q);
     const double alpha = rz / p.dot(q);
     x += alpha * p;
     r -= alpha * q;
@@ -451,14 +513,16 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   }
   w.cgIterations = it;
 
-  // v += dv
+  // v += J dv'
+  t = x;
+  expandJointVelocities(w, tree, t);
   for (int b = 0; b < nb; ++b) {
     if (model.bodies.isFixed[at(b)]) continue;
-    s.bodyVelocity.col(b) += x.segment<3>(6 * b);
-    s.bodyAngularVelocity.col(b) += x.segment<3>(6 * b + 3);
+    s.bodyVelocity.col(b) += t.segment<3>(6 * b);
+    s.bodyAngularVelocity.col(b) += t.segment<3>(6 * b + 3);
   }
   for (int n = 0; n < nn; ++n) {
-    if (!model.nodes.isFixed(n)) s.nodeVelocity.col(n) += x.segment<3>(nodeOffset(model, n));
+    if (!model.nodes.isFixed(n)) s.nodeVelocity.col(n) += t.segment<3>(nodeOffset(model, n));
   }
 }
 
@@ -585,23 +649,35 @@ void computeForces(const Model& model, const State& s, const Activations& act, c
   accumulateGravityAndGyroscopic(model, s, o, w);
 }
 
+namespace {
+const std::pair<IntegratorKind, const char*> kIntegratorNames[] = {
+    {IntegratorKind::SymplecticEuler, "symplectic-euler"},
+    {IntegratorKind::ImplicitEuler, "implicit-euler"},
+    {IntegratorKind::ImplicitEulerJoints, "implicit-euler-joints"}};
+}  // namespace
+
 const char* integratorName(IntegratorKind k) {
-  return k == IntegratorKind::SymplecticEuler ? "symplectic-euler" : "implicit-euler";
+  for (const auto& [kind, name] : kIntegratorNames)
+    if (kind == k) return name;
+  return "?";
+}
+
+std::string integratorNames() {
+  std::string out;
+  for (const auto& [kind, name] : kIntegratorNames) out += (out.empty() ? "" : ", ") + std::string(name);
+  return out;
 }
 
 bool integratorFromName(const std::string& name, IntegratorKind& out) {
-  if (name == "symplectic-euler") {
-    out = IntegratorKind::SymplecticEuler;
-    return true;
-  }
-  if (name == "implicit-euler") {
-    out = IntegratorKind::ImplicitEuler;
-    return true;
-  }
+  for (const auto& [kind, n] : kIntegratorNames)
+    if (name == n) {
+      out = kind;
+      return true;
+    }
   return false;
 }
 
-double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : 1e-2; }
+double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 1e-5 : 1e-2; }
 
 void validateStepOptions(const StepOptions& o) {
   auto fail = [](const std::string& field, double v, const char* rule) {
@@ -667,6 +743,26 @@ StepWork makeStepWork(const Model& model) {
       for (int k = 0; k < 3; ++k) fixed.push_back(6 * nb + 3 * i + k);
   w.fixedDofs = Eigen::Map<const Eigen::VectorXi>(fixed.data(), static_cast<Eigen::Index>(fixed.size()));
   w.jointMassInverse.assign(at(nj), Matrix3d::Zero());
+  // the joint tree: joints whose child hangs on no other joint, ordered parents first (a joint closing a
+  // loop stays with the impulse solver of stage 3 only)
+  w.treeParent = model.joints.parent;
+  w.treeChild = model.joints.child;
+  w.treeLeverParent = Eigen::Matrix3Xd::Zero(3, nj);
+  w.treeLeverChild = Eigen::Matrix3Xd::Zero(3, nj);
+  {
+    std::vector<char> placed(at(nb), 0), taken(at(nj), 0);
+    for (int b = 0; b < nb; ++b) placed[at(b)] = model.bodies.isFixed[at(b)];
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (int i = 0; i < nj; ++i) {
+        const int p = model.joints.parent[at(i)], c = model.joints.child[at(i)];
+        if (taken[at(i)] || !placed[at(p)] || placed[at(c)]) continue;
+        w.treeJoints.push_back(i);
+        taken[at(i)] = placed[at(c)] = 1;
+        grew = true;
+      }
+    }
+  }
   w.rotation.assign(at(nb), Matrix3d::Identity());
   w.inverseInertiaWorld = w.inverseInertiaBody;
   w.bodyForce = Eigen::Matrix3Xd::Zero(3, nb);
@@ -675,12 +771,16 @@ StepWork makeStepWork(const Model& model) {
   w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
   w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgDiag, &w.cgB}) *v = Eigen::VectorXd::Zero(n);
+  w.bodyTreeMap = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
+  for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgDiag, &w.cgB, &w.cgT}) *v = Eigen::VectorXd::Zero(n);
   return w;
 }
 
 void step(const Model& model, State& state, double dt, const Activations& act, const StepOptions& options,
           StepWork& work) {
+  // joints: the tree solve keeps the anchors together only if the start velocity does (an initial state may not)
+  if (options.integrator == IntegratorKind::ImplicitEulerJoints) solveJointVelocities(model, state, options, work);
+
   // forces: muscles, cartilage, gut pressure, joint friction and stiffness, gravity
   computeForces(model, state, act, options, work);
 

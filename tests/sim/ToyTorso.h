@@ -8,6 +8,7 @@
 
 #include "pneuma/sim/Elements.h"
 #include "pneuma/sim/Model.h"
+#include "pneuma/sim/Step.h"
 
 #include <Eigen/Geometry>
 
@@ -290,6 +291,17 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   for (int side : {-1, 1})
     m.landmarks.points.addBodyPoint(rib[{0, side}], ribPoint(0, side, 0.5 * kPi) - m.bodies.com.col(rib[{0, side}]));
   return m;
+}
+
+/// [s] time step of the integrator tests on the toy models: its bodies are heavier than the default model's
+/// ribs, so the explicit scheme runs at 0.25 ms here (the default model needs defaultTimeStep(): 10 us).
+inline double toyTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : defaultTimeStep(k); }
+
+/// A name usable as a gtest parameter name: "implicit-euler-joints" -> "implicit_euler_joints".
+inline std::string gtestName(std::string name) {
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
 }
 
 }  // namespace pneuma::sim::test

@@ -25,7 +25,7 @@ class Integrators : public ::testing::TestWithParam<IntegratorKind> {};
 double measurePeriod(const Model& model, State& s, const StepOptions& o, double duration,
                      const std::function<double(const State&)>& signal) {
   StepWork w = makeStepWork(model);
-  const double dt = defaultTimeStep(o.integrator);
+  const double dt = test::toyTimeStep(o.integrator);
   std::vector<double> crossings;
   double prev = signal(s);
   while (s.time < duration) {
@@ -114,7 +114,7 @@ TEST_P(Integrators, PressurisedSpringSphereReachesEquilibriumRadius) {
   o.gravity = false;
   State s = makeInitialState(m);
   StepWork w = makeStepWork(m);
-  const double dt = defaultTimeStep(o.integrator);
+  const double dt = test::toyTimeStep(o.integrator);
   while (s.time < 3.0) step(m, s, dt, relaxedActivations(), o, w);
   const double radius = s.nodePosition.colwise().norm().mean();
   EXPECT_NEAR(radius, expected, 0.002 * expected);
@@ -123,8 +123,9 @@ TEST_P(Integrators, PressurisedSpringSphereReachesEquilibriumRadius) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, Integrators,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler),
-                         [](const auto& info) { return std::string(info.param == IntegratorKind::SymplecticEuler ? "SymplecticEuler" : "ImplicitEuler"); });
+                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
+                         [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 }  // namespace
 }  // namespace pneuma::sim

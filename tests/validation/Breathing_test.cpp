@@ -2,31 +2,18 @@
 // Figures 4-6) and physiology. The experiments and their checks live in sim/Experiments.h, shared with
 // `pneuma-cli validate`, so the report and these tests cannot drift apart. Skips when the default model
 // has not been built (PNEUMA_DEFAULT_MODEL_DIR, built by 'pneuma-cli model build').
+#include "DefaultModel.h"
+
 #include "pneuma/sim/Experiments.h"
-#include "pneuma/sim/ModelIO.h"
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <filesystem>
 #include <map>
-#include <memory>
 
 namespace pneuma::sim {
 namespace {
 
-std::shared_ptr<const Model> defaultModel() {
-  static const std::shared_ptr<const Model> model = []() -> std::shared_ptr<const Model> {
-    const char* env = std::getenv("PNEUMA_DEFAULT_MODEL_DIR");
-    const std::string dir = env != nullptr ? env : PNEUMA_DEFAULT_MODEL_DIR;
-    if (!std::filesystem::exists(dir + "/model.json")) return nullptr;
-    return std::make_shared<const Model>(loadModel(dir));
-  }();
-  return model;
-}
-
-#define REQUIRE_DEFAULT_MODEL()                                                  \
-  if (!defaultModel()) GTEST_SKIP() << "default model not built (PNEUMA_DEFAULT_MODEL_DIR)"
+using test::defaultModel;
 
 // one finished run per (style, friction scale), shared by the tests
 const StyleRun& run(const std::string& style, double frictionScale = 1.0) {

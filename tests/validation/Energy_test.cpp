@@ -33,7 +33,7 @@ TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
   computeMetrics(m, s, relaxed, o, w, met);
   const double e0 = met.kineticEnergy + met.elasticEnergy;
   double previous = e0;
-  const double dt = defaultTimeStep(o.integrator);
+  const double dt = test::toyTimeStep(o.integrator);
   while (s.time < 6.0) {
     step(m, s, dt, relaxed, o, w);
     computeMetrics(m, s, relaxed, o, w, met);
@@ -50,8 +50,9 @@ TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, EnergyDecay,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler),
-                         [](const auto& info) { return std::string(info.param == IntegratorKind::SymplecticEuler ? "SymplecticEuler" : "ImplicitEuler"); });
+                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
+                         [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 }  // namespace
 }  // namespace pneuma::sim

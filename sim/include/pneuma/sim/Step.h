@@ -22,10 +22,21 @@
 ///   linear or nearly so, so backward Euler removes their step limit at the cost of a few CG passes
 ///   that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so its numerical
 ///   damping of high frequencies is harmless, while a position-based (XPBD) scheme would not follow
-///   the paper's force laws (Eq. 2, 4, 5) as directly. Default dt 10 ms (symplectic Euler: 0.25 ms,
-///   which needs bones of realistic mass; on very light ribs it needs < 0.05 ms).
-/// Ball joints are not part of the linear solve: after the velocity update, sequential impulses remove
-/// the relative velocity at every joint and a mass-weighted projection removes the position drift.
+///   the paper's force laws (Eq. 2, 4, 5) as directly. Default dt 10 ms. Symplectic Euler's default is
+///   10 us: on the default model its limit is the diaphragm damping on the light dome nodes (dt < 2 m / sum b,
+///   b = 250 N s/m) and the 10-25 g ribs; 20 us blows up within 0.1 s (real-time factor about 0.1).
+/// - ImplicitEulerJoints: the same backward Euler solved in the coordinates of the joint tree: the linear
+///   velocity of every body hanging on a ball joint is eliminated, v_c = v_p + w_p x r_p - w_c x r_c
+///   (J: reduced -> full velocities), and CG solves J^T (M + dt D + dt^2 K) J dv' = J^T rhs. The joints
+///   then hold inside the linear solve, so joint friction (Eq. 3) couples a rib's spin to the spine about
+///   the joint rather than about the rib's com. Why: ImplicitEuler treats friction and stiffness without
+///   the joints and projects afterwards; that split is not consistent in dt (deep breathing on the default
+///   model: 1260 mL at dt 10 ms, 1755 mL at 2 ms) and gains energy at mu >~ 0.5 N m s/rad (relaxed, no
+///   gravity: 5e-4 J -> 400 J in 1.5 s). ImplicitEulerJoints gives 651 mL at both dt and decays for any mu
+///   tested (up to 15 N m s/rad). Not yet the default: the presets are calibrated on ImplicitEuler.
+/// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
+/// at every joint (all of it for ImplicitEuler, the linearisation error for ImplicitEulerJoints) and a
+/// mass-weighted projection removes the position drift.
 
 #include "pneuma/sim/Activation.h"
 #include "pneuma/sim/Metrics.h"
@@ -42,10 +53,12 @@
 namespace pneuma::sim {
 
 /// Time integration scheme.
-enum class IntegratorKind { SymplecticEuler, ImplicitEuler };
+enum class IntegratorKind { SymplecticEuler, ImplicitEuler, ImplicitEulerJoints };
 
-/// "symplectic-euler" or "implicit-euler".
+/// "symplectic-euler", "implicit-euler" or "implicit-euler-joints".
 const char* integratorName(IntegratorKind k);
+/// All valid names, comma separated (for error messages).
+std::string integratorNames();
 /// Inverse of integratorName(); returns false when unknown.
 bool integratorFromName(const std::string& name, IntegratorKind& out);
 /// Default time step [s] of each integrator: stable on the default model (see the validation tests).
@@ -100,8 +113,12 @@ struct StepWork {
   Eigen::MatrixXd bodyBlock;           ///< body block of the implicit system, dense (6 #B x 6 #B)
   Eigen::LDLT<Eigen::MatrixXd> bodyFactor;  ///< its factorization, the CG preconditioner for body entries
   long long stepsSinceFactor = 0;      ///< [-] counts implicit steps to refresh bodyFactor
-  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps dv
-                                                          ///< of the last step as the next warm start
+  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
+                                                               ///< dv' of the last step as the next warm start
+  std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
+  std::vector<int> treeParent, treeChild;  ///< parent / child body of every joint (#J)
+  Eigen::Matrix3Xd treeLeverParent, treeLeverChild;  ///< [m] joint anchor minus com, world, at the step start (3 x #J)
+  Eigen::MatrixXd bodyTreeMap;         ///< [-, m] body part of the tree map J (6 #B x 6 #B), scratch
 };
 
 /// Allocates the scratch memory for `model` and computes its rest gut volume.

@@ -1,0 +1,94 @@
+// The integrators on the default model (sim/Step.h): every one is stable at its default time step (issue 4);
+// implicit-euler-joints, backward Euler in the coordinates of the joint tree, (a) only dissipates under strong
+// rib-joint friction (Eq. 3, Zordan et al. 2004 Sec. 5), where the split solve of implicit-euler gains energy,
+// and (b) breathes the same at dt 10 ms and 5 ms.
+#include "DefaultModel.h"
+#include "ToyTorso.h"
+
+#include "pneuma/sim/Experiments.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/Step.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace pneuma::sim {
+namespace {
+
+class DefaultStep : public ::testing::TestWithParam<IntegratorKind> {};
+
+// deep breathing (the largest motion) from the rest pose at the integrator's default dt: no blow-up (Simulation
+// checks every step for NaN, speed and joint error) and the joints hold within 0.1 mm
+TEST_P(DefaultStep, IsStableOnTheDefaultModel) {
+  REQUIRE_DEFAULT_MODEL();
+  SimulationOptions o;
+  o.step.integrator = GetParam();
+  o.settleTime = 0.0;
+  // explicit: 0.3 s is 30,000 steps; implicit: two deep breaths
+  const double duration = GetParam() == IntegratorKind::SymplecticEuler ? 0.3 : 10.0;
+  Simulation sim(test::defaultModel(), std::make_unique<BreathStyleController>(loadBreathStyle("deep")), o);
+  double worstJoint = 0.0;
+  ASSERT_NO_THROW(sim.advance(duration, [&](const Simulation& s) {
+    worstJoint = std::max(worstJoint, s.latestMetrics().maxJointError);
+    return true;
+  }));
+  EXPECT_LT(worstJoint, 1e-4);
+  EXPECT_GT(sim.state().time, duration - 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sim, DefaultStep,
+                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
+                         [](const auto& info) { return test::gtestName(integratorName(info.param)); });
+
+// relaxed, no gravity, random spins of every moving body: total energy must not grow (Eq. 3 is dissipative)
+TEST(ImplicitEulerJoints, StrongRibFrictionOnlyDissipates) {
+  REQUIRE_DEFAULT_MODEL();
+  const Model& m = *test::defaultModel();
+  StepOptions o;
+  o.integrator = IntegratorKind::ImplicitEulerJoints;
+  o.gravity = false;
+  o.jointFrictionScale = 100.0;  // 5 N m s/rad at the rib-spine joints: 10x past where implicit-euler blows up
+  State s = makeInitialState(m);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) s.bodyAngularVelocity.col(b) = 0.5 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  StepWork w = makeStepWork(m);
+  Metrics met;
+  const Activations relaxed = relaxedActivations();
+  computeMetrics(m, s, relaxed, o, w, met);
+  const double e0 = met.kineticEnergy + met.elasticEnergy;
+  double peak = 0.0;
+  const double dt = defaultTimeStep(o.integrator);
+  while (s.time < 1.5) {
+    step(m, s, dt, relaxed, o, w);
+    computeMetrics(m, s, relaxed, o, w, met);
+    peak = std::max(peak, met.kineticEnergy + met.elasticEnergy);
+    ASSERT_LT(met.maxJointError, 1e-4) << "joint error at t = " << s.time;
+  }
+  EXPECT_LT(peak, e0) << "energy grew above its initial value";
+  EXPECT_LT(met.kineticEnergy + met.elasticEnergy, 0.2 * e0);
+}
+
+// the same deep breathing at dt 10 ms and 5 ms: tidal volume within 3 % (a consistent integrator converges)
+TEST(ImplicitEulerJoints, DeepBreathingDoesNotDependOnTheTimeStep) {
+  REQUIRE_DEFAULT_MODEL();
+  ExperimentSettings settings;
+  settings.simulation.step.integrator = IntegratorKind::ImplicitEulerJoints;
+  settings.styleDuration = 10.0;  // two breaths at 12 b/m
+  const BreathStyle deep = loadBreathStyle("deep");
+  settings.simulation.dt = 0.01;
+  const double coarse = runBreathStyle(test::defaultModel(), deep, settings).summary.tidalVolume;
+  settings.simulation.dt = 0.005;
+  const double fine = runBreathStyle(test::defaultModel(), deep, settings).summary.tidalVolume;
+  RecordProperty("tidal_volume_ml_dt10ms", std::to_string(coarse * 1e6));
+  RecordProperty("tidal_volume_ml_dt5ms", std::to_string(fine * 1e6));
+  EXPECT_GT(fine, 1e-4);  // it breathes (more than 100 mL)
+  EXPECT_NEAR(coarse, fine, 0.03 * fine);
+}
+
+}  // namespace
+}  // namespace pneuma::sim
