@@ -353,26 +353,32 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
     out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
 }
 
-// Jacobi preconditioner of the gut nodes: inverse diagonal of M + dt D + dt^2 K on node entries (element
-// terms with the squared barycentric weights); body entries are left zero (the factored body block covers them)
-void buildPreconditioner(const Model& model, const StepWork& w, double dt, Eigen::VectorXd& diag) {
-  diag.setZero();
-  for (int n = 0; n < model.nodes.size(); ++n) diag.segment<3>(nodeOffset(model, n)).setConstant(model.nodes.mass(n));
+// block-Jacobi preconditioner of the gut nodes: the inverse 3x3 diagonal block of M + dt D + dt^2 K at every
+// node (element terms with the squared barycentric weights, the gut pressure's kp g_n g_n^T); zero when fixed
+void buildPreconditioner(const Model& model, const StepOptions& o, const StepWork& w, double dt,
+                         std::vector<Matrix3d>& blocks) {
+  for (int n = 0; n < model.nodes.size(); ++n) blocks[at(n)] = model.nodes.mass(n) * Matrix3d::Identity();
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
-    const double k = dt * dt * (w.elementStiffness(e) + w.elementGeometric(e)) + dt * w.elementDamping(e);
-    if (k == 0.0) continue;
-    const Vector3d d2 = w.elementDirection.col(e).cwiseAbs2();
+    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
+    if (ka == 0.0 && kg == 0.0) continue;
+    const Vector3d d = w.elementDirection.col(e);
+    const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
     for (int side = 0; side < 2; ++side) {
       if (w.endpointBody(side, e) >= 0) continue;
       const AnchorSet& a = side == 0 ? el.endA : el.endB;
       for (int i = 0; i < 3; ++i) {
         const int n = a.nodes(i, e);
-        if (n >= 0) diag.segment<3>(nodeOffset(model, n)) += (k * a.weights(i, e) * a.weights(i, e)) * d2;
+        if (n >= 0) blocks[at(n)] += (a.weights(i, e) * a.weights(i, e)) * ke;
       }
     }
   }
-  for (Eigen::Index i = 0; i < diag.size(); ++i) diag(i) = diag(i) > 0.0 ? 1.0 / diag(i) : 0.0;
+  if (w.gutPressure > 0.0) {
+    const double kp = dt * dt * effectiveKappa(model, o) * w.restGutVolume / (w.gutVolume * w.gutVolume);
+    for (int n = 0; n < model.nodes.size(); ++n) blocks[at(n)] += kp * w.gutGradient.col(n) * w.gutGradient.col(n).transpose();
+  }
+  for (int n = 0; n < model.nodes.size(); ++n)
+    blocks[at(n)] = model.nodes.isFixed(n) ? Matrix3d::Zero() : Matrix3d(blocks[at(n)].inverse());
 }
 
 // the dense body block of M + dt D + dt^2 K (6 #B square), factored: the preconditioner of the stiff,
@@ -439,10 +445,11 @@ void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector
   w.bodyFactor.compute(a);
 }
 
-// z = P^-1 r: the factored body block for bodies, Jacobi for nodes
+// z = P^-1 r: the factored body block for bodies, block Jacobi for nodes
 void applyPreconditioner(const StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
   const Eigen::Index nb6 = w.bodyBlock.rows();
-  z.tail(z.size() - nb6) = w.cgDiag.tail(z.size() - nb6).cwiseProduct(r.tail(r.size() - nb6));
+  for (std::size_t n = 0; n < w.nodeBlockInverse.size(); ++n)
+    z.segment<3>(nb6 + 3 * static_cast<Eigen::Index>(n)) = w.nodeBlockInverse[n] * r.segment<3>(nb6 + 3 * static_cast<Eigen::Index>(n));
   if (nb6 > 0) z.head(nb6) = w.bodyFactor.solve(r.head(nb6));
 }
 
@@ -489,7 +496,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   maskReduced(w, tree, rhs);
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
-  buildPreconditioner(model, w, dt, w.cgDiag);
+  buildPreconditioner(model, o, w, dt, w.nodeBlockInverse);
   if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, tree, w, dt);
   maskReduced(w, tree, x);
   applySystem(model, o, w, tree, dt, x, t, z, q);
@@ -772,7 +779,8 @@ StepWork makeStepWork(const Model& model) {
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
   w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
   w.bodyTreeMap = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgDiag, &w.cgB, &w.cgT}) *v = Eigen::VectorXd::Zero(n);
+  w.nodeBlockInverse.assign(at(nn), Matrix3d::Zero());
+  for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgB, &w.cgT}) *v = Eigen::VectorXd::Zero(n);
   return w;
 }
 

@@ -15,7 +15,8 @@
 ///   node and body velocities, solving (M + dt D + dt^2 K) dv = dt (f - dt K v) with a matrix-free
 ///   conjugate gradient, warm-started from the previous dv. Preconditioner: the dense 6#B x 6#B body
 ///   block of the system, LDLT-factored every `preconditionerRefresh` steps (the light, stiffly coupled
-///   ribcage: ~25 bodies), and Jacobi for the gut nodes. K holds the element stiffness along and across each
+///   ribcage: ~25 bodies), and block Jacobi (3x3 per node, with the gut pressure's diagonal blocks) for the
+///   gut nodes. K holds the element stiffness along and across each
 ///   taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
 ///   joint springs; D holds element damping and joint friction. Why this one: the stiff parts of the
 ///   model (cartilage, the gut's near-incompressibility kappa, joint friction on light ribs) are
@@ -76,7 +77,7 @@ struct StepOptions {
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
   int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
   int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the body-block preconditioner every n steps
-  double cgTolerance = 1e-3;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
+  double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
 };
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
@@ -113,8 +114,9 @@ struct StepWork {
   Eigen::MatrixXd bodyBlock;           ///< body block of the implicit system, dense (6 #B x 6 #B)
   Eigen::LDLT<Eigen::MatrixXd> bodyFactor;  ///< its factorization, the CG preconditioner for body entries
   long long stepsSinceFactor = 0;      ///< [-] counts implicit steps to refresh bodyFactor
-  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgDiag, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
-                                                               ///< dv' of the last step as the next warm start
+  std::vector<Eigen::Matrix3d> nodeBlockInverse;  ///< [1/kg] inverse 3x3 node blocks of M + dt D + dt^2 K (#N)
+  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
+                                                      ///< dv' of the last step as the next warm start
   std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
   std::vector<int> treeParent, treeChild;  ///< parent / child body of every joint (#J)
   Eigen::Matrix3Xd treeLeverParent, treeLeverChild;  ///< [m] joint anchor minus com, world, at the step start (3 x #J)
