@@ -64,9 +64,9 @@ double groupResponse(const DriveCalibration& calibration, ElementGroup g, double
 /// Feedback settings.
 struct PatternControllerOptions {
   /// [-] proportional gain on the fraction error. The muscles answer within a frame or two, so the loop
-  /// oscillates at the frame rate beyond about 1.5 (at the default 60 Hz output rate); 1.2 cuts the
-  /// solver's volume jitter during holds by about a third (against 0.8) and still tracks a plant 25 %
-  /// stronger than calibrated.
+  /// oscillates at the frame rate beyond about 1.5 (at the default 60 Hz output rate); 1.2 cut the
+  /// solver's volume jitter during holds by about a third against 0.8 (at CG tolerance 1e-3) and still
+  /// tracks a plant 25 % stronger than calibrated.
   double kp = 1.2;
   double ki = 30.0;               ///< [1/s] integral gain
   double integralLimit = 0.2;     ///< [-] clamp of the integral term I, in fraction units
