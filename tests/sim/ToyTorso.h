@@ -8,6 +8,7 @@
 
 #include "pneuma/sim/Elements.h"
 #include "pneuma/sim/Model.h"
+#include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
 
 #include <Eigen/Geometry>
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -291,6 +293,19 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   for (int side : {-1, 1})
     m.landmarks.points.addBodyPoint(rib[{0, side}], ribPoint(0, side, 0.5 * kPi) - m.bodies.com.col(rib[{0, side}]));
   return m;
+}
+
+/// The rest state with random velocities: N(0, nodeSpeed^2) [m/s] per moving node axis and N(0, spin^2)
+/// [rad/s] per moving body axis, from a fixed seed (the energy tests' initial condition).
+inline State randomVelocityState(const Model& m, double nodeSpeed, double spin, unsigned seed = 3) {
+  State s = makeInitialState(m);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int i = 0; i < m.nodes.size(); ++i)
+    if (!m.nodes.isFixed(i)) s.nodeVelocity.col(i) = nodeSpeed * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) s.bodyAngularVelocity.col(b) = spin * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  return s;
 }
 
 /// [s] time step of the integrator tests on the toy models: its bodies are heavier than the default model's

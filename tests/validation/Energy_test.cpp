@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
 
 namespace pneuma::sim {
 namespace {
@@ -19,13 +18,7 @@ TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
   StepOptions o;
   o.gravity = false;
   o.integrator = GetParam();
-  State s = makeInitialState(m);
-  std::mt19937 rng(3);
-  std::normal_distribution<double> n(0.0, 1.0);
-  for (int i = 0; i < m.nodes.size(); ++i)
-    if (!m.nodes.isFixed(i)) s.nodeVelocity.col(i) = 0.1 * Eigen::Vector3d(n(rng), n(rng), n(rng));
-  for (int b = 0; b < m.bodies.size(); ++b)
-    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) s.bodyAngularVelocity.col(b) = 0.5 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  State s = test::randomVelocityState(m, 0.1, 0.5);
 
   StepWork w = makeStepWork(m);
   Metrics met;

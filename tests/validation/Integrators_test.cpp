@@ -12,7 +12,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
 
 namespace pneuma::sim {
 namespace {
@@ -51,11 +50,7 @@ TEST(ImplicitEulerJoints, StrongRibFrictionOnlyDissipates) {
   o.integrator = IntegratorKind::ImplicitEulerJoints;
   o.gravity = false;
   o.jointFrictionScale = 100.0;  // 5 N m s/rad at the rib-spine joints: 10x past where implicit-euler blows up
-  State s = makeInitialState(m);
-  std::mt19937 rng(3);
-  std::normal_distribution<double> n(0.0, 1.0);
-  for (int b = 0; b < m.bodies.size(); ++b)
-    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) s.bodyAngularVelocity.col(b) = 0.5 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  State s = test::randomVelocityState(m, 0.0, 0.5);
   StepWork w = makeStepWork(m);
   Metrics met;
   const Activations relaxed = relaxedActivations();
