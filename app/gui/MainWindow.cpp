@@ -581,11 +581,20 @@ QString MainWindow::setBreathStyle(const QString& name) {
   return {};
 }
 
-void MainWindow::pushAffect(const QString& name, bool isImmediate) {
-  if (!m_worker || name.isEmpty()) return;
+QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
+  if (m_affectCombo->findText(name) < 0) {
+    QStringList valid;
+    for (int i = 0; i < m_affectCombo->count(); ++i) valid << m_affectCombo->itemText(i);
+    const QString error = QString("unknown affect '%1' (valid: %2)").arg(name, valid.join(", "));
+    report("Unknown affect", error);
+    return error;
+  }
+  m_affectCombo->setCurrentText(name);
+  if (!m_worker) return "no model is open";
   m_worker->requestAffect(name.toStdString(),
                           isImmediate ? sim::pattern::SwitchMode::Immediate : sim::pattern::SwitchMode::EndOfCycle);
   showMessage(QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"), 5000);
+  return {};
 }
 
 void MainWindow::play() { m_playAction->setChecked(true); }

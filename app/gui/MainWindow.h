@@ -70,7 +70,8 @@ class MainWindow : public QMainWindow {
   /// Blocks (processing events) until the worker has written it. @return empty or the error.
   QString exportRun(const QString& pvdPath);
   /// Pushes an affect preset (de Melo et al. 2010), at the end of the current breath or immediately.
-  void pushAffect(const QString& name, bool isImmediate);
+  /// @return empty, or the error (an unknown name lists the valid ones; no model open).
+  QString pushAffect(const QString& name, bool isImmediate);
 
   /// Renders the 3D view now and returns a grab of the whole window (what the user sees).
   QImage grabWindow();

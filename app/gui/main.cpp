@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
   const QCommandLineOption model("model", "Model directory (default: $PNEUMA_MODEL_DIR or <bindir>/../models/default).",
                                  "DIR");
   const QCommandLineOption style("style", "Breath style: calm, deep, panting or forced-exhale.", "NAME");
+  const QCommandLineOption affect("affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).",
+                                  "NAME");
   const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.", "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
@@ -55,7 +57,7 @@ int main(int argc, char** argv) {
   const QCommandLineOption measure("measure",
                                    "Run for SECONDS of wall time, print render fps and real-time factor, exit.",
                                    "SECONDS");
-  parser.addOptions({model, style, camera, labels, speed, screenshot, after, measure});
+  parser.addOptions({model, style, affect, camera, labels, speed, screenshot, after, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -105,6 +107,10 @@ int main(int argc, char** argv) {
   if (parser.isSet(style) && !window.setBreathStyle(parser.value(style)).isEmpty() && isScripted) return 2;
   const QString modelDir = parser.isSet(model) ? parser.value(model) : pneuma::app::MainWindow::defaultModelDir();
   const bool hasModel = window.openModel(modelDir).isEmpty();
+  if (hasModel && parser.isSet(affect)) {
+    // an unknown name is reported by the window (dialog, or stderr when scripted)
+    if (!window.pushAffect(parser.value(affect), true).isEmpty() && isScripted) return 2;
+  }
   window.scene().setCamera(preset->second);
   if (parser.isSet(labels)) {
     pneuma::viz::DisplayOptions options = window.scene().options();
