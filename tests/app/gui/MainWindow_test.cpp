@@ -36,6 +36,19 @@ struct ToyWindow {
   }
 };
 
+// a shown window with the default model open; skips when the default model has not been built
+class DefaultModelWindow : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const QString modelDir = defaultModelDir();
+    if (modelDir.isEmpty()) GTEST_SKIP() << "no default model at " << PNEUMA_DEFAULT_MODEL_DIR;
+    window.show();
+    ASSERT_EQ(window.openModel(modelDir), QString());
+  }
+  QApplication& qt = application();  // before any widget
+  MainWindow window;
+};
+
 // the breathing rate [1/min] measured from the lung volume the volume plot holds, from time `from` [s]:
 // the volume low-passed by a centred 0.4 s moving average (it removes the few-hertz wobble of the
 // ribcage, far above any breathing rate), then the sim's own cycle analysis (sim::summarize)
@@ -180,13 +193,7 @@ TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
 }
 
 // the toy torso is not calibrated to breathe cleanly, so the rate is measured on the default model
-TEST(MainWindow, FrequencyEditChangesTheMeasuredBreathingRate) {
-  const QString modelDir = defaultModelDir();
-  if (modelDir.isEmpty()) GTEST_SKIP() << "no default model at " << PNEUMA_DEFAULT_MODEL_DIR;
-  application();
-  MainWindow window;
-  window.show();
-  ASSERT_EQ(window.openModel(modelDir), QString());
+TEST_F(DefaultModelWindow, FrequencyEditChangesTheMeasuredBreathingRate) {
   app::ParameterPanel* panel = window.parameters();
   window.plots()->setWindow(100.0);
 
@@ -309,13 +316,7 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
 
 // the pattern drive calibrates on a model whose muscles raise the lung volume: the default model (the toy
 // torso's volume only sinks during the calibration staircase, which the drive refuses)
-TEST(MainWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
-  const QString modelDir = defaultModelDir();
-  if (modelDir.isEmpty()) GTEST_SKIP() << "no default model at " << PNEUMA_DEFAULT_MODEL_DIR;
-  application();
-  MainWindow window;
-  window.show();
-  ASSERT_EQ(window.openModel(modelDir), QString());
+TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   // an unknown name is refused with the valid ones; the known one is pushed
   const QString error = window.pushAffect("pnic", true);
   EXPECT_TRUE(error.contains("unknown affect 'pnic'")) << error.toStdString();
