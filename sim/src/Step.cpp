@@ -134,17 +134,17 @@ void maskFixed(const StepWork& w, Eigen::VectorXd& x) {
 }
 
 // zero what is not a coordinate of the joint tree: fixed entries and the linear velocities of jointed bodies
-void maskReduced(const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& x) {
+void maskReduced(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& x) {
   maskFixed(w, x);
-  for (int j : tree) x.segment<3>(6 * w.treeChild[at(j)]).setZero();
+  for (int j : tree) x.segment<3>(6 * joints.child[at(j)]).setZero();
 }
 
 // u <- J u: the linear velocity of each body hanging on a tree joint follows from its parent's motion and
 // its own spin, so the anchor points move together: v_c = v_p + w_p x r_p - w_c x r_c (parents first)
 template <typename Vec>
-void expandJointVelocities(const StepWork& w, const std::vector<int>& tree, Vec&& u) {
+void expandJointVelocities(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Vec&& u) {
   for (int j : tree) {
-    const int p = w.treeParent[at(j)], c = w.treeChild[at(j)];
+    const int p = joints.parent[at(j)], c = joints.child[at(j)];
     u.template segment<3>(6 * c) = u.template segment<3>(6 * p) +
                                    u.template segment<3>(6 * p + 3).cross(w.treeLeverParent.col(j)) -
                                    u.template segment<3>(6 * c + 3).cross(w.treeLeverChild.col(j));
@@ -153,9 +153,9 @@ void expandJointVelocities(const StepWork& w, const std::vector<int>& tree, Vec&
 
 // f <- J^T f: a force on a dependent linear velocity acts on the parent's com and, through the levers,
 // as torques r_p x f on the parent and -r_c x f on the child (children first)
-void gatherJointForces(const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& f) {
+void gatherJointForces(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& f) {
   for (auto it = tree.rbegin(); it != tree.rend(); ++it) {
-    const int j = *it, p = w.treeParent[at(j)], c = w.treeChild[at(j)];
+    const int j = *it, p = joints.parent[at(j)], c = joints.child[at(j)];
     const Vector3d fc = f.segment<3>(6 * c);
     f.segment<3>(6 * p) += fc;
     f.segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
@@ -426,7 +426,7 @@ void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector
   if (!tree.empty()) {
     Eigen::MatrixXd& jt = w.bodyTreeMap;
     jt.setIdentity();
-    for (Eigen::Index k = 0; k < jt.cols(); ++k) expandJointVelocities(w, tree, jt.col(k));
+    for (Eigen::Index k = 0; k < jt.cols(); ++k) expandJointVelocities(model.joints, w, tree, jt.col(k));
     a = (jt.transpose() * a * jt).eval();
   }
   // fixed bodies and dependent linear velocities get identity rows
@@ -437,7 +437,7 @@ void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector
     a.block<6, 6>(6 * b, 6 * b).setIdentity();
   }
   for (int jj : tree) {
-    const int c = w.treeChild[at(jj)];
+    const int c = model.joints.child[at(jj)];
     a.middleRows(6 * c, 3).setZero();
     a.middleCols(6 * c, 3).setZero();
     a.block<3, 3>(6 * c, 6 * c).setIdentity();
@@ -458,12 +458,12 @@ void applySystem(const Model& model, const StepOptions& o, const StepWork& w, co
                  const Eigen::VectorXd& u,
                  Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
   t = u;
-  expandJointVelocities(w, tree, t);
+  expandJointVelocities(model.joints, w, tree, t);
   applyStiffnessDamping(model, o, w, t, dt * dt, dt, out);
   applyMass(model, w, t, z);
   out += z;
-  gatherJointForces(w, tree, out);
-  maskReduced(w, tree, out);
+  gatherJointForces(model.joints, w, tree, out);
+  maskReduced(model.joints, w, tree, out);
 }
 
 // linearly implicit Euler (Baraff & Witkin 1998): (M + dt D + dt^2 K) dv = dt (f - dt K v), by PCG, in the
@@ -475,8 +475,8 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   static const std::vector<int> kNoJoints;
   const std::vector<int>& tree = o.integrator == IntegratorKind::ImplicitEulerJoints ? w.treeJoints : kNoJoints;
   for (int j : tree) {
-    w.treeLeverParent.col(j) = w.rotation[at(w.treeParent[at(j)])] * w.jointLocalParent.col(j);
-    w.treeLeverChild.col(j) = w.rotation[at(w.treeChild[at(j)])] * w.jointLocalChild.col(j);
+    w.treeLeverParent.col(j) = w.rotation[at(model.joints.parent[at(j)])] * w.jointLocalParent.col(j);
+    w.treeLeverChild.col(j) = w.rotation[at(model.joints.child[at(j)])] * w.jointLocalChild.col(j);
   }
 
   // current generalized velocity and forces
@@ -492,13 +492,13 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   }
   applyStiffnessDamping(model, o, w, p, dt * dt, 0.0, q);
   rhs = dt * rhs - q;
-  gatherJointForces(w, tree, rhs);
-  maskReduced(w, tree, rhs);
+  gatherJointForces(model.joints, w, tree, rhs);
+  maskReduced(model.joints, w, tree, rhs);
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
   buildPreconditioner(model, o, w, dt, w.nodeBlockInverse);
   if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, tree, w, dt);
-  maskReduced(w, tree, x);
+  maskReduced(model.joints, w, tree, x);
   applySystem(model, o, w, tree, dt, x, t, z, q);
   r = rhs - q;
   applyPreconditioner(w, r, z);
@@ -522,7 +522,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
 
   // v += J dv'
   t = x;
-  expandJointVelocities(w, tree, t);
+  expandJointVelocities(model.joints, w, tree, t);
   for (int b = 0; b < nb; ++b) {
     if (model.bodies.isFixed[at(b)]) continue;
     s.bodyVelocity.col(b) += t.segment<3>(6 * b);
@@ -752,8 +752,6 @@ StepWork makeStepWork(const Model& model) {
   w.jointMassInverse.assign(at(nj), Matrix3d::Zero());
   // the joint tree: joints whose child hangs on no other joint, ordered parents first (a joint closing a
   // loop stays with the impulse solver of stage 3 only)
-  w.treeParent = model.joints.parent;
-  w.treeChild = model.joints.child;
   w.treeLeverParent = Eigen::Matrix3Xd::Zero(3, nj);
   w.treeLeverChild = Eigen::Matrix3Xd::Zero(3, nj);
   {

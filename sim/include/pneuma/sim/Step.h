@@ -118,7 +118,6 @@ struct StepWork {
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
                                                       ///< dv' of the last step as the next warm start
   std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
-  std::vector<int> treeParent, treeChild;  ///< parent / child body of every joint (#J)
   Eigen::Matrix3Xd treeLeverParent, treeLeverChild;  ///< [m] joint anchor minus com, world, at the step start (3 x #J)
   Eigen::MatrixXd bodyTreeMap;         ///< [-, m] body part of the tree map J (6 #B x 6 #B), scratch
 };
