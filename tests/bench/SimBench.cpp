@@ -1,17 +1,15 @@
 // Speed of the simulation core (Google Benchmark): the real-time factor per breath style on the
 // default model (simulated seconds per wall-clock second, one thread), and the cost of one step as the
 // gut mesh is refined 4x per level (synthetic toy torso, 162 -> 642 -> 2562 gut nodes).
+#include "DefaultModel.h"
 #include "ToyTorso.h"
 
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
-#include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Simulation.h"
 
 #include <benchmark/benchmark.h>
 
-#include <cstdlib>
-#include <filesystem>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -19,14 +17,7 @@
 namespace pneuma::sim {
 namespace {
 
-std::shared_ptr<const Model> defaultModel() {
-  static std::shared_ptr<const Model> model = [] {
-    const char* env = std::getenv("PNEUMA_DEFAULT_MODEL_DIR");
-    const std::string dir = env != nullptr ? env : PNEUMA_DEFAULT_MODEL_DIR;
-    return std::filesystem::exists(dir + "/model.json") ? std::make_shared<const Model>(loadModel(dir)) : nullptr;
-  }();
-  return model;
-}
+using test::defaultModel;
 
 // real-time factor of a breath style on the default model, after 100 settling steps (1 s at the implicit
 // integrators' 10 ms; rtf is a rate over the CPU time of the loop, i.e. wall time on an idle core; stepping,

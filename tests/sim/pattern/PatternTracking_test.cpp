@@ -1,13 +1,13 @@
 // Validation: the physical default model follows the affect presets (issue 7 targets): tracking RMS
 // < 10 % of the target's peak-to-peak, measured rate within 0.5 b/m, suspensions held within 5 %.
-#include "pneuma/sim/ModelIO.h"
+#include "DefaultModel.h"
+
 #include "pneuma/sim/pattern/PatternController.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <string>
 
 using namespace pneuma::sim;
@@ -16,13 +16,7 @@ using namespace pneuma::sim::pattern;
 namespace {
 
 const std::string kResources = PNEUMA_RESOURCE_DIR;
-const std::string kModelDir = PNEUMA_DEFAULT_MODEL_DIR;
-
-std::shared_ptr<const Model> defaultModel() {
-  static std::shared_ptr<const Model> model =
-      std::filesystem::exists(kModelDir + "/model.json") ? std::make_shared<const Model>(loadModel(kModelDir)) : nullptr;
-  return model;
-}
+using pneuma::sim::test::defaultModel;
 
 // the drive calibration of the default model, measured once per process
 const DriveCalibration& calibration() {
@@ -33,7 +27,7 @@ const DriveCalibration& calibration() {
 class PatternTracking : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override {
-    if (!defaultModel()) GTEST_SKIP() << "default model absent: " << kModelDir;
+    REQUIRE_DEFAULT_MODEL();
   }
 };
 
@@ -73,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(Presets, PatternTracking,
 class PatternTrackingRobustness : public ::testing::TestWithParam<double> {};
 
 TEST_P(PatternTrackingRobustness, FollowsExcitementWithMisCalibratedMuscleGains) {
-  if (!defaultModel()) GTEST_SKIP() << "default model absent: " << kModelDir;
+  REQUIRE_DEFAULT_MODEL();
   SimulationOptions options;
   for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal, ElementGroup::Diaphragm})
     options.step.activeGainScale[static_cast<std::size_t>(g)] = GetParam();
@@ -97,7 +91,7 @@ INSTANTIATE_TEST_SUITE_P(GainScales, PatternTrackingRobustness, ::testing::Value
 class PatternSuspension : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(PatternSuspension, HoldsTheVolumeForTheWholeSuspension) {
-  if (!defaultModel()) GTEST_SKIP() << "default model absent: " << kModelDir;
+  REQUIRE_DEFAULT_MODEL();
   const Pattern pattern = loadAffect(GetParam(), kResources);
   const double peak = pattern.layers.front().cycle.depthMax;
   SimulationOptions options;
