@@ -471,9 +471,7 @@ void applySystem(const Model& model, const StepOptions& o, const StepWork& w, co
 void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepOptions& o, StepWork& w) {
   const int nb = model.bodies.size(), nn = model.nodes.size();
   Eigen::VectorXd &x = w.cgX, &r = w.cgR, &z = w.cgZ, &p = w.cgP, &q = w.cgQ, &rhs = w.cgB, &t = w.cgT;
-  // implicit-euler-joints: the joint tree's coordinates; implicit-euler: the full space (joints in stage 3 only)
-  static const std::vector<int> kNoJoints;
-  const std::vector<int>& tree = o.integrator == IntegratorKind::ImplicitEulerJoints ? w.treeJoints : kNoJoints;
+  const std::vector<int>& tree = w.treeJoints;
   for (int j : tree) {
     w.treeLeverParent.col(j) = w.rotation[at(model.joints.parent[at(j)])] * w.jointLocalParent.col(j);
     w.treeLeverChild.col(j) = w.rotation[at(model.joints.child[at(j)])] * w.jointLocalChild.col(j);
@@ -637,7 +635,7 @@ void integratePositions(const Model& model, State& s, double dt, StepWork& w) {
 
 std::string describeBlowUpCause(double dt) {
   std::ostringstream os;
-  os << "likely cause: dt = " << dt << " s too large for the stiffness (lower dt or use implicit-euler)";
+  os << "likely cause: dt = " << dt << " s too large for the stiffness (lower dt, or use implicit-euler-joints)";
   return os.str();
 }
 
@@ -659,7 +657,6 @@ void computeForces(const Model& model, const State& s, const Activations& act, c
 namespace {
 const std::pair<IntegratorKind, const char*> kIntegratorNames[] = {
     {IntegratorKind::SymplecticEuler, "symplectic-euler"},
-    {IntegratorKind::ImplicitEuler, "implicit-euler"},
     {IntegratorKind::ImplicitEulerJoints, "implicit-euler-joints"}};
 }  // namespace
 

@@ -73,10 +73,9 @@ void stepTime(benchmark::State& state) {
 }
 
 const bool kRegistered = [] {
-  // every breath style with the default integrator; calm with the others
+  // every breath style with the default integrator; calm with the reference one
   std::vector<std::pair<IntegratorKind, const char*>> runs;
-  for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) runs.emplace_back(IntegratorKind::ImplicitEuler, style);
-  runs.emplace_back(IntegratorKind::ImplicitEulerJoints, "calm");
+  for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) runs.emplace_back(IntegratorKind::ImplicitEulerJoints, style);
   runs.emplace_back(IntegratorKind::SymplecticEuler, "calm");
   for (const auto& [integrator, style] : runs)
     benchmark::RegisterBenchmark((std::string("RealTimeFactor/") + integratorName(integrator) + "/" + style).c_str(),

@@ -115,7 +115,7 @@ TEST(Scenario, BadFieldsAreNamedByTheirJsonPath) {
   expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"pattern": 3}})",
               {"controller.pattern: must be a pattern file path"});
   expectError(with(R"("overrides": {"dt_s": 0})"), {"overrides.dt_s: must be > 0"});
-  expectError(with(R"("overrides": {"integrator": "rk4"})"), {"overrides.integrator", "rk4", "implicit-euler"});
+  expectError(with(R"("overrides": {"integrator": "rk4"})"), {"overrides.integrator", "rk4", "implicit-euler-joints"});
   expectError(with(R"("overrides": {"active_gain_scale": {"diaphram": 2}})"),
               {"overrides.active_gain_scale.diaphram: unknown muscle group", "diaphragm"});
   expectError(with(R"("overrides": {"passive_gain_scale": {"rectus": -1}})"), {"overrides.passive_gain_scale.rectus: must be >= 0"});

@@ -131,7 +131,7 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   const Activations a = c.activations(0.1, none);  // inhale
   EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha, panting.diaphragmAlpha);
   EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha);
-  EXPECT_LT(panting.intercostalAlpha, 1.0);
+  EXPECT_LT(panting.diaphragmAlpha, 1.0);
   const std::string text = serializeBreathStyle(panting);
   EXPECT_EQ(serializeBreathStyle(parseBreathStyle(text, "panting.json")), text);
   BreathStyle bad = panting;

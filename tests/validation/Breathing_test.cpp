@@ -79,15 +79,10 @@ TEST(Breathing, SpineSwaysBackwardOnDeepInhale) {
   expectPassed(swayChecks(run("deep", 1.0), run("deep", 0.0)), {"sway.backward"});
 }
 
-// Section 5: without joint friction the spine sways clearly less. KNOWN FAILING, disabled so the rest of
-// the suite can gate CI (issue 4 stays open): the frictionless sway is 0.90 of the sway with friction (bound
-// < 0.5). With implicit-euler the sway comes from the split joint solve and the passive abdominal wall pulling
-// the sternum back (the spine is a cantilever on the fixed lumbar spine), not from Eq. 3: rib friction of
-// 0.05 N m s/rad gives ~0.1 N m against 300 N m/rad of spine stiffness. implicit-euler-joints is stable up to
-// 15 N m s/rad and at 5 N m s/rad its friction does move the spine back during the inhale (most posterior
-// displacement -1.2 mm vs -0.4 mm frictionless), but the presets are not calibrated on it yet
-// (docs/cli.md, sim/Step.h). Run with --gtest_also_run_disabled_tests; `pneuma-cli validate` reports it.
-TEST(Breathing, DISABLED_FrictionlessSpineSwaysClearlyLess) {
+// Section 5: without joint friction the spine sways clearly less ("through these friction-based torques, as
+// the ribs move, the spine moves"): the mean most-posterior displacement of the spine top during the inhales
+// without friction is below half of that with the calibrated rib friction (12 N m s/rad)
+TEST(Breathing, FrictionlessSpineSwaysClearlyLess) {
   REQUIRE_DEFAULT_MODEL();
   expectPassed(swayChecks(run("deep", 1.0), run("deep", 0.0)), {"sway.friction_ratio"});
 }

@@ -43,8 +43,7 @@ TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, EnergyDecay,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler,
-                                           IntegratorKind::ImplicitEulerJoints),
+                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEulerJoints),
                          [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The integrators on the default model (sim/Step.h): every one is stable at its default time step (issue 4);
 // implicit-euler-joints, backward Euler in the coordinates of the joint tree, (a) only dissipates under strong
-// rib-joint friction (Eq. 3, Zordan et al. 2004 Sec. 5), where the split solve of implicit-euler gains energy,
-// and (b) breathes the same at dt 10 ms and 5 ms.
+// rib-joint friction (Eq. 3, Zordan et al. 2004 Sec. 5), where a split solve (joints imposed after the linear
+// solve) gained energy, and (b) breathes the same at dt 10 ms and 5 ms.
 #include "DefaultModel.h"
 #include "ToyTorso.h"
 
@@ -38,8 +38,7 @@ TEST_P(DefaultStep, IsStableOnTheDefaultModel) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, DefaultStep,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEuler,
-                                           IntegratorKind::ImplicitEulerJoints),
+                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEulerJoints),
                          [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 // relaxed, no gravity, random spins of every moving body: total energy must not grow (Eq. 3 is dissipative)
@@ -49,7 +48,7 @@ TEST(ImplicitEulerJoints, StrongRibFrictionOnlyDissipates) {
   StepOptions o;
   o.integrator = IntegratorKind::ImplicitEulerJoints;
   o.gravity = false;
-  o.jointFrictionScale = 100.0;  // 5 N m s/rad at the rib-spine joints: 10x past where implicit-euler blows up
+  o.jointFrictionScale = 10.0;  // 120 N m s/rad at the rib-spine joints, 10x the calibrated mu
   State s = test::randomVelocityState(m, 0.0, 0.5);
   StepWork w = makeStepWork(m);
   Metrics met;

@@ -63,7 +63,7 @@ TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
     EXPECT_TRUE(s.contains(key)) << key;
   EXPECT_FALSE(s["partial"].get<bool>());
   EXPECT_EQ(s["pneuma_version"], PNEUMA_VERSION);
-  EXPECT_EQ(s["integrator"], "implicit-euler");
+  EXPECT_EQ(s["integrator"], "implicit-euler-joints");
   EXPECT_TRUE(s["tracking_rms_pct"].is_null());  // no volume target for a breath style
   EXPECT_GT(s["tidal_volume_ml"].get<double>(), 0.0);
   EXPECT_GE(s["breaths_per_minute"].get<double>(), 0.0);

@@ -72,13 +72,18 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
 
 /// Checks of Section 8.1, Table 2 and Figures 4-6 on runs named "calm", "deep", "panting" and
 /// "forced-exhale" (checks whose runs are missing are left out): gut volume error < 2 % in every style;
-/// calm tidal volume 500 +/- 50 mL at 15 +/- 0.5 b/m; deep above calm, 1-3 L, 12 +/- 0.5 b/m; panting
-/// 60 +/- 1 b/m, below calm, chest-dominant (xiphoid/umbilicus excursion ratio above calm's); forced exhale
+/// calm tidal volume 500 +/- 50 mL at 15 +/- 0.5 b/m; deep above calm, 0.6-3 L, 12 +/- 0.5 b/m; panting
+/// 60 +/- 1 b/m, below calm, chest-dominant (the ratio of the xiphoid's to the umbilicus's anterior-posterior
+/// excursion, the motion seen from the side as in Fig. 5, above calm's); forced exhale
 /// below calm end-expiration, umbilicus >= 1 cm posterior, xiphoid down.
 std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 
-/// [m] backward sway of the spine top on inhale: its y at the frame of largest lung volume minus its y
-/// at the frame of smallest lung volume, after settling (< 0: the spine moves backward on inhale).
+/// [m] backward sway of the spine top during inhales (Section 5: "during a deep inhale, as the ribs are
+/// pulled upward, the spine moves backward"): for every full inhale after settling (the controller's
+/// windows [settle + k T, settle + (k + inhaleFraction) T), T = 60 / breathsPerMinute), the most posterior
+/// displacement of the spine top's y from its value at the inhale's start, averaged over the inhales
+/// (< 0: the spine moves backward). Measured during the inhale rather than at peak volume because the
+/// friction torque of Eq. 3 follows the ribs' angular velocity and vanishes when they stop.
 double spineSway(const StyleRun& run);
 
 /// Section 5: with friction the spine moves backward on a deep inhale (sway < -0.1 mm), and without

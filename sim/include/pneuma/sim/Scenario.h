@@ -11,7 +11,7 @@
 ///     "duration_s": 30, "seed": 1,
 ///     "controller": {"style": "calm"},            // or {"affect": "startle"}, or {"pattern": "file.json"},
 ///                                                 // or {"pattern": { ...inline pattern file... }}
-///     "overrides": {"integrator": "implicit-euler", "dt_s": 0.002, "settle_time_s": 2,
+///     "overrides": {"integrator": "implicit-euler-joints", "dt_s": 0.002, "settle_time_s": 2,
 ///                   "gravity": true, "joint_friction_scale": 1, "kappa_pa": 2e4,
 ///                   "active_gain_scale": {"diaphragm": 1.1}, "passive_gain_scale": {"cartilage": 2}},
 ///     "outputs": {"output_rate_hz": 60, "csv": true, "plots": true, "vtk": false}

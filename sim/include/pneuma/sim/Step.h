@@ -11,32 +11,28 @@
 /// - SymplecticEuler: the paper's reference scheme (Section 6.1), v += F/m dt, then x += v dt, for
 ///   nodes and bodies (quaternions integrated with the new angular velocity). Explicit, so dt is
 ///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max).
-/// - ImplicitEuler: linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH 1998) over all
-///   node and body velocities, solving (M + dt D + dt^2 K) dv = dt (f - dt K v) with a matrix-free
-///   conjugate gradient, warm-started from the previous dv. Preconditioner: the dense 6#B x 6#B body
-///   block of the system, LDLT-factored every `preconditionerRefresh` steps (the light, stiffly coupled
-///   ribcage: ~25 bodies), and block Jacobi (3x3 per node, with the gut pressure's diagonal blocks) for the
-///   gut nodes. K holds the element stiffness along and across each
-///   taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
-///   joint springs; D holds element damping and joint friction. Why this one: the stiff parts of the
-///   model (cartilage, the gut's near-incompressibility kappa, joint friction on light ribs) are
-///   linear or nearly so, so backward Euler removes their step limit at the cost of a few CG passes
-///   that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so its numerical
-///   damping of high frequencies is harmless, while a position-based (XPBD) scheme would not follow
-///   the paper's force laws (Eq. 2, 4, 5) as directly. Default dt 10 ms. Symplectic Euler's default is
-///   10 us: on the default model its limit is the diaphragm damping on the light dome nodes (dt < 2 m / sum b,
-///   b = 250 N s/m) and the 10-25 g ribs; 20 us blows up within 0.1 s (real-time factor about 0.1).
-/// - ImplicitEulerJoints: the same backward Euler solved in the coordinates of the joint tree: the linear
+/// - ImplicitEulerJoints (the default): linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH
+///   1998), solving (M + dt D + dt^2 K) dv = dt (f - dt K v) in the coordinates of the joint tree: the linear
 ///   velocity of every body hanging on a ball joint is eliminated, v_c = v_p + w_p x r_p - w_c x r_c
-///   (J: reduced -> full velocities), and CG solves J^T (M + dt D + dt^2 K) J dv' = J^T rhs. The joints
-///   then hold inside the linear solve, so joint friction (Eq. 3) couples a rib's spin to the spine about
-///   the joint rather than about the rib's com. Why: ImplicitEuler treats friction and stiffness without
-///   the joints and projects afterwards; that split is not consistent in dt (deep breathing on the default
-///   model: 1260 mL at dt 10 ms, 1755 mL at 2 ms) and gains energy at mu >~ 0.5 N m s/rad (relaxed, no
-///   gravity: 5e-4 J -> 400 J in 1.5 s). ImplicitEulerJoints gives 651 mL at both dt and decays for any mu
-///   tested (up to 15 N m s/rad). Not yet the default: the presets are calibrated on ImplicitEuler.
+///   (J: reduced -> full velocities), and a matrix-free conjugate gradient, warm-started from the previous
+///   dv', solves J^T (M + dt D + dt^2 K) J dv' = J^T rhs. K holds the element stiffness along and across
+///   each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
+///   joint springs; D holds element damping and joint friction. Preconditioner: the dense body block of
+///   the reduced system, LDLT-factored every `preconditionerRefresh` steps (the light, stiffly coupled
+///   ribcage), and block Jacobi (3x3 per node, with the gut pressure's diagonal blocks) for the gut nodes.
+///   Why this one: the stiff parts of the model (cartilage, the gut's near-incompressibility kappa, joint
+///   friction on 10-25 g ribs) are linear or nearly so, so backward Euler removes their step limit at the
+///   cost of a few CG passes that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so
+///   its numerical damping of high frequencies is harmless, while a position-based (XPBD) scheme would not
+///   follow the paper's force laws (Eq. 2, 4, 5) as directly. The joints hold inside the linear solve, so
+///   joint friction (Eq. 3) couples a rib's spin to the spine about the joint rather than about the rib's
+///   com: friction only dissipates (tested up to 15 N m s/rad, 100x the calibrated mu) and the result does
+///   not depend on dt (deep breathing within 3 % between 10 and 2 ms). An earlier variant that solved in
+///   the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
+///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 10 ms
+///   (20 ms still runs but the gut volume error grows to 4 % with the calibrated gains).
 /// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
-/// at every joint (all of it for ImplicitEuler, the linearisation error for ImplicitEulerJoints) and a
+/// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
 /// mass-weighted projection removes the position drift.
 
 #include "pneuma/sim/Activation.h"
@@ -54,9 +50,9 @@
 namespace pneuma::sim {
 
 /// Time integration scheme.
-enum class IntegratorKind { SymplecticEuler, ImplicitEuler, ImplicitEulerJoints };
+enum class IntegratorKind { SymplecticEuler, ImplicitEulerJoints };
 
-/// "symplectic-euler", "implicit-euler" or "implicit-euler-joints".
+/// "symplectic-euler" or "implicit-euler-joints".
 const char* integratorName(IntegratorKind k);
 /// All valid names, comma separated (for error messages).
 std::string integratorNames();
@@ -67,7 +63,7 @@ double defaultTimeStep(IntegratorKind k);
 
 /// Per-run physical switches and solver settings.
 struct StepOptions {
-  IntegratorKind integrator = IntegratorKind::ImplicitEuler;
+  IntegratorKind integrator = IntegratorKind::ImplicitEulerJoints;
   bool gravity = true;                ///< apply Model::gravity to bodies and nodes
   double jointFrictionScale = 1.0;    ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
   double kappa = -1.0;                ///< [Pa] gut bulk modulus of Eq. 4; < 0 uses Model::gut.kappa
@@ -128,7 +124,7 @@ StepWork makeStepWork(const Model& model);
 /// Stage 1 alone: clears and accumulates work.bodyForce [N], bodyTorque [N m] (world, about each com) and
 /// nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3)
 /// and stiffness, gravity and the gyroscopic term; also fills the per-element and gut by-products.
-/// Joint friction is included for ImplicitEuler only; SymplecticEuler integrates it implicitly per joint
+/// Joint friction is included for ImplicitEulerJoints only; SymplecticEuler integrates it implicitly per joint
 /// right after the velocity update (unconditionally stable for light bones).
 void computeForces(const Model& model, const State& state, const Activations& act, const StepOptions& options,
                    StepWork& work);
