@@ -10,7 +10,9 @@
 #include <QTimer>
 #include <QVTKOpenGLNativeWidget.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
@@ -32,6 +34,18 @@ int main(int argc, char** argv) {
   }
   int qtArgc = static_cast<int>(qtArgv.size());
   qtArgv.push_back(nullptr);
+
+  // without a display Qt would abort with a plugin message: say what to do instead
+  const bool hasPlatformArg = std::any_of(qtArgv.begin(), qtArgv.end() - 1, [](const char* a) {
+    return std::string(a) == "-platform" || std::string(a) == "--platform";
+  });
+  const auto isSet = [](const char* name) { return std::getenv(name) && *std::getenv(name); };
+  if (!isSet("DISPLAY") && !isSet("WAYLAND_DISPLAY") && !isSet("QT_QPA_PLATFORM") && !hasPlatformArg) {
+    std::fprintf(stderr,
+                 "pneuma: no display (DISPLAY is not set): run it in a desktop session or under "
+                 "'xvfb-run -a -s \"-screen 0 1280x800x24\" pneuma ...'; for headless runs use pneuma-cli\n");
+    return 2;
+  }
 
   QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
   QApplication app(qtArgc, qtArgv.data());

@@ -1,6 +1,6 @@
 #pragma once
 /// @file CliRunner.h
-/// Runs build/bin/pneuma-cli as a child process for the CLI tests: captured stdout/stderr and exit code,
+/// Runs build/bin/pneuma-cli (or the app) as a child process for the CLI and GUI tests: captured stdout/stderr and exit code,
 /// optionally interrupted with SIGINT after a delay.
 
 #include <gtest/gtest.h>
@@ -33,14 +33,14 @@ inline std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-/// Runs pneuma-cli with `args`. When `sigintAfterSeconds` > 0, sends SIGINT after that delay.
+/// Runs build/bin/`program` with `args`. When `sigintAfterSeconds` > 0, sends SIGINT after that delay.
 /// `env` entries ("NAME=value") are added to the child's environment.
-inline CliResult runCli(const std::vector<std::string>& args, double sigintAfterSeconds = 0.0,
-                        const std::vector<std::string>& env = {}) {
+inline CliResult runProgram(const std::string& program, const std::vector<std::string>& args,
+                            double sigintAfterSeconds = 0.0, const std::vector<std::string>& env = {}) {
   static int counter = 0;
   const std::string base = testing::TempDir() + "pneuma_cli_" + std::to_string(getpid()) + "_" + std::to_string(++counter);
   const std::string outPath = base + ".out", errPath = base + ".err";
-  const std::string exe = std::string(PNEUMA_BIN_DIR) + "/pneuma-cli";
+  const std::string exe = std::string(PNEUMA_BIN_DIR) + "/" + program;
 
   pid_t pid = fork();
   if (pid == 0) {
@@ -69,6 +69,12 @@ inline CliResult runCli(const std::vector<std::string>& args, double sigintAfter
   std::remove(outPath.c_str());
   std::remove(errPath.c_str());
   return r;
+}
+
+/// Runs pneuma-cli (see runProgram()).
+inline CliResult runCli(const std::vector<std::string>& args, double sigintAfterSeconds = 0.0,
+                        const std::vector<std::string>& env = {}) {
+  return runProgram("pneuma-cli", args, sigintAfterSeconds, env);
 }
 
 /// Number of lines in `s` (a final line without newline counts).

@@ -1,6 +1,7 @@
 // What the user sees in the main window, asserted on grabs, widgets and exported files under Xvfb.
 // The run uses the sim tests' toy torso (every part of the default model at a tenth of the size).
 
+#include "../cli/CliRunner.h"
 #include "GuiTestSupport.h"
 #include "gui/LivePlots.h"
 #include "gui/MainWindow.h"
@@ -363,4 +364,12 @@ TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {
   EXPECT_TRUE(w.window.lastError().contains("blew up")) << w.window.lastError().toStdString();
   ASSERT_NE(w.window.shown(), nullptr);
   EXPECT_FALSE(w.window.shown()->isRunning);
+}
+
+// without a display the app says what to do and exits 2, instead of Qt's plugin abort
+TEST(App, WithoutADisplayExplainsAndExitsTwo) {
+  const test::CliResult r = test::runProgram("pneuma", {"--style", "calm"}, 0.0, {"DISPLAY=", "WAYLAND_DISPLAY="});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("no display"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pneuma-cli"), std::string::npos) << r.err;
 }
