@@ -152,7 +152,9 @@ Activations BreathStyleController::activations(double t, const Metrics& /*latest
   // after a finite number of cycles, hold the cycle-start posture
   const double tc = (s.cycles > 0 && t >= s.cycles * period) ? 0.0 : std::max(t, 0.0);
   const double phase = std::fmod(tc, period) / period;  // [-] 0 = start of inhale
-  const bool inhale = phase < s.inhaleFraction;
+  // the cycle-start posture itself (settling, holds) is the relaxed end of an exhale: diaphragm and rectus off
+  const bool isRest = tc == 0.0;
+  const bool inhale = !isRest && phase < s.inhaleFraction;
   const double c = std::cos(2.0 * kPi * phase);
 
   Activations a = relaxedActivations();
@@ -162,7 +164,7 @@ Activations BreathStyleController::activations(double t, const Metrics& /*latest
   slot(a, ElementGroup::IntercostalExternal) = {s.intercostalMean + s.intercostalAmplitude * c, s.intercostalAlpha};
   slot(a, ElementGroup::IntercostalInternal) = {s.intercostalMean - s.intercostalAmplitude * c, s.intercostalAlpha};
   // rectus: forced exhale only, during the exhale part
-  if (s.rectusActive && !inhale) slot(a, ElementGroup::Rectus) = {s.rectusR, 1.0};
+  if (s.rectusActive && !isRest && !inhale) slot(a, ElementGroup::Rectus) = {s.rectusR, 1.0};
   return a;
 }
 

@@ -12,7 +12,9 @@
 ///  - inner intercostals: out of phase, r(t) = mean - amplitude cos(2 pi t / T), alpha = intercostalAlpha;
 ///  - rectus: only when rectusActive (forced exhale): alpha = 1 and r = rectusR during exhale;
 ///  - transversus/obliques and cartilage stay passive (alpha = 0, r = 1).
-/// When cycles > 0 the style plays that many cycles and then holds the cycle-start activations.
+/// The cycle-start posture (t <= 0, i.e. during settling, and the hold after a finite style) is the relaxed end
+/// of an exhale: diaphragm and rectus off, intercostals at their t = 0 values. When cycles > 0 the style plays that many cycles
+/// and then holds that posture.
 
 #include "pneuma/sim/Controller.h"
 
