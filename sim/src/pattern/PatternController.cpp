@@ -34,51 +34,63 @@ double invert(const GroupResponse& reach, double demand) {
   return 1.0;
 }
 
-// split a demand >= 0 between a chest and a belly lever: chest takes `share` of it, and a lever that
-// cannot give its part (capacity reached, or no capacity at all) hands the rest to the other one;
-// returns the two activations
-std::pair<double, double> splitDemand(double demand, double share, const GroupResponse& chest,
-                                      const GroupResponse& belly) {
-  const double capChest = chest.back(), capBelly = belly.back();
-  if (capChest <= 0.0) share = 0.0;
-  if (capBelly <= 0.0) share = 1.0;
-  double dChest = demand * share, dBelly = demand - dChest;
-  if (dBelly > capBelly) dChest += dBelly - capBelly, dBelly = capBelly;
-  if (dChest > capChest) dBelly = std::min(dBelly + dChest - capChest, capBelly), dChest = capChest;
-  return {capChest > 0.0 ? invert(chest, dChest) : 0.0, capBelly > 0.0 ? invert(belly, dBelly) : 0.0};
-}
-
-// the four levers of the drive: inspiratory chest and belly, expiratory chest and belly (abdominal wall:
-// rectus and transversus/obliques at one activation, their useful reaches added)
+// one lever: the useful reach curve of its muscle group(s) and their time constant
+struct Lever {
+  GroupResponse reach{};  // [-] monotone useful fraction change at each of kCalibrationAlphas
+  double tau = 0.0;       // [s] lag of the lung volume behind the lever's activation
+  double capacity() const { return reach.back(); }
+};
+// a channel of the drive (chest or belly): the lever that raises the volume and the one that lowers it
+struct Channel {
+  Lever in, out;
+  // [-] the capacity in the direction of a signed demand (0 for none)
+  double capacity(double demand) const { return demand > 0.0 ? in.capacity() : demand < 0.0 ? out.capacity() : 0.0; }
+};
+// the drive's two channels: chest (external / internal intercostals) and belly (diaphragm / abdominal
+// wall: rectus and transversus/obliques at one activation, their useful reaches added)
 struct Levers {
-  GroupResponse chestIn, bellyIn, chestOut, bellyOut;
+  Channel chest, belly;
 };
 Levers levers(const DriveCalibration& c) {
+  auto lever = [&c](ElementGroup g, double sign) { return Lever{reach(c.response[idx(g)], sign), c.timeConstant[idx(g)]}; };
   Levers l;
-  l.chestIn = reach(c.response[idx(ElementGroup::IntercostalExternal)], 1.0);
-  l.bellyIn = reach(c.response[idx(ElementGroup::Diaphragm)], 1.0);
-  l.chestOut = reach(c.response[idx(ElementGroup::IntercostalInternal)], -1.0);
-  const GroupResponse rectus = reach(c.response[idx(ElementGroup::Rectus)], -1.0);
-  const GroupResponse obliques = reach(c.response[idx(ElementGroup::TransversusObliques)], -1.0);
-  for (std::size_t k = 0; k < l.bellyOut.size(); ++k) l.bellyOut[k] = rectus[k] + obliques[k];
+  l.chest = {lever(ElementGroup::IntercostalExternal, 1.0), lever(ElementGroup::IntercostalInternal, -1.0)};
+  l.belly.in = lever(ElementGroup::Diaphragm, 1.0);
+  const Lever rectus = lever(ElementGroup::Rectus, -1.0), obliques = lever(ElementGroup::TransversusObliques, -1.0);
+  for (std::size_t k = 0; k < l.belly.out.reach.size(); ++k) l.belly.out.reach[k] = rectus.reach[k] + obliques.reach[k];
+  const double wall = rectus.capacity() + obliques.capacity();
+  l.belly.out.tau = wall > 0.0 ? (rectus.capacity() * rectus.tau + obliques.capacity() * obliques.tau) / wall : 0.0;
   return l;
 }
 
-// calibration run: each driven group in turn rests for kRest, then steps through the non-zero levels of
-// kCalibrationAlphas, kLevel at each (r fixed); control time t
+// signed demand of one channel: its share of the static demand plus the inverse of its lag, tau times
+// its share of the target's rate, with the tau of the lever that acts (the raising one when positive)
+double channelDemand(double share, double shareRate, const Channel& ch) {
+  const double up = share + ch.in.tau * shareRate;
+  return up >= 0.0 ? up : std::min(share + ch.out.tau * shareRate, 0.0);
+}
+
+// moves what channel `from` cannot give (beyond its capacity in the demand's direction, all of it when it
+// has none) to channel `to`; the sum of the two demands is kept
+void handOver(double& from, const Channel& chFrom, double& to) {
+  const double excess = std::copysign(std::max(std::abs(from) - chFrom.capacity(from), 0.0), from);
+  from -= excess;
+  to += excess;
+}
+
+// calibration run of one group: it rests for kRest, then steps through the non-zero levels of
+// kCalibrationAlphas, kLevel at each (r fixed), while every other group stays relaxed; control time t
 constexpr double kRest = 0.6;   // [s]
 constexpr double kLevel = 0.8;  // [s]
 constexpr double kGroupTime = kRest + kLevel * (kCalibrationAlphas.size() - 1);  // [s] per group
 class StaircaseController : public Controller {
  public:
-  explicit StaircaseController(double r) : m_r(r) {}
+  StaircaseController(ElementGroup group, double r) : m_group(group), m_r(r) {}
   Activations activations(double t, const Metrics&) override {
     Activations a = relaxedActivations();
-    const auto group = static_cast<std::size_t>(t / kGroupTime);
-    const double tGroup = t - group * kGroupTime;
-    if (group < std::size(kDrivenGroups) && tGroup >= kRest) {
-      const auto level = std::min(1 + static_cast<std::size_t>((tGroup - kRest) / kLevel), kCalibrationAlphas.size() - 1);
-      a[idx(kDrivenGroups[group])] = {m_r, kCalibrationAlphas[level]};
+    if (t >= kRest) {
+      const auto level = std::min(1 + static_cast<std::size_t>((t - kRest) / kLevel), kCalibrationAlphas.size() - 1);
+      a[idx(m_group)] = {m_r, kCalibrationAlphas[level]};
     }
     return a;
   }
@@ -86,6 +98,7 @@ class StaircaseController : public Controller {
   std::unique_ptr<Controller> clone() const override { return std::make_unique<StaircaseController>(*this); }
 
  private:
+  ElementGroup m_group;
   double m_r;
 };
 
@@ -97,6 +110,15 @@ double meanVolume(const Trace& trace, double from, double to) {
     if (trace.time[i] >= from && trace.time[i] < to) sum += trace.lungVolume[i], ++n;
   if (n == 0) throw Error("calibrateDrive: no output frames in [" + std::to_string(from) + ", " + std::to_string(to) + ") s");
   return sum / n;
+}
+
+// integral [m^3 s] of (final - V(t)) over the trace frames with time in [from, to) (rectangle rule on
+// the frame times): for a first-order response to a step settling at `final` it is tau times the step
+double settlingArea(const Trace& trace, double from, double to, double final) {
+  double area = 0.0;
+  for (std::size_t i = 1; i < trace.size(); ++i)
+    if (trace.time[i] > from && trace.time[i] <= to) area += (final - trace.lungVolume[i - 1]) * (trace.time[i] - trace.time[i - 1]);
+  return area;
 }
 
 }  // namespace
@@ -116,18 +138,28 @@ DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const Simula
   constexpr double kLevelWindow = 0.4;  // [s] response: end of each level
   DriveCalibration c;
   c.contractionR = contractionR;
-  const double t0 = options.settleTime;
-  Simulation sim(std::move(model), std::make_unique<StaircaseController>(contractionR), options);
-  sim.advance(t0 + kGroupTime * std::size(kDrivenGroups));
+  const double start = options.settleTime;
   for (std::size_t n = 0; n < std::size(kDrivenGroups); ++n) {
-    const double start = t0 + n * kGroupTime;
+    // one run per group from the settled torso: the ribs' slow release (rib friction) would otherwise
+    // carry one group's answer into the next group's baseline
+    Simulation sim(model, std::make_unique<StaircaseController>(kDrivenGroups[n], contractionR), options);
+    sim.advance(start + kGroupTime);
     const double rest = meanVolume(sim.trace(), start + kRest - kRestWindow, start + kRest);
     if (n == 0) c.restVolume = rest;
     GroupResponse& r = c.response[idx(kDrivenGroups[n])];
+    double area = 0.0, change = 0.0;  // [m^3 s], [m^3] summed over the steps
     for (std::size_t k = 1; k < r.size(); ++k) {
       const double end = start + kRest + k * kLevel;
       r[k] = (meanVolume(sim.trace(), end - kLevelWindow, end) - rest) / c.volumePerFraction;
+      const double from = rest + r[k - 1] * c.volumePerFraction, to = rest + r[k] * c.volumePerFraction;
+      // steps that take the group further from rest (a group past its peak answers the other way)
+      if ((to - from) * r[k] > 0.0) {
+        area += settlingArea(sim.trace(), end - kLevel, end, to);
+        change += to - from;
+      }
     }
+    // method of moments over the whole staircase: tau = sum of areas / sum of changes
+    c.timeConstant[idx(kDrivenGroups[n])] = std::abs(change) > 0.0 ? std::max(area / change, 0.0) : 0.0;
   }
   return c;
 }
@@ -151,10 +183,14 @@ PatternController::PatternController(LayerStack stack, DriveCalibration calibrat
       if (!std::isfinite(c.response[idx(g)][k]))
         throw Error(std::string("calibration.response.") + groupName(g) + "[" + std::to_string(k) +
                     "]: must be finite, got " + std::to_string(c.response[idx(g)][k]));
+  for (ElementGroup g : kDrivenGroups)
+    if (!(c.timeConstant[idx(g)] >= 0.0 && c.timeConstant[idx(g)] < 10.0))
+      throw Error(std::string("calibration.timeConstant.") + groupName(g) + ": must be in [0, 10) s, got " +
+                  std::to_string(c.timeConstant[idx(g)]));
   const Levers l = levers(c);
-  if (l.chestIn.back() + l.bellyIn.back() <= 0.0)
+  if (l.chest.in.capacity() + l.belly.in.capacity() <= 0.0)
     throw Error("calibration.response: neither intercostal_external nor diaphragm raises the lung volume");
-  if (l.chestOut.back() + l.bellyOut.back() <= 0.0)
+  if (l.chest.out.capacity() + l.belly.out.capacity() <= 0.0)
     throw Error("calibration.response: none of intercostal_internal, rectus, transversus_obliques lowers the lung volume");
   if (!(c.volumePerFraction > 0.0)) throw Error("calibration.volumePerFraction: must be > 0");
   if (!(c.restVolume >= 0.0)) throw Error("calibration.restVolume: must be >= 0");
@@ -181,7 +217,7 @@ void PatternController::restart() {
   m_restVolumeSeen = 0.0;
   m_lastTime = m_lastFrameControlTime = m_startTime = 0.0;
   m_lastFrameTime = -1.0;
-  m_target = m_measured = m_error = m_integral = 0.0;
+  m_target = m_targetRate = m_measured = m_error = m_integral = 0.0;
   m_balance = m_stack.balance();
   m_tracking = TrackingStats();
 }
@@ -194,7 +230,7 @@ Activations PatternController::activations(double t, const Metrics& latest) {
   if (!m_isControlling && t <= 0.0) {
     if (latest.lungVolume > 0.0 && m_calibration.restVolume == 0.0) m_restVolumeSeen = latest.lungVolume;
     m_target = m_calibration.restFraction;
-    return distribute(0.0, m_balance);
+    return distribute(0.0, 0.0, m_balance);
   }
 
   // control starts: the pattern clock starts here, and its first breath blends from the measured volume
@@ -212,9 +248,11 @@ Activations PatternController::activations(double t, const Metrics& latest) {
   const double dt = t - m_lastTime;
   m_lastTime = t;
 
-  // target, and the feed-forward demand: its distance from rest
+  // target, and the feed-forward demand: its distance from rest, and its rate (backward difference)
+  const double previousTarget = m_target;
   m_target = m_stack.sample(t - m_startTime);
   const double feedForward = m_target - m_calibration.restFraction;
+  m_targetRate = dt > 0.0 ? (m_target - previousTarget) / dt : 0.0;
 
   // feedback: a new frame was measured at this very control time
   if (latest.time > m_lastFrameTime && m_calibration.restVolume > 0.0) {
@@ -223,8 +261,8 @@ Activations PatternController::activations(double t, const Metrics& latest) {
     // anti-windup: integrate only while the muscles can still give what the error asks for
     const double demand = feedForward + m_options.kp * m_error + m_integral;
     const Levers l = levers(m_calibration);
-    const bool isSaturated = m_error > 0.0 ? demand >= l.chestIn.back() + l.bellyIn.back()
-                                           : -demand >= l.chestOut.back() + l.bellyOut.back();
+    const bool isSaturated = m_error > 0.0 ? demand >= l.chest.in.capacity() + l.belly.in.capacity()
+                                           : -demand >= l.chest.out.capacity() + l.belly.out.capacity();
     if (!isSaturated)
       m_integral = std::clamp(m_integral + m_options.ki * m_error * (t - m_lastFrameControlTime),
                               -m_options.integralLimit, m_options.integralLimit);
@@ -241,25 +279,26 @@ Activations PatternController::activations(double t, const Metrics& latest) {
   m_balance += (m_stack.balance() - m_balance) * (1.0 - std::exp(-dt / m_options.balanceTimeConstant));
 
   // feed-forward plus PI feedback, in volume-fraction units
-  return distribute(feedForward + m_options.kp * m_error + m_integral, m_balance);
+  return distribute(feedForward + m_options.kp * m_error + m_integral, m_targetRate, m_balance);
 }
 
-Activations PatternController::distribute(double demand, double balance) const {
+Activations PatternController::distribute(double demand, double rate, double balance) const {
   Activations a = relaxedActivations();
   for (ElementGroup group : kDrivenGroups) a[idx(group)].r = m_calibration.contractionR;
   const Levers l = levers(m_calibration);
-  if (demand >= 0.0) {
-    // inspiration: external intercostals (chest, share b) and diaphragm (belly, 1 - b)
-    const auto [chest, belly] = splitDemand(demand, balance, l.chestIn, l.bellyIn);
-    a[idx(ElementGroup::IntercostalExternal)].alpha = chest;
-    a[idx(ElementGroup::Diaphragm)].alpha = belly;
-  } else {
-    // expiration below rest: internal intercostals (chest) and the abdominal wall (belly), forced
-    const auto [chest, belly] = splitDemand(-demand, balance, l.chestOut, l.bellyOut);
-    a[idx(ElementGroup::IntercostalInternal)].alpha = chest;
-    for (ElementGroup wall : {ElementGroup::Rectus, ElementGroup::TransversusObliques})
-      a[idx(wall)].alpha = reach(m_calibration.response[idx(wall)], -1.0).back() > 0.0 ? belly : 0.0;
-  }
+  // split by the balance, each channel with its own lag compensation; a saturated channel hands over
+  double chest = channelDemand(balance * demand, balance * rate, l.chest);
+  double belly = channelDemand((1.0 - balance) * demand, (1.0 - balance) * rate, l.belly);
+  handOver(belly, l.belly, chest);
+  handOver(chest, l.chest, belly);
+  // chest: external intercostals raise, internal intercostals lower the volume
+  a[idx(ElementGroup::IntercostalExternal)].alpha = invert(l.chest.in.reach, chest);
+  a[idx(ElementGroup::IntercostalInternal)].alpha = invert(l.chest.out.reach, -chest);
+  // belly: the diaphragm raises it, the abdominal wall lowers it (forced expiration)
+  a[idx(ElementGroup::Diaphragm)].alpha = invert(l.belly.in.reach, belly);
+  const double wall = invert(l.belly.out.reach, -belly);
+  for (ElementGroup g : {ElementGroup::Rectus, ElementGroup::TransversusObliques})
+    a[idx(g)].alpha = reach(m_calibration.response[idx(g)], -1.0).back() > 0.0 ? wall : 0.0;
   return a;
 }
 

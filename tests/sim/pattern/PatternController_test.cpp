@@ -107,6 +107,40 @@ TEST(PatternController, InvertsTheMusclesNonLinearityWithoutFeedback) {
   }
 }
 
+TEST(PatternController, LagFeedForwardInvertsAFirstOrderPlant) {
+  // feed-forward alone on a plant that lags its activations by tau = 0.2 s (the recalibrated ribcage):
+  // panic's 1 Hz panting lags by atan(2 pi 0.2) = 51 degrees without the tau * dv_T/dt term, and is
+  // followed to within the one-step backward difference with it (the plant is the exact first-order lag)
+  auto openLoopRms = [](double calibratedTau) {
+    DriveCalibration c = plantCalibration();
+    c.timeConstant.fill(calibratedTau);
+    PatternControllerOptions open;
+    open.kp = open.ki = 0.0;
+    PatternController ctl(makeLayerStack(loadAffect("panic", kResources), 1), c, open);
+    Plant plant;
+    plant.tau = 0.2;
+    plant.gainError = 1.0;
+    plant.run(ctl, 20.0, c);
+    return ctl.tracking().rmsPercentOfPeakToPeak();
+  };
+  const double without = openLoopRms(0.0), with = openLoopRms(0.2);
+  RecordProperty("rms_pct_without", std::to_string(without));
+  RecordProperty("rms_pct_with", std::to_string(with));
+  EXPECT_GT(without, 20.0);  // 25 %
+  EXPECT_LT(with, 3.0);
+}
+
+TEST(PatternController, RejectsANegativeTimeConstant) {
+  DriveCalibration c = plantCalibration();
+  c.timeConstant[idx(ElementGroup::IntercostalInternal)] = -0.1;
+  try {
+    makeAffectController("neutral", kResources, 1, c);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("calibration.timeConstant.intercostal_internal"), std::string::npos) << e.what();
+  }
+}
+
 TEST(PatternController, BalanceSplitsTheDriveBetweenChestAndBelly) {
   // mean alpha of intercostals vs diaphragm over the run: focus/panic chest, relaxation belly
   auto chestShare = [](const char* affect) {

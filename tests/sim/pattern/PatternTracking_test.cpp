@@ -33,6 +33,22 @@ class PatternTracking : public ::testing::TestWithParam<const char*> {
 
 }  // namespace
 
+// the calibration staircase identifies each lever's lag: the rib friction (Eq. 3, 12 N m s/rad) makes the
+// intercostals, which turn the ribs, a slower lever than the diaphragm, which mainly pushes the gut down;
+// every lag is far below a breath (1 s at 60 b/m) and above the 10 ms step
+TEST(PatternDriveCalibration, IdentifiesTheRibcageAsTheSlowerLeverOnTheDefaultModel) {
+  REQUIRE_DEFAULT_MODEL();
+  const auto tau = [](ElementGroup g) { return calibration().timeConstant[static_cast<std::size_t>(g)]; };
+  for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal, ElementGroup::Diaphragm,
+                         ElementGroup::Rectus}) {
+    RecordProperty(std::string("tau_s_") + groupName(g), std::to_string(tau(g)));
+    EXPECT_GT(tau(g), 0.02) << groupName(g);
+    EXPECT_LT(tau(g), 0.5) << groupName(g);
+  }
+  EXPECT_GT(tau(ElementGroup::IntercostalExternal), 1.5 * tau(ElementGroup::Diaphragm));
+  EXPECT_GT(tau(ElementGroup::IntercostalInternal), 1.5 * tau(ElementGroup::Diaphragm));
+}
+
 TEST_P(PatternTracking, FollowsThePresetOnTheDefaultModel) {
   const std::string affect = GetParam();
   const double duration = 20.0;  // [s] of control after settling

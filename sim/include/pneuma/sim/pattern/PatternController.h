@@ -55,6 +55,9 @@ struct DriveCalibration {
   /// acting the other way is not used. Linear interpolation between the levels.
   std::array<GroupResponse, kElementGroupCount> response{};
   double contractionR = 0.6;      ///< [-] r of every driven group (Eq. 2)
+  /// [s] tau_g: per ElementGroup, the time constant of the lung volume's answer to a step of that
+  /// group's activation, identified on the calibration staircase (0 = an instantaneous group).
+  std::array<double, kElementGroupCount> timeConstant{};
 };
 
 /// [-] R_g(alpha): the calibrated static volume-fraction change of group g alone at activation alpha in
@@ -63,12 +66,13 @@ double groupResponse(const DriveCalibration& calibration, ElementGroup g, double
 
 /// Feedback settings.
 struct PatternControllerOptions {
-  /// [-] proportional gain on the fraction error. The muscles answer within a frame or two, so the loop
-  /// oscillates at the frame rate beyond about 1.5 (at the default 60 Hz output rate); 1.2 cut the
-  /// solver's volume jitter during holds by about a third against 0.8 (at CG tolerance 1e-3) and still
-  /// tracks a plant 25 % stronger than calibrated.
-  double kp = 1.2;
-  double ki = 30.0;               ///< [1/s] integral gain
+  /// [-] proportional gain on the fraction error. With the rib friction of the recalibrated model
+  /// (12 N m s/rad) the chest lags its activation by about 0.2 s, and the lag left over by the
+  /// feed-forward needs a stiffer loop than the old fast plant did: K_p 1.2 and K_i 30 /s left panic at
+  /// 8.5 % and startle's hold at 8.2 %, K_p 3 and K_i 100 /s give 2.9 % and 4.5 %; beyond K_i 150 /s the
+  /// hold starts ringing (5.6 %).
+  double kp = 3.0;
+  double ki = 100.0;              ///< [1/s] integral gain
   double integralLimit = 0.2;     ///< [-] clamp of the integral term I, in fraction units
   double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
 };
@@ -125,7 +129,8 @@ class PatternController : public Controller {
   const DriveCalibration& calibration() const { return m_calibration; }
 
  private:
-  Activations distribute(double demand, double balance) const;  // demand d and balance b -> alphas
+  // demand d [-], target rate [1/s] and balance b [-] -> alphas
+  Activations distribute(double demand, double rate, double balance) const;
   void restart();                                               // back to the state at construction
 
   LayerStack m_stack;
@@ -141,6 +146,7 @@ class PatternController : public Controller {
   double m_lastFrameTime = -1.0;  // [s] Metrics::time of the last frame used
   double m_lastFrameControlTime = 0.0;  // [s] control time at which that frame arrived
   double m_target = 0.0;          // [-] v_T at m_lastTime
+  double m_targetRate = 0.0;      // [1/s] dv_T/dt, backward difference over the last step
   double m_measured = 0.0;        // [-] v_M of the last frame
   double m_error = 0.0;           // [-] e of the last frame
   double m_integral = 0.0;        // [-] I = ki * integral(e dt), clamped
