@@ -24,14 +24,19 @@ GroupResponse reach(const GroupResponse& response, double sign) {
   return r;
 }
 
-// the activation whose reach is `demand` (linear between levels; 0 for no demand, 1 beyond the capacity)
+// the activation whose reach is `demand` (linear between levels; 0 for no demand; beyond the capacity the
+// lowest level that reaches it: a group whose answer falls again at high activation is not driven past its peak)
 double invert(const GroupResponse& reach, double demand) {
   if (demand <= 0.0) return 0.0;
-  for (std::size_t k = 1; k < reach.size(); ++k)
-    if (reach[k] >= demand && reach[k] > reach[k - 1])
+  std::size_t peak = 0;
+  for (std::size_t k = 1; k < reach.size(); ++k) {
+    if (reach[k] <= reach[k - 1]) continue;
+    if (reach[k] >= demand)
       return kCalibrationAlphas[k - 1] +
              (demand - reach[k - 1]) / (reach[k] - reach[k - 1]) * (kCalibrationAlphas[k] - kCalibrationAlphas[k - 1]);
-  return 1.0;
+    peak = k;
+  }
+  return kCalibrationAlphas[peak];
 }
 
 // one lever: the useful reach curve of its muscle group(s) and their time constant
@@ -63,19 +68,23 @@ Levers levers(const DriveCalibration& c) {
   return l;
 }
 
-// signed demand of one channel: its share of the static demand plus the inverse of its lag, tau times
-// its share of the target's rate, with the tau of the lever that acts (the raising one when positive)
-double channelDemand(double share, double shareRate, const Channel& ch) {
-  const double up = share + ch.in.tau * shareRate;
-  return up >= 0.0 ? up : std::min(share + ch.out.tau * shareRate, 0.0);
+// a channel's whole demand (as if it took all of the target): the static demand plus the inverse of its
+// lag, tau times the target's rate, with the tau of the lever that acts (the raising one when positive)
+double channelDemand(double demand, double rate, const Channel& ch) {
+  const double up = demand + ch.in.tau * rate;
+  return up >= 0.0 ? up : std::min(demand + ch.out.tau * rate, 0.0);
 }
 
-// moves what channel `from` cannot give (beyond its capacity in the demand's direction, all of it when it
-// has none) to channel `to`; the sum of the two demands is kept
-void handOver(double& from, const Channel& chFrom, double& to) {
-  const double excess = std::copysign(std::max(std::abs(from) - chFrom.capacity(from), 0.0), from);
-  from -= excess;
-  to += excess;
+// the share of the target the chest takes: the balance b, lowered (raised) until the chest's (belly's)
+// part of its whole demand fits its capacity when both pull the same way; the other channel takes over
+// that part of the target and compensates its own lag for it
+double chestShare(double balance, double chestWhole, double bellyWhole, const Levers& l) {
+  if (chestWhole * bellyWhole < 0.0) return balance;  // opposite directions: each is clipped on its own
+  double b = balance;
+  if (std::abs(b * chestWhole) > l.chest.capacity(chestWhole)) b = l.chest.capacity(chestWhole) / std::abs(chestWhole);
+  if (std::abs((1.0 - b) * bellyWhole) > l.belly.capacity(bellyWhole))
+    b = std::max(b, 1.0 - l.belly.capacity(bellyWhole) / std::abs(bellyWhole));
+  return b;
 }
 
 // calibration run of one group: it rests for kRest, then steps through the non-zero levels of
@@ -286,11 +295,11 @@ Activations PatternController::distribute(double demand, double rate, double bal
   Activations a = relaxedActivations();
   for (ElementGroup group : kDrivenGroups) a[idx(group)].r = m_calibration.contractionR;
   const Levers l = levers(m_calibration);
-  // split by the balance, each channel with its own lag compensation; a saturated channel hands over
-  double chest = channelDemand(balance * demand, balance * rate, l.chest);
-  double belly = channelDemand((1.0 - balance) * demand, (1.0 - balance) * rate, l.belly);
-  handOver(belly, l.belly, chest);
-  handOver(chest, l.chest, belly);
+  // split the target by the balance, each channel with its own lag compensation; a saturated channel
+  // hands part of its share to the other
+  const double chestWhole = channelDemand(demand, rate, l.chest), bellyWhole = channelDemand(demand, rate, l.belly);
+  const double b = chestShare(balance, chestWhole, bellyWhole, l);
+  const double chest = b * chestWhole, belly = (1.0 - b) * bellyWhole;
   // chest: external intercostals raise, internal intercostals lower the volume
   a[idx(ElementGroup::IntercostalExternal)].alpha = invert(l.chest.in.reach, chest);
   a[idx(ElementGroup::IntercostalInternal)].alpha = invert(l.chest.out.reach, -chest);

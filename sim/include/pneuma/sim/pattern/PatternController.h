@@ -9,23 +9,29 @@
 /// (the rest level of every preset: neutral breathing is 5-25 %) and S [m^3] the volume per unit fraction,
 /// 2.5 L by default, so that neutral breathing has a 0.5 L tidal volume and v = 1 lies 2.4 L above rest.
 ///
-/// Control law, every step, in volume-fraction units (a demand d is a fraction change from rest):
-///   d = (v_T - v_rest)                      feed-forward: the target's distance from rest
-///     + K_p e + I,  dI/dt = K_i e             PI feedback on e = v_T - v_M (v_M measured at each frame)
-/// There is no lead term: on the default model the volume follows a step in activation within 20-40 ms,
-/// far faster than any preset's breath, and a lead of 0.05 s doubled panic's tracking error.
-/// d > 0 is inspiratory, split by the thoraco-abdominal balance b between the external intercostals
-/// (b d) and the diaphragm ((1 - b) d); d < 0 is expiratory, split between the internal intercostals
-/// (b |d|) and rectus + transversus/obliques ((1 - b) |d|), which therefore work in forced expirations only.
-/// Each group's share is turned into an activation by inverting its calibrated static response curve
-/// R_g(alpha) (volume-fraction change of the group alone at activation alpha, see calibrateDrive()):
-/// alpha_g = R_g^-1(share). The inversion removes the muscles' strong non-linearity (on the default model
-/// the external intercostals give 0.04 at alpha = 0.05 but only 0.27 at alpha = 1), so the feedback sees
-/// a near-unit static plant; a group that saturates (its share beyond R_g(1)), or that moves the volume
-/// the wrong way on this model, hands its share to its partner. The integral stops while the demand
-/// is beyond what the muscles can give (anti-windup). Unlike Zordan's binary alpha with a varying r,
-/// alpha is graded and r fixed (contractionR): force then grows with the command and an idle antagonist
-/// adds no stiffness, which a feedback loop needs.
+/// Control law, every step, in volume-fraction units (a demand is a fraction change from rest):
+///   d   = (v_T - v_rest) + K_p e + I,  dI/dt = K_i e     static feed-forward plus PI feedback on
+///                                                      e = v_T - v_M (v_M measured at each frame)
+///   d_c = b d + tau_c b dv_T/dt                         chest channel (intercostals)
+///   d_a = (1 - b) d + tau_a (1 - b) dv_T/dt             belly channel (diaphragm, abdominal wall)
+/// with b the thoraco-abdominal balance [-], dv_T/dt [1/s] the target's rate (backward difference over
+/// the last step) and tau [s] the identified lag (DriveCalibration::timeConstant) of the lever that acts:
+/// the tau term inverts a first-order lag (tau dV/dt + V = u  =>  u = V + tau dV/dt). The rib friction
+/// makes the intercostals lag their activation by about 0.2 s on the default model; without the term
+/// the chest falls behind fast breathing and stays above the trough, waiting for the ribs' slow passive
+/// release. d_c > 0 drives the external intercostals, d_c < 0 the internal intercostals; d_a > 0 the
+/// diaphragm, d_a < 0 rectus + transversus/obliques (so the abdominal wall works below rest and at the
+/// end of fast expirations). Each group's demand is turned into an activation by inverting its
+/// calibrated static response curve R_g(alpha) (volume-fraction change of the group alone at activation
+/// alpha, see calibrateDrive()): alpha_g = R_g^-1(d). The inversion removes the muscles' strong
+/// non-linearity, so the feedback sees a near-unit static plant. When both channels pull the same way and
+/// one cannot give its part (beyond the peak of its curve, or its group moves the volume the wrong way
+/// on this model), the balance b is shifted until it fits: the other channel takes over that share of
+/// the target and compensates its own lag for it (a fast diaphragm must not be given the slow chest's
+/// lead). No group is driven past its curve's peak.
+/// The integral stops while the demand is beyond what the muscles can give (anti-windup). Unlike
+/// Zordan's binary alpha with a varying r, alpha is graded and r fixed (contractionR): force then grows
+/// with the command and an idle antagonist adds no stiffness, which a feedback loop needs.
 
 #include "pneuma/sim/Controller.h"
 #include "pneuma/sim/Simulation.h"
@@ -56,7 +62,8 @@ struct DriveCalibration {
   std::array<GroupResponse, kElementGroupCount> response{};
   double contractionR = 0.6;      ///< [-] r of every driven group (Eq. 2)
   /// [s] tau_g: per ElementGroup, the time constant of the lung volume's answer to a step of that
-  /// group's activation, identified on the calibration staircase (0 = an instantaneous group).
+  /// group's activation, identified on the calibration staircase (0 = an instantaneous group); the
+  /// controller's feed-forward asks tau_g dv_T/dt ahead of the target. In [0, 10) s.
   std::array<double, kElementGroupCount> timeConstant{};
 };
 
@@ -87,11 +94,17 @@ struct TrackingStats {
   double rmsPercentOfPeakToPeak() const;
 };
 
-/// Measures each muscle group's static response curve on `model` (one run): after the settling phase,
-/// each driven group in turn rests for 0.6 s (the mean volume of its last 0.3 s is its baseline) and is
-/// then held alone at each level of kCalibrationAlphas (r = contractionR) for 0.8 s; R_g(alpha_k) is the
-/// mean volume of the last 0.4 s of level k minus the baseline, divided by S. The first baseline is
-/// V_rest. 37 s of simulated time, about 4 s of wall time on the default model.
+/// Measures each muscle group's static response curve and lag on `model`: one run per driven group from
+/// the settled torso (so that the ribs' slow release after one group cannot enter the next group's
+/// baseline). The group rests for 0.6 s (the mean volume of the last 0.3 s is its baseline) and is then
+/// held alone at each level of kCalibrationAlphas (r = contractionR) for 0.8 s; R_g(alpha_k) is the mean
+/// volume of the last 0.4 s of level k minus the baseline, divided by S. The lag is the method of moments
+/// over the steps k that take the group further from rest (|R_g| growing):
+///   tau_g = sum_k integral over level k of (V_k - V(t)) dt / sum_k (V_k - V_(k-1))   [s],
+/// with V_k the level's settled volume: exact for a first-order response (tau dV/dt + V = V_k) that
+/// settles within the level.
+/// The first group's baseline is V_rest. 5 x 9 s of simulated time, about 8 s of wall time on the
+/// default model.
 /// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options = {},
                                 double contractionR = 0.6);
