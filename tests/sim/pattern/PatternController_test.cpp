@@ -34,8 +34,8 @@ DriveCalibration plantCalibration() {
 
 // a lung whose volume relaxes with time constant tau [s] towards the static response of the activations
 // (the calibrated curves, additive over groups), whose true responses are `gainError` times the calibrated
-// ones; frames at 60 Hz as in Simulation. The default model's volume settles within about 0.2 s of a step
-// in activation (tau ~ 0.06 s).
+// ones; frames at 60 Hz as in Simulation. On the default model the intercostals lag their activation by
+// about 0.2 s (rib friction) and the diaphragm by about 0.07 s.
 struct Plant {
   double tau = 0.06, gainError = 0.8, volume = 2.4e-3, time = 0.0, nextFrame = 0.0;
   Metrics latest;
@@ -161,6 +161,7 @@ TEST(PatternController, BalanceSplitsTheDriveBetweenChestAndBelly) {
 }
 
 TEST(PatternController, ExpiratoryMusclesWorkOnlyBelowRest) {
+  // (instantaneous levers, tau = 0; with a lag the wall also helps at the end of fast expirations)
   const DriveCalibration c = plantCalibration();
   auto ctl = makeAffectController("neutral", kResources, 1, c);
   Plant plant;
