@@ -153,14 +153,15 @@ void expandJointVelocities(const Joints& joints, const StepWork& w, const std::v
 
 // f <- J^T f: a force on a dependent linear velocity acts on the parent's com and, through the levers,
 // as torques r_p x f on the parent and -r_c x f on the child (children first)
-void gatherJointForces(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& f) {
+template <typename Vec>
+void gatherJointForces(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Vec&& f) {
   for (auto it = tree.rbegin(); it != tree.rend(); ++it) {
     const int j = *it, p = joints.parent[at(j)], c = joints.child[at(j)];
-    const Vector3d fc = f.segment<3>(6 * c);
-    f.segment<3>(6 * p) += fc;
-    f.segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
-    f.segment<3>(6 * c + 3) -= w.treeLeverChild.col(j).cross(fc);
-    f.segment<3>(6 * c).setZero();
+    const Vector3d fc = f.template segment<3>(6 * c);
+    f.template segment<3>(6 * p) += fc;
+    f.template segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
+    f.template segment<3>(6 * c + 3) -= w.treeLeverChild.col(j).cross(fc);
+    f.template segment<3>(6 * c).setZero();
   }
 }
 
@@ -353,46 +354,20 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
     out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
 }
 
-// block-Jacobi preconditioner of the gut nodes: the inverse 3x3 diagonal block of M + dt D + dt^2 K at every
-// node (element terms with the squared barycentric weights, the gut pressure's kp g_n g_n^T); zero when fixed
-void buildPreconditioner(const Model& model, const StepOptions& o, const StepWork& w, double dt,
-                         std::vector<Matrix3d>& blocks) {
-  for (int n = 0; n < model.nodes.size(); ++n) blocks[at(n)] = model.nodes.mass(n) * Matrix3d::Identity();
-  const Elements& el = model.elements;
-  for (int e = 0; e < el.size(); ++e) {
-    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
-    if (ka == 0.0 && kg == 0.0) continue;
-    const Vector3d d = w.elementDirection.col(e);
-    const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
-    for (int side = 0; side < 2; ++side) {
-      if (w.endpointBody(side, e) >= 0) continue;
-      const AnchorSet& a = side == 0 ? el.endA : el.endB;
-      for (int i = 0; i < 3; ++i) {
-        const int n = a.nodes(i, e);
-        if (n >= 0) blocks[at(n)] += (a.weights(i, e) * a.weights(i, e)) * ke;
-      }
-    }
-  }
-  if (w.gutPressure > 0.0) {
-    const double kp = dt * dt * effectiveKappa(model, o) * w.restGutVolume / (w.gutVolume * w.gutVolume);
-    for (int n = 0; n < model.nodes.size(); ++n) blocks[at(n)] += kp * w.gutGradient.col(n) * w.gutGradient.col(n).transpose();
-  }
-  for (int n = 0; n < model.nodes.size(); ++n)
-    blocks[at(n)] = model.nodes.isFixed(n) ? Matrix3d::Zero() : Matrix3d(blocks[at(n)].inverse());
-}
-
-// the dense body block of M + dt D + dt^2 K (6 #B square), factored: the preconditioner of the stiff,
-// light ribcage; fixed bodies get identity rows
-void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
+// the dense body block of M + dt D + dt^2 K (6 #B square) and the coupling of the body entries to the
+// attached nodes' entries (6 #B x 3 #attached), both restricted to the joint tree (J^T . J, J^T .)
+void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
   const int nb = model.bodies.size();
   Eigen::MatrixXd& a = w.bodyBlock;
+  Eigen::MatrixXd& c = w.bodyNodeBlock;
   a.setZero();
+  c.setZero();
   for (int b = 0; b < nb; ++b) {
     const Matrix3d& r = w.rotation[at(b)];
     a.block<3, 3>(6 * b, 6 * b) = model.bodies.mass(b) * Matrix3d::Identity();
     a.block<3, 3>(6 * b + 3, 6 * b + 3) = r * model.bodies.inertia[at(b)] * r.transpose();
   }
-  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints and sign -1 across the two ends
+  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints, w_k I for node k, sign -1 across the ends
   const Elements& el = model.elements;
   Eigen::Matrix<double, 3, 6> ja, jb;
   for (int e = 0; e < el.size(); ++e) {
@@ -407,50 +382,167 @@ void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector
     if (ba >= 0) a.block<6, 6>(6 * ba, 6 * ba) += ja.transpose() * ke * ja;
     if (bb >= 0) a.block<6, 6>(6 * bb, 6 * bb) += jb.transpose() * ke * jb;
     if (ba >= 0 && bb >= 0) {
-      const Eigen::Matrix<double, 6, 6> c = ja.transpose() * ke * jb;
-      a.block<6, 6>(6 * ba, 6 * bb) -= c;
-      a.block<6, 6>(6 * bb, 6 * ba) -= c.transpose();
+      const Eigen::Matrix<double, 6, 6> cab = ja.transpose() * ke * jb;
+      a.block<6, 6>(6 * ba, 6 * bb) -= cab;
+      a.block<6, 6>(6 * bb, 6 * ba) -= cab.transpose();
+      continue;
+    }
+    // one body end, nodes at the other
+    const int side = ba >= 0 ? 1 : 0, b = ba >= 0 ? ba : bb;
+    const AnchorSet& nodes = side == 0 ? el.endA : el.endB;
+    const Eigen::Matrix<double, 6, 3> jk = (ba >= 0 ? ja : jb).transpose() * ke;
+    for (int k = 0; k < 3; ++k) {
+      const int n = nodes.nodes(k, e);
+      if (n >= 0) c.block<6, 3>(6 * b, 3 * w.attachedColumn(n)) -= nodes.weights(k, e) * jk;
     }
   }
   // joint springs and friction on relative angular velocity
   const Joints& j = model.joints;
   for (int i = 0; i < j.size(); ++i) {
     const double kj = dt * dt * j.stiffness(i) + dt * j.friction(i) * o.jointFrictionScale;
-    const int p = j.parent[at(i)], c = j.child[at(i)];
-    a.block<3, 3>(6 * c + 3, 6 * c + 3).diagonal().array() += kj;
+    const int p = j.parent[at(i)], ch = j.child[at(i)];
+    a.block<3, 3>(6 * ch + 3, 6 * ch + 3).diagonal().array() += kj;
     a.block<3, 3>(6 * p + 3, 6 * p + 3).diagonal().array() += kj;
-    a.block<3, 3>(6 * c + 3, 6 * p + 3).diagonal().array() -= kj;
-    a.block<3, 3>(6 * p + 3, 6 * c + 3).diagonal().array() -= kj;
+    a.block<3, 3>(6 * ch + 3, 6 * p + 3).diagonal().array() -= kj;
+    a.block<3, 3>(6 * p + 3, 6 * ch + 3).diagonal().array() -= kj;
   }
-  // restrict to the joint tree's coordinates: J^T A J, with J the body part of expandJointVelocities
+  // restrict to the joint tree's coordinates: J^T A J = J^T (J^T A)^T for symmetric A
   if (!tree.empty()) {
-    Eigen::MatrixXd& jt = w.bodyTreeMap;
-    jt.setIdentity();
-    for (Eigen::Index k = 0; k < jt.cols(); ++k) expandJointVelocities(model.joints, w, tree, jt.col(k));
-    a = (jt.transpose() * a * jt).eval();
+    for (Eigen::Index k = 0; k < a.cols(); ++k) gatherJointForces(model.joints, w, tree, a.col(k));
+    a.transposeInPlace();
+    for (Eigen::Index k = 0; k < a.cols(); ++k) gatherJointForces(model.joints, w, tree, a.col(k));
+    for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
   }
-  // fixed bodies and dependent linear velocities get identity rows
-  for (int b = 0; b < nb; ++b) {
-    if (!model.bodies.isFixed[at(b)]) continue;
-    a.middleRows(6 * b, 6).setZero();
-    a.middleCols(6 * b, 6).setZero();
-    a.block<6, 6>(6 * b, 6 * b).setIdentity();
-  }
-  for (int jj : tree) {
-    const int c = model.joints.child[at(jj)];
-    a.middleRows(6 * c, 3).setZero();
-    a.middleCols(6 * c, 3).setZero();
-    a.block<3, 3>(6 * c, 6 * c).setIdentity();
-  }
-  w.bodyFactor.compute(a);
 }
 
-// z = P^-1 r: the factored body block for bodies, block Jacobi for nodes
-void applyPreconditioner(const StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+// streams the lower triangle of the implicit system without the gut's rank-one term, J^T (M + dt D + dt^2 K0) J,
+// as add(row, col, value) in full coordinates; the sequence of (row, col) depends on the model's topology only
+template <typename Sink>
+void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
   const Eigen::Index nb6 = w.bodyBlock.rows();
-  for (std::size_t n = 0; n < w.nodeBlockInverse.size(); ++n)
-    z.segment<3>(nb6 + 3 * static_cast<Eigen::Index>(n)) = w.nodeBlockInverse[n] * r.segment<3>(nb6 + 3 * static_cast<Eigen::Index>(n));
-  if (nb6 > 0) z.head(nb6) = w.bodyFactor.solve(r.head(nb6));
+  // bodies: the dense block
+  for (Eigen::Index c = 0; c < nb6; ++c)
+    for (Eigen::Index r = c; r < nb6; ++r) add(r, c, w.bodyBlock(r, c));
+  // bodies and attached nodes, where they can couple
+  for (std::size_t k = 0; k < w.attachedNodes.size(); ++k)
+    for (int i = 0; i < 3; ++i)
+      for (Eigen::Index r = 0; r < nb6; ++r)
+        if (w.couplingMask(r, static_cast<Eigen::Index>(k)))
+          add(nodeOffset(model, w.attachedNodes[k]) + i, r, w.bodyNodeBlock(r, 3 * static_cast<Eigen::Index>(k) + i));
+  // node masses
+  for (int n = 0; n < model.nodes.size(); ++n)
+    for (int i = 0; i < 3; ++i) add(nodeOffset(model, n) + i, nodeOffset(model, n) + i, model.nodes.mass(n));
+  // elements between nodes: w_k w_l s_k s_l K_e for every pair of node terms of the two endpoints
+  const Elements& el = model.elements;
+  for (int e = 0; e < el.size(); ++e) {
+    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
+    const Vector3d d = w.elementDirection.col(e);
+    const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
+    for (int sa = 0; sa < 2; ++sa) {
+      if (w.endpointBody(sa, e) >= 0) continue;
+      const AnchorSet& a = sa == 0 ? el.endA : el.endB;
+      for (int sb = 0; sb < 2; ++sb) {
+        if (w.endpointBody(sb, e) >= 0) continue;
+        const AnchorSet& b = sb == 0 ? el.endA : el.endB;
+        for (int ka3 = 0; ka3 < 3; ++ka3) {
+          for (int kb3 = 0; kb3 < 3; ++kb3) {
+            const int na = a.nodes(ka3, e), nb = b.nodes(kb3, e);
+            if (na < 0 || nb < 0 || na < nb) continue;
+            const double s = (sa == sb ? 1.0 : -1.0) * a.weights(ka3, e) * b.weights(kb3, e);
+            for (int c = 0; c < 3; ++c)
+              for (int r = na == nb ? c : 0; r < 3; ++r) add(nodeOffset(model, na) + r, nodeOffset(model, nb) + c, s * ke(r, c));
+          }
+        }
+      }
+    }
+  }
+}
+
+// the preconditioner: a sparse LDLT factorization of the reduced system without the gut's rank-one term,
+// kept for several steps, plus that term by Sherman-Morrison; u = sqrt(kp) g over the free coordinates
+void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
+  assembleBodyBlocks(model, o, tree, w, dt);
+  // the free coordinates and the matrix pattern: once per integrator
+  const bool onTree = !tree.empty();
+  if (w.systemPattern.empty() || onTree != w.factorOnTree) {
+    Eigen::VectorXd mask = Eigen::VectorXd::Ones(w.cgX.size());
+    maskReduced(model.joints, w, tree, mask);
+    w.freeIndex.setConstant(mask.size(), -1);
+    std::vector<int> free;
+    for (Eigen::Index i = 0; i < mask.size(); ++i)
+      if (mask(i) != 0.0) {
+        w.freeIndex(i) = static_cast<int>(free.size());
+        free.push_back(static_cast<int>(i));
+      }
+    w.freeCoordinates = Eigen::Map<const Eigen::VectorXi>(free.data(), static_cast<Eigen::Index>(free.size()));
+    // an attached node couples to the entries of its bodies and of their ancestors in the joint tree
+    std::vector<int> parentOf(at(model.bodies.size()), -1);
+    for (int j : tree) parentOf[at(model.joints.child[at(j)])] = model.joints.parent[at(j)];
+    w.couplingMask.setZero(w.bodyNodeBlock.rows(), static_cast<Eigen::Index>(w.attachedNodes.size()));
+    const Elements& el = model.elements;
+    for (int e = 0; e < el.size(); ++e) {
+      for (int side = 0; side < 2; ++side) {
+        const int body = w.endpointBody(1 - side, e);
+        if (w.endpointBody(side, e) >= 0 || body < 0) continue;
+        const AnchorSet& a = side == 0 ? el.endA : el.endB;
+        for (int k = 0; k < 3; ++k)
+          for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)])
+            w.couplingMask.block(6 * b, w.attachedColumn(a.nodes(k, e)), 6, 1).setOnes();
+      }
+    }
+    std::vector<Eigen::Triplet<double>> entries;
+    streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double) {
+      if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) entries.emplace_back(w.freeIndex(r), w.freeIndex(c), 0.0);
+    });
+    const Eigen::Index nf = w.freeCoordinates.size();
+    w.system.matrix.resize(nf, nf);
+    w.system.matrix.setFromTriplets(entries.begin(), entries.end());
+    w.system.matrix.makeCompressed();
+    // the value slot of every streamed entry
+    w.systemPattern.clear();
+    for (const auto& t : entries) {
+      const int* begin = w.system.matrix.innerIndexPtr() + w.system.matrix.outerIndexPtr()[t.col()];
+      const int* end = w.system.matrix.innerIndexPtr() + w.system.matrix.outerIndexPtr()[t.col() + 1];
+      w.systemPattern.push_back(static_cast<int>(std::lower_bound(begin, end, t.row()) - w.system.matrix.innerIndexPtr()));
+    }
+    w.system.ldlt.analyzePattern(w.system.matrix);
+    w.factorOnTree = onTree;
+    w.compactR.setZero(nf);
+    w.compactZ.setZero(nf);
+  }
+  // values, then the numeric factorization
+  double* values = w.system.matrix.valuePtr();
+  std::fill(values, values + w.system.matrix.nonZeros(), 0.0);
+  std::size_t slot = 0;
+  streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double v) {
+    if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) values[w.systemPattern[slot++]] += v;
+  });
+  w.system.ldlt.factorize(w.system.matrix);
+  // the gut pressure's rank-one stiffness kp g g^T: (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1 u)
+  const Eigen::Index nf = w.freeCoordinates.size();
+  w.rankOne.setZero(nf);
+  if (w.gutPressure > 0.0) {
+    const double su = dt * std::sqrt(effectiveKappa(model, o) * w.restGutVolume) / w.gutVolume;
+    for (Eigen::Index k = 0; k < nf; ++k) {
+      const Eigen::Index i = w.freeCoordinates(k) - 6 * static_cast<Eigen::Index>(model.bodies.size());
+      if (i >= 0) w.rankOne(k) = su * w.gutGradient(i % 3, i / 3);
+    }
+  }
+  w.rankOneSolve = w.system.ldlt.solve(w.rankOne);
+  w.rankOneScale = 1.0 / (1.0 + w.rankOne.dot(w.rankOneSolve));
+  w.factorDt = dt;
+  w.factorAge = 0;
+  w.factorStiffness = w.elementStiffness;
+}
+
+// z = P^-1 r with the factored system (zero on the masked coordinates)
+void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+  const Eigen::Index nf = w.freeCoordinates.size();
+  for (Eigen::Index k = 0; k < nf; ++k) w.compactR(k) = r(w.freeCoordinates(k));
+  w.compactZ = w.system.ldlt.solve(w.compactR);
+  w.compactZ -= (w.rankOneScale * w.rankOne.dot(w.compactZ)) * w.rankOneSolve;
+  z.setZero();
+  for (Eigen::Index k = 0; k < nf; ++k) z(w.freeCoordinates(k)) = w.compactZ(k);
 }
 
 // out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates (t: scratch)
@@ -496,8 +588,18 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   maskReduced(model.joints, w, tree, rhs);
 
   // preconditioned conjugate gradient, warm-started from the previous step's dv
-  buildPreconditioner(model, o, w, dt, w.nodeBlockInverse);
-  if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, tree, w, dt);
+  // a stale factorization is a good preconditioner for a few steps: refresh it when it has aged, when the
+  // last solve needed many iterations, or when dt or the coordinates changed
+  int changed = 0;
+  for (Eigen::Index e = 0; e < w.factorStiffness.size(); ++e) {
+    const double k0 = w.factorStiffness(e), k = w.elementStiffness(e);
+    changed += (k0 > 0.0) != (k > 0.0) || std::abs(k - k0) > 0.5 * k0;
+  }
+  const bool stale = w.system.matrix.size() == 0 || w.factorAge >= o.preconditionerRefresh ||
+                     w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges || dt != w.factorDt ||
+                     !tree.empty() != w.factorOnTree;
+  if (stale) factorSystem(model, o, tree, w, dt);
+  ++w.factorAge;
   maskReduced(model.joints, w, tree, x);
   applySystem(model, o, w, tree, dt, x, t, z, q);
   r = rhs - q;
@@ -706,6 +808,7 @@ void validateStepOptions(const StepOptions& o) {
   if (!(o.jointTolerance > 0.0)) fail("jointTolerance", o.jointTolerance, "must be > 0");
   if (o.cgMaxIterations < 1) fail("cgMaxIterations", o.cgMaxIterations, "must be >= 1");
   if (o.preconditionerRefresh < 1) fail("preconditionerRefresh", o.preconditionerRefresh, "must be >= 1");
+  if (o.refactorIterations < 0) fail("refactorIterations", o.refactorIterations, "must be >= 0");
   if (!(o.cgTolerance > 0.0)) fail("cgTolerance", o.cgTolerance, "must be > 0");
 }
 
@@ -776,8 +879,21 @@ StepWork makeStepWork(const Model& model) {
   w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
   w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  w.bodyTreeMap = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  w.nodeBlockInverse.assign(at(nn), Matrix3d::Zero());
+  // nodes tied by an element to a body: their coupling columns in bodyNodeBlock
+  w.attachedColumn.setConstant(nn, -1);
+  for (int e = 0; e < ne; ++e) {
+    for (int side = 0; side < 2; ++side) {
+      if (w.endpointBody(side, e) >= 0 || w.endpointBody(1 - side, e) < 0) continue;
+      const AnchorSet& a = side == 0 ? model.elements.endA : model.elements.endB;
+      for (int k = 0; k < 3; ++k) {
+        const int node = a.nodes(k, e);
+        if (node < 0 || w.attachedColumn(node) >= 0) continue;
+        w.attachedColumn(node) = static_cast<int>(w.attachedNodes.size());
+        w.attachedNodes.push_back(node);
+      }
+    }
+  }
+  w.bodyNodeBlock = Eigen::MatrixXd::Zero(6 * nb, 3 * static_cast<Eigen::Index>(w.attachedNodes.size()));
   for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgB, &w.cgT}) *v = Eigen::VectorXd::Zero(n);
   return w;
 }

@@ -44,8 +44,9 @@
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/State.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 
 #include <array>
 #include <string>
@@ -76,13 +77,39 @@ struct StepOptions {
   int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
   int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
-  int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the body-block preconditioner every n steps
+  int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the preconditioner at least every n steps
+  int refactorIterations = 4;         ///< [-] implicit Euler: refactor when the last solve needed more CG iterations
+  int refactorElementChanges = 8;     ///< [-] implicit Euler: refactor when more elements went slack or taut, or changed
+                                      ///< stiffness by half, since the last factorization
   double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
 };
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
 /// @throws Error naming the field and value.
 void validateStepOptions(const StepOptions& o);
+
+/// The implicit system's sparse matrix without the gut's rank-one term and its LDLT factorization (Eigen's
+/// simplicial LDLT, AMD ordering, lower triangle). Copies refactor the copied matrix (the factor itself cannot
+/// be copied); the numbers are the same, so a copied StepWork steps bit-identically.
+struct SparseSystemFactor {
+  Eigen::SparseMatrix<double> matrix;                       ///< lower triangle, #free square
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< its factorization
+  SparseSystemFactor() = default;
+  SparseSystemFactor(const SparseSystemFactor& o) : matrix(o.matrix) { refactor(); }
+  SparseSystemFactor& operator=(const SparseSystemFactor& o) {
+    matrix = o.matrix;
+    refactor();
+    return *this;
+  }
+  ~SparseSystemFactor() = default;
+
+ private:
+  void refactor() {
+    if (matrix.size() == 0) return;
+    ldlt.analyzePattern(matrix);
+    ldlt.factorize(matrix);
+  }
+};
 
 /// Preallocated scratch memory of step() (no allocation per step) and the by-products of the last
 /// step that metrics need. Make one per (Model, State) pair with makeStepWork().
@@ -111,15 +138,28 @@ struct StepWork {
   Eigen::Matrix3Xd gutGradient;        ///< [m^2] dV/dx per node (3 x #N)
   double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
   int cgIterations = 0;                ///< [-] CG iterations of the last implicit step
-  Eigen::MatrixXd bodyBlock;           ///< body block of the implicit system, dense (6 #B x 6 #B)
-  Eigen::LDLT<Eigen::MatrixXd> bodyFactor;  ///< its factorization, the CG preconditioner for body entries
-  long long stepsSinceFactor = 0;      ///< [-] counts implicit steps to refresh bodyFactor
-  std::vector<Eigen::Matrix3d> nodeBlockInverse;  ///< [1/kg] inverse 3x3 node blocks of M + dt D + dt^2 K (#N)
+  Eigen::MatrixXd bodyBlock;           ///< [kg, kg m, kg m^2] body block of the implicit system, J^T . J (6 #B x 6 #B)
+  Eigen::MatrixXd bodyNodeBlock;       ///< [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
+  std::vector<int> attachedNodes;      ///< nodes sharing an element with a body (#attached)
+  Eigen::VectorXi attachedColumn;      ///< node -> its index in attachedNodes, or -1 (#N)
+  Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> couplingMask;  ///< 1 where a body entry can couple to an
+                                                                     ///< attached node (6 #B x #attached)
+  Eigen::VectorXi freeIndex;           ///< implicit solver entry -> free coordinate, or -1 (fixed or dependent)
+  Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
+  SparseSystemFactor system;           ///< the preconditioner's matrix and factorization (#free square)
+  std::vector<int> systemPattern;      ///< value slot in system.matrix of every streamed entry (see Step.cpp)
+  Eigen::VectorXd rankOne;             ///< [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
+  Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
+  double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
+  Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
+  double factorDt = 0.0;               ///< [s] dt of the factorization
+  Eigen::VectorXd factorStiffness;     ///< [N/m] elementStiffness at the factorization (#E)
+  int factorAge = 0;                   ///< [-] steps solved with the current factorization
+  bool factorOnTree = false;           ///< the factorization is in the joint tree's coordinates
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
                                                       ///< dv' of the last step as the next warm start
   std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
   Eigen::Matrix3Xd treeLeverParent, treeLeverChild;  ///< [m] joint anchor minus com, world, at the step start (3 x #J)
-  Eigen::MatrixXd bodyTreeMap;         ///< [-, m] body part of the tree map J (6 #B x 6 #B), scratch
 };
 
 /// Allocates the scratch memory for `model` and computes its rest gut volume.
