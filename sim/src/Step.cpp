@@ -419,16 +419,19 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
 // as add(row, col, value) in full coordinates; the sequence of (row, col) depends on the model's topology only
 template <typename Sink>
 void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
-  const Eigen::Index nb6 = w.bodyBlock.rows();
+  // the free body entries come first among the free coordinates
+  const int* freeBegin = w.freeCoordinates.data();
+  const Eigen::Index nbf = std::lower_bound(freeBegin, freeBegin + w.freeCoordinates.size(), w.bodyBlock.rows()) - freeBegin;
   // bodies: the dense block
-  for (Eigen::Index c = 0; c < nb6; ++c)
-    for (Eigen::Index r = c; r < nb6; ++r) add(r, c, w.bodyBlock(r, c));
+  for (Eigen::Index c = 0; c < nbf; ++c)
+    for (Eigen::Index r = c; r < nbf; ++r) add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
   // bodies and attached nodes, where they can couple
   for (std::size_t k = 0; k < w.attachedNodes.size(); ++k)
     for (int i = 0; i < 3; ++i)
-      for (Eigen::Index r = 0; r < nb6; ++r)
-        if (w.couplingMask(r, static_cast<Eigen::Index>(k)))
-          add(nodeOffset(model, w.attachedNodes[k]) + i, r, w.bodyNodeBlock(r, 3 * static_cast<Eigen::Index>(k) + i));
+      for (Eigen::Index c = 0; c < nbf; ++c)
+        if (w.couplingMask(freeBegin[c], static_cast<Eigen::Index>(k)))
+          add(nodeOffset(model, w.attachedNodes[k]) + i, freeBegin[c],
+              w.bodyNodeBlock(freeBegin[c], 3 * static_cast<Eigen::Index>(k) + i));
   // node masses
   for (int n = 0; n < model.nodes.size(); ++n)
     for (int i = 0; i < 3; ++i) add(nodeOffset(model, n) + i, nodeOffset(model, n) + i, model.nodes.mass(n));
@@ -490,34 +493,29 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
             w.couplingMask.block(6 * b, w.attachedColumn(a.nodes(k, e)), 6, 1).setOnes();
       }
     }
-    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<std::array<int, 2>> entries;
     streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double) {
-      if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) entries.emplace_back(w.freeIndex(r), w.freeIndex(c), 0.0);
+      if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) entries.push_back({w.freeIndex(r), w.freeIndex(c)});
     });
     const Eigen::Index nf = w.freeCoordinates.size();
-    w.system.matrix.resize(nf, nf);
-    w.system.matrix.setFromTriplets(entries.begin(), entries.end());
-    w.system.matrix.makeCompressed();
+    std::vector<std::array<int, 2>> blocks;
+    for (const auto& [r, c] : entries) blocks.push_back({r / 3, c / 3});
+    w.system.analyze(static_cast<int>(nf / 3), blocks);
     // the value slot of every streamed entry
     w.systemPattern.clear();
-    for (const auto& t : entries) {
-      const int* begin = w.system.matrix.innerIndexPtr() + w.system.matrix.outerIndexPtr()[t.col()];
-      const int* end = w.system.matrix.innerIndexPtr() + w.system.matrix.outerIndexPtr()[t.col() + 1];
-      w.systemPattern.push_back(static_cast<int>(std::lower_bound(begin, end, t.row()) - w.system.matrix.innerIndexPtr()));
-    }
-    w.system.ldlt.analyzePattern(w.system.matrix);
+    for (const auto& [r, c] : entries) w.systemPattern.push_back(w.system.slot(r, c));
     w.factorOnTree = onTree;
     w.compactR.setZero(nf);
     w.compactZ.setZero(nf);
   }
   // values, then the numeric factorization
-  double* values = w.system.matrix.valuePtr();
-  std::fill(values, values + w.system.matrix.nonZeros(), 0.0);
+  w.system.clearValues();
+  double* values = w.system.values();
   std::size_t slot = 0;
   streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double v) {
     if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) values[w.systemPattern[slot++]] += v;
   });
-  w.system.ldlt.factorize(w.system.matrix);
+  if (!w.system.factorize()) throw Error("implicit solve: the system matrix is not positive definite (likely cause: a negative stiffness or mass)");
   // the gut pressure's rank-one stiffness kp g g^T: (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1 u)
   const Eigen::Index nf = w.freeCoordinates.size();
   w.rankOne.setZero(nf);
@@ -528,7 +526,8 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
       if (i >= 0) w.rankOne(k) = su * w.gutGradient(i % 3, i / 3);
     }
   }
-  w.rankOneSolve = w.system.ldlt.solve(w.rankOne);
+  w.rankOneSolve = w.rankOne;
+  w.system.solve(w.rankOneSolve);
   w.rankOneScale = 1.0 / (1.0 + w.rankOne.dot(w.rankOneSolve));
   w.factorDt = dt;
   w.factorAge = 0;
@@ -539,7 +538,8 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
 void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
   const Eigen::Index nf = w.freeCoordinates.size();
   for (Eigen::Index k = 0; k < nf; ++k) w.compactR(k) = r(w.freeCoordinates(k));
-  w.compactZ = w.system.ldlt.solve(w.compactR);
+  w.compactZ = w.compactR;
+  w.system.solve(w.compactZ);
   w.compactZ -= (w.rankOneScale * w.rankOne.dot(w.compactZ)) * w.rankOneSolve;
   z.setZero();
   for (Eigen::Index k = 0; k < nf; ++k) z(w.freeCoordinates(k)) = w.compactZ(k);
@@ -595,20 +595,20 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
     const double k0 = w.factorStiffness(e), k = w.elementStiffness(e);
     changed += (k0 > 0.0) != (k > 0.0) || std::abs(k - k0) > 0.5 * k0;
   }
-  const bool stale = w.system.matrix.size() == 0 || w.factorAge >= o.preconditionerRefresh ||
+  const bool stale = w.system.blocks() == 0 || w.factorAge >= o.preconditionerRefresh ||
                      w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges || dt != w.factorDt ||
                      !tree.empty() != w.factorOnTree;
   if (stale) factorSystem(model, o, tree, w, dt);
   ++w.factorAge;
-  maskReduced(model.joints, w, tree, x);
+  // start from x = P^-1 rhs (exact right after a refactorization); rhs^T P^-1 rhs scales the stop test:
+  // a relative residual, or the residual's energy norm r^T P^-1 r below 1e-12 J
+  applyPreconditioner(w, rhs, x);
+  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(x), 1e-24);
   applySystem(model, o, w, tree, dt, x, t, z, q);
   r = rhs - q;
   applyPreconditioner(w, r, z);
   p = z;
   double rz = r.dot(z);
-  // stop on a relative residual, or when the residual's energy norm r^T P r is below 1e-12 J
-  applyPreconditioner(w, rhs, q);
-  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(q), 1e-24);
   int it = 0;
   for (; it < o.cgMaxIterations && rz > stop; ++it) {
     applySystem(model, o, w, tree, dt, p, t, z, q);

@@ -40,13 +40,12 @@
 /// mass-weighted projection removes the position drift.
 
 #include "pneuma/sim/Activation.h"
+#include "pneuma/sim/BlockLdlt.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/State.h"
 
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 
 #include <array>
 #include <string>
@@ -88,29 +87,6 @@ struct StepOptions {
 /// @throws Error naming the field and value.
 void validateStepOptions(const StepOptions& o);
 
-/// The implicit system's sparse matrix without the gut's rank-one term and its LDLT factorization (Eigen's
-/// simplicial LDLT, AMD ordering, lower triangle). Copies refactor the copied matrix (the factor itself cannot
-/// be copied); the numbers are the same, so a copied StepWork steps bit-identically.
-struct SparseSystemFactor {
-  Eigen::SparseMatrix<double> matrix;                       ///< lower triangle, #free square
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< its factorization
-  SparseSystemFactor() = default;
-  SparseSystemFactor(const SparseSystemFactor& o) : matrix(o.matrix) { refactor(); }
-  SparseSystemFactor& operator=(const SparseSystemFactor& o) {
-    matrix = o.matrix;
-    refactor();
-    return *this;
-  }
-  ~SparseSystemFactor() = default;
-
- private:
-  void refactor() {
-    if (matrix.size() == 0) return;
-    ldlt.analyzePattern(matrix);
-    ldlt.factorize(matrix);
-  }
-};
-
 /// Preallocated scratch memory of step() (no allocation per step) and the by-products of the last
 /// step that metrics need. Make one per (Model, State) pair with makeStepWork().
 struct StepWork {
@@ -146,8 +122,8 @@ struct StepWork {
                                                                      ///< attached node (6 #B x #attached)
   Eigen::VectorXi freeIndex;           ///< implicit solver entry -> free coordinate, or -1 (fixed or dependent)
   Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
-  SparseSystemFactor system;           ///< the preconditioner's matrix and factorization (#free square)
-  std::vector<int> systemPattern;      ///< value slot in system.matrix of every streamed entry (see Step.cpp)
+  BlockLdlt system;                    ///< the preconditioner's matrix and factorization (#free / 3 blocks square)
+  std::vector<int> systemPattern;      ///< value slot in system.values() of every streamed entry (see Step.cpp)
   Eigen::VectorXd rankOne;             ///< [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
   Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
   double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
