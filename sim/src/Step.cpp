@@ -295,27 +295,52 @@ void integrateJointFriction(const Model& model, State& s, double dt, const StepO
   }
 }
 
-// out = kScale K u + dScale D u: the linearised stiffness and damping of elements, gut pressure and joints
-void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w,
-                           const Eigen::VectorXd& u, double kScale, double dScale, Eigen::VectorXd& out) {
-  out.setZero();
-  const Elements& el = model.elements;
-  for (int e = 0; e < el.size(); ++e) {
+// packs the elements that take part in kScale K + dScale D (taut or in tension) for applyStiffnessDamping:
+// elements between two single nodes with their solver offsets, the others by index
+void linearizeElements(const Model& model, double kScale, double dScale, StepWork& w) {
+  w.linearKScale = kScale;
+  w.linearDScale = dScale;
+  w.linearNodeCount = 0;
+  w.linearOtherCount = 0;
+  for (int e = 0; e < model.elements.size(); ++e) {
     const double ka = kScale * w.elementStiffness(e) + dScale * w.elementDamping(e);
     const double kg = kScale * w.elementGeometric(e);
     if (ka == 0.0 && kg == 0.0) continue;
-    const Vector3d d = w.elementDirection.col(e);
     const int na = w.endpointNode(0, e), nb = w.endpointNode(1, e);
     if (na >= 0 && nb >= 0) {
-      // fast path: both ends are single nodes (most gut strands)
-      const Eigen::Index oa = nodeOffset(model, na), ob = nodeOffset(model, nb);
-      const Vector3d du = Eigen::Map<const Vector3d>(u.data() + ob) - Eigen::Map<const Vector3d>(u.data() + oa);
-      const double along = d.dot(du);
-      const Vector3d y = ka * along * d + kg * (du - along * d);
-      Eigen::Map<Vector3d>(out.data() + oa) -= y;
-      Eigen::Map<Vector3d>(out.data() + ob) += y;
-      continue;
+      const int i = w.linearNodeCount++;
+      w.linearNodes.col(i) << static_cast<int>(nodeOffset(model, na)), static_cast<int>(nodeOffset(model, nb));
+      w.linearNodeCoeffs.col(i) << ka, kg, w.elementDirection.col(e);
+    } else {
+      const int i = w.linearOtherCount++;
+      w.linearOther(i) = e;
+      w.linearOtherCoeffs.col(i) << ka, kg;
     }
+  }
+}
+
+// out = kScale K u + dScale D u: the linearised stiffness and damping of elements, gut pressure and joints,
+// with the scales and elements packed by linearizeElements()
+void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w, const Eigen::VectorXd& u,
+                           Eigen::VectorXd& out) {
+  const double kScale = w.linearKScale, dScale = w.linearDScale;
+  out.setZero();
+  // elements between two single nodes (most gut strands)
+  for (int i = 0; i < w.linearNodeCount; ++i) {
+    const double* c = w.linearNodeCoeffs.col(i).data();
+    const Eigen::Index oa = w.linearNodes(0, i), ob = w.linearNodes(1, i);
+    const Vector3d d(c[2], c[3], c[4]);
+    const Vector3d du = Eigen::Map<const Vector3d>(u.data() + ob) - Eigen::Map<const Vector3d>(u.data() + oa);
+    const double along = d.dot(du);
+    const Vector3d y = c[0] * along * d + c[1] * (du - along * d);
+    Eigen::Map<Vector3d>(out.data() + oa) -= y;
+    Eigen::Map<Vector3d>(out.data() + ob) += y;
+  }
+  // elements with a body or weighted-node end
+  for (int i = 0; i < w.linearOtherCount; ++i) {
+    const int e = w.linearOther(i);
+    const double ka = w.linearOtherCoeffs(0, i), kg = w.linearOtherCoeffs(1, i);
+    const Vector3d d = w.elementDirection.col(e);
     const Vector3d ra = w.leverA.col(e), rb = w.leverB.col(e);
     const Vector3d du = anchorVelocity(model, w, 1, e, rb, u) - anchorVelocity(model, w, 0, e, ra, u);
     const double along = d.dot(du);
@@ -355,7 +380,7 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
 }
 
 // the dense body block of M + dt D + dt^2 K (6 #B square) and the coupling of the body entries to the
-// attached nodes' entries (6 #B x 3 #attached), both restricted to the joint tree (J^T . J, J^T .)
+// attached nodes' entries (6 #B x 3 #attached), both restricted to the joint tree (J^T . J on the free rows, J^T .)
 void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
   const int nb = model.bodies.size();
   Eigen::MatrixXd& a = w.bodyBlock;
@@ -406,11 +431,11 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     a.block<3, 3>(6 * ch + 3, 6 * p + 3).diagonal().array() -= kj;
     a.block<3, 3>(6 * p + 3, 6 * ch + 3).diagonal().array() -= kj;
   }
-  // restrict to the joint tree's coordinates: J^T A J = J^T (J^T A)^T for symmetric A
+  // restrict to the joint tree's coordinates: J^T A by columns, then (J^T A) J by rows (the free rows only)
   if (!tree.empty()) {
     for (Eigen::Index k = 0; k < a.cols(); ++k) gatherJointForces(model.joints, w, tree, a.col(k));
-    a.transposeInPlace();
-    for (Eigen::Index k = 0; k < a.cols(); ++k) gatherJointForces(model.joints, w, tree, a.col(k));
+    for (Eigen::Index k = 0; k < w.freeCoordinates.size() && w.freeCoordinates(k) < a.rows(); ++k)
+      gatherJointForces(model.joints, w, tree, a.row(w.freeCoordinates(k)).transpose());
     for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
   }
 }
@@ -464,7 +489,6 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
 // the preconditioner: a sparse LDLT factorization of the reduced system without the gut's rank-one term,
 // kept for several steps, plus that term by Sherman-Morrison; u = sqrt(kp) g over the free coordinates
 void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
-  assembleBodyBlocks(model, o, tree, w, dt);
   // the free coordinates and the matrix pattern: once per integrator
   const bool onTree = !tree.empty();
   if (w.systemPattern.empty() || onTree != w.factorOnTree) {
@@ -509,6 +533,7 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     w.compactZ.setZero(nf);
   }
   // values, then the numeric factorization
+  assembleBodyBlocks(model, o, tree, w, dt);
   w.system.clearValues();
   double* values = w.system.values();
   std::size_t slot = 0;
@@ -545,13 +570,13 @@ void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd&
   for (Eigen::Index k = 0; k < nf; ++k) z(w.freeCoordinates(k)) = w.compactZ(k);
 }
 
-// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates (t: scratch)
-void applySystem(const Model& model, const StepOptions& o, const StepWork& w, const std::vector<int>& tree, double dt,
+// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates, dt as packed by linearizeElements (t, z: scratch)
+void applySystem(const Model& model, const StepOptions& o, const StepWork& w, const std::vector<int>& tree,
                  const Eigen::VectorXd& u,
                  Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
   t = u;
   expandJointVelocities(model.joints, w, tree, t);
-  applyStiffnessDamping(model, o, w, t, dt * dt, dt, out);
+  applyStiffnessDamping(model, o, w, t, out);
   applyMass(model, w, t, z);
   out += z;
   gatherJointForces(model.joints, w, tree, out);
@@ -582,13 +607,13 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
     p.segment<3>(nodeOffset(model, n)) = s.nodeVelocity.col(n);
     rhs.segment<3>(nodeOffset(model, n)) = w.nodeForce.col(n);
   }
-  applyStiffnessDamping(model, o, w, p, dt * dt, 0.0, q);
+  linearizeElements(model, dt * dt, 0.0, w);
+  applyStiffnessDamping(model, o, w, p, q);
   rhs = dt * rhs - q;
   gatherJointForces(model.joints, w, tree, rhs);
   maskReduced(model.joints, w, tree, rhs);
 
-  // preconditioned conjugate gradient, warm-started from the previous step's dv
-  // a stale factorization is a good preconditioner for a few steps: refresh it when it has aged, when the
+  // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner for a few steps: refresh it when it has aged, when the
   // last solve needed many iterations, or when dt or the coordinates changed
   int changed = 0;
   for (Eigen::Index e = 0; e < w.factorStiffness.size(); ++e) {
@@ -600,18 +625,19 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
                      !tree.empty() != w.factorOnTree;
   if (stale) factorSystem(model, o, tree, w, dt);
   ++w.factorAge;
+  linearizeElements(model, dt * dt, dt, w);
   // start from x = P^-1 rhs (exact right after a refactorization); rhs^T P^-1 rhs scales the stop test:
   // a relative residual, or the residual's energy norm r^T P^-1 r below 1e-12 J
   applyPreconditioner(w, rhs, x);
   const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(x), 1e-24);
-  applySystem(model, o, w, tree, dt, x, t, z, q);
+  applySystem(model, o, w, tree, x, t, z, q);
   r = rhs - q;
   applyPreconditioner(w, r, z);
   p = z;
   double rz = r.dot(z);
   int it = 0;
   for (; it < o.cgMaxIterations && rz > stop; ++it) {
-    applySystem(model, o, w, tree, dt, p, t, z, q);
+    applySystem(model, o, w, tree, p, t, z, q);
     const double alpha = rz / p.dot(q);
     x += alpha * p;
     r -= alpha * q;
@@ -825,6 +851,10 @@ StepWork makeStepWork(const Model& model) {
   w.elementStiffness = Eigen::VectorXd::Zero(ne);
   w.elementGeometric = Eigen::VectorXd::Zero(ne);
   w.elementDamping = Eigen::VectorXd::Zero(ne);
+  w.linearNodes = Eigen::Matrix2Xi::Zero(2, ne);
+  w.linearNodeCoeffs = Eigen::Matrix<double, 5, Eigen::Dynamic>::Zero(5, ne);
+  w.linearOther = Eigen::VectorXi::Zero(ne);
+  w.linearOtherCoeffs = Eigen::Matrix2Xd::Zero(2, ne);
   w.inverseInertiaBody.resize(at(nb));
   for (int b = 0; b < nb; ++b)
     w.inverseInertiaBody[at(b)] = model.bodies.isFixed[at(b)] ? Matrix3d::Zero() : Matrix3d(model.bodies.inertia[at(b)].inverse());

@@ -100,6 +100,15 @@ struct StepWork {
   Eigen::VectorXd elementStiffness;    ///< [N/m] |dF/dl| of taut elements, 0 when slack (#E)
   Eigen::VectorXd elementGeometric;    ///< [N/m] transverse stiffness |F| / l of elements in tension (#E)
   Eigen::VectorXd elementDamping;      ///< [N s/m] b of taut elements, 0 when slack (#E)
+  double linearKScale = 0.0;           ///< [s^2] scale of K in the packed linearisation (dt^2)
+  double linearDScale = 0.0;           ///< [s] scale of D in it (dt, or 0 for the right-hand side)
+  int linearNodeCount = 0;             ///< [-] packed elements between two single nodes
+  Eigen::Matrix2Xi linearNodes;        ///< their implicit solver offsets, A and B (2 x #E, first linearNodeCount used)
+  Eigen::Matrix<double, 5, Eigen::Dynamic> linearNodeCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l, then
+                                                              ///< [-] the direction (5 x #E)
+  int linearOtherCount = 0;            ///< [-] packed elements with a body or weighted-node end
+  Eigen::VectorXi linearOther;         ///< their element indices (#E, first linearOtherCount used)
+  Eigen::Matrix2Xd linearOtherCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l (2 x #E)
   Eigen::Matrix2Xi endpointBody;       ///< body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
   Eigen::Matrix2Xi endpointNode;       ///< the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
   Eigen::VectorXi fixedDofs;           ///< indices of fixed-body and fixed-node entries of the implicit solver vectors
