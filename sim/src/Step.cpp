@@ -517,17 +517,20 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
             w.couplingMask.block(6 * b, w.attachedColumn(a.nodes(k, e)), 6, 1).setOnes();
       }
     }
+    // every streamed entry in free coordinates, (-1, -1) when fixed or dependent
     std::vector<std::array<int, 2>> entries;
     streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double) {
-      if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) entries.push_back({w.freeIndex(r), w.freeIndex(c)});
+      entries.push_back({w.freeIndex(r), w.freeIndex(c)});
+      if (entries.back()[0] < 0 || entries.back()[1] < 0) entries.back() = {-1, -1};
     });
     const Eigen::Index nf = w.freeCoordinates.size();
     std::vector<std::array<int, 2>> blocks;
-    for (const auto& [r, c] : entries) blocks.push_back({r / 3, c / 3});
+    for (const auto& [r, c] : entries)
+      if (r >= 0) blocks.push_back({r / 3, c / 3});
     w.system.analyze(static_cast<int>(nf / 3), blocks);
-    // the value slot of every streamed entry
+    // the value slot of every streamed entry, -1 when dropped
     w.systemPattern.clear();
-    for (const auto& [r, c] : entries) w.systemPattern.push_back(w.system.slot(r, c));
+    for (const auto& [r, c] : entries) w.systemPattern.push_back(r >= 0 ? w.system.slot(r, c) : -1);
     w.factorOnTree = onTree;
     w.compactR.setZero(nf);
     w.compactZ.setZero(nf);
@@ -537,8 +540,9 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
   w.system.clearValues();
   double* values = w.system.values();
   std::size_t slot = 0;
-  streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double v) {
-    if (w.freeIndex(r) >= 0 && w.freeIndex(c) >= 0) values[w.systemPattern[slot++]] += v;
+  streamSystem(model, w, dt, [&](Eigen::Index, Eigen::Index, double v) {
+    const int k = w.systemPattern[slot++];
+    if (k >= 0) values[k] += v;
   });
   if (!w.system.factorize()) throw Error("implicit solve: the system matrix is not positive definite (likely cause: a negative stiffness or mass)");
   // the gut pressure's rank-one stiffness kp g g^T: (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1 u)
@@ -556,7 +560,9 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
   w.rankOneScale = 1.0 / (1.0 + w.rankOne.dot(w.rankOneSolve));
   w.factorDt = dt;
   w.factorAge = 0;
-  w.factorStiffness = w.elementStiffness;
+  w.factorAxial = dt * dt * w.elementStiffness + dt * w.elementDamping;
+  w.factorTransverse = dt * dt * w.elementGeometric;
+  w.factorDirection = w.elementDirection;
 }
 
 // z = P^-1 r with the factored system (zero on the masked coordinates)
@@ -613,12 +619,18 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   gatherJointForces(model.joints, w, tree, rhs);
   maskReduced(model.joints, w, tree, rhs);
 
-  // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner for a few steps: refresh it when it has aged, when the
-  // last solve needed many iterations, or when dt or the coordinates changed
+  // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner for a
+  // few steps: refresh it when it has aged, when the last solve needed many iterations, when the stiffness of
+  // several elements changed much (muscles going slack or taut, activation steps, fast rotation), or when dt or
+  // the coordinates changed
   int changed = 0;
-  for (Eigen::Index e = 0; e < w.factorStiffness.size(); ++e) {
-    const double k0 = w.factorStiffness(e), k = w.elementStiffness(e);
-    changed += (k0 > 0.0) != (k > 0.0) || std::abs(k - k0) > 0.5 * k0;
+  for (Eigen::Index e = 0; e < w.factorAxial.size(); ++e) {
+    // |K_e - K_e0| <= |a - a0| + |g - g0| + 2 max(a, a0) |d - d0| for K_e = a d d^T + g (I - d d^T)
+    const double a = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), g = dt * dt * w.elementGeometric(e);
+    const double a0 = w.factorAxial(e), g0 = w.factorTransverse(e);
+    const double change = std::abs(a - a0) + std::abs(g - g0) +
+                          2.0 * std::max(a, a0) * (w.elementDirection.col(e) - w.factorDirection.col(e)).norm();
+    changed += change > 0.25 * std::max(a0, g0) && change > 0.0;
   }
   const bool stale = w.system.blocks() == 0 || w.factorAge >= o.preconditionerRefresh ||
                      w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges || dt != w.factorDt ||
@@ -835,6 +847,7 @@ void validateStepOptions(const StepOptions& o) {
   if (o.cgMaxIterations < 1) fail("cgMaxIterations", o.cgMaxIterations, "must be >= 1");
   if (o.preconditionerRefresh < 1) fail("preconditionerRefresh", o.preconditionerRefresh, "must be >= 1");
   if (o.refactorIterations < 0) fail("refactorIterations", o.refactorIterations, "must be >= 0");
+  if (o.refactorElementChanges < 0) fail("refactorElementChanges", o.refactorElementChanges, "must be >= 0");
   if (!(o.cgTolerance > 0.0)) fail("cgTolerance", o.cgTolerance, "must be > 0");
 }
 

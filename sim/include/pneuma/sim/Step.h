@@ -75,11 +75,12 @@ struct StepOptions {
   std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kpe and b per group
   int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
-  int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
+  int cgMaxIterations = 200;          ///< [-] implicit Euler: max CG iterations (typically 0-8; up to ~90 in the step
+                                      ///< where many muscles go slack at once, before the refactorization)
   int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the preconditioner at least every n steps
   int refactorIterations = 4;         ///< [-] implicit Euler: refactor when the last solve needed more CG iterations
-  int refactorElementChanges = 8;     ///< [-] implicit Euler: refactor when more elements went slack or taut, or changed
-                                      ///< stiffness by half, since the last factorization
+  int refactorElementChanges = 4;     ///< [-] implicit Euler: refactor when the 3x3 stiffness of more elements changed
+                                      ///< by a quarter (slack/taut, activation, rotation) since the last factorization
   double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
 };
 
@@ -138,7 +139,9 @@ struct StepWork {
   double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
   Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
   double factorDt = 0.0;               ///< [s] dt of the factorization
-  Eigen::VectorXd factorStiffness;     ///< [N/m] elementStiffness at the factorization (#E)
+  Eigen::VectorXd factorAxial;         ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
+  Eigen::VectorXd factorTransverse;    ///< [kg] dt^2 |F| / l at the factorization (#E)
+  Eigen::Matrix3Xd factorDirection;    ///< [-] elementDirection at the factorization (3 x #E)
   int factorAge = 0;                   ///< [-] steps solved with the current factorization
   bool factorOnTree = false;           ///< the factorization is in the joint tree's coordinates
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
