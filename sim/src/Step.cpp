@@ -447,14 +447,15 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
   // the free body entries come first among the free coordinates
   const int* freeBegin = w.freeCoordinates.data();
   const Eigen::Index nbf = std::lower_bound(freeBegin, freeBegin + w.freeCoordinates.size(), w.bodyBlock.rows()) - freeBegin;
-  // bodies: the dense block
+  // bodies, where they can couple
   for (Eigen::Index c = 0; c < nbf; ++c)
-    for (Eigen::Index r = c; r < nbf; ++r) add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
+    for (Eigen::Index r = c; r < nbf; ++r)
+      if (w.bodyMask(freeBegin[r] / 6, freeBegin[c] / 6)) add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
   // bodies and attached nodes, where they can couple
   for (std::size_t k = 0; k < w.attachedNodes.size(); ++k)
     for (int i = 0; i < 3; ++i)
       for (Eigen::Index c = 0; c < nbf; ++c)
-        if (w.couplingMask(freeBegin[c], static_cast<Eigen::Index>(k)))
+        if (w.couplingMask(freeBegin[c] / 6, static_cast<Eigen::Index>(k)))
           add(nodeOffset(model, w.attachedNodes[k]) + i, freeBegin[c],
               w.bodyNodeBlock(freeBegin[c], 3 * static_cast<Eigen::Index>(k) + i));
   // node masses
@@ -502,19 +503,29 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
         free.push_back(static_cast<int>(i));
       }
     w.freeCoordinates = Eigen::Map<const Eigen::VectorXi>(free.data(), static_cast<Eigen::Index>(free.size()));
-    // an attached node couples to the entries of its bodies and of their ancestors in the joint tree
-    std::vector<int> parentOf(at(model.bodies.size()), -1);
+    // which entries can be nonzero: a body couples to the bodies it shares an element or a joint with, an
+    // attached node to the bodies of its elements; in the joint tree's coordinates each body stands for
+    // itself and its ancestors (its motion is theirs plus its own)
+    const int nb = model.bodies.size();
+    std::vector<int> parentOf(at(nb), -1);
     for (int j : tree) parentOf[at(model.joints.child[at(j)])] = model.joints.parent[at(j)];
-    w.couplingMask.setZero(w.bodyNodeBlock.rows(), static_cast<Eigen::Index>(w.attachedNodes.size()));
+    w.bodyMask.setZero(nb, nb);
+    const auto coupleBodies = [&](int b1, int b2) {
+      for (int x = b1; x >= 0; x = parentOf[at(x)])
+        for (int y = b2; y >= 0; y = parentOf[at(y)]) w.bodyMask(x, y) = w.bodyMask(y, x) = 1;
+    };
+    for (int b = 0; b < nb; ++b) coupleBodies(b, b);
+    for (int i = 0; i < model.joints.size(); ++i) coupleBodies(model.joints.parent[at(i)], model.joints.child[at(i)]);
+    w.couplingMask.setZero(nb, static_cast<Eigen::Index>(w.attachedNodes.size()));
     const Elements& el = model.elements;
     for (int e = 0; e < el.size(); ++e) {
+      if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0) coupleBodies(w.endpointBody(0, e), w.endpointBody(1, e));
       for (int side = 0; side < 2; ++side) {
         const int body = w.endpointBody(1 - side, e);
         if (w.endpointBody(side, e) >= 0 || body < 0) continue;
         const AnchorSet& a = side == 0 ? el.endA : el.endB;
         for (int k = 0; k < 3; ++k)
-          for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)])
-            w.couplingMask.block(6 * b, w.attachedColumn(a.nodes(k, e)), 6, 1).setOnes();
+          for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)]) w.couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
       }
     }
     // every streamed entry in free coordinates, (-1, -1) when fixed or dependent
