@@ -412,8 +412,9 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
       a.block<6, 6>(6 * bb, 6 * ba) -= cab.transpose();
       continue;
     }
-    // one body end, nodes at the other
+    // one moving body end, nodes at the other
     const int side = ba >= 0 ? 1 : 0, b = ba >= 0 ? ba : bb;
+    if (model.bodies.isFixed[at(b)]) continue;
     const AnchorSet& nodes = side == 0 ? el.endA : el.endB;
     const Eigen::Matrix<double, 6, 3> jk = (ba >= 0 ? ja : jb).transpose() * ke;
     for (int k = 0; k < 3; ++k) {
@@ -431,9 +432,11 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     a.block<3, 3>(6 * ch + 3, 6 * p + 3).diagonal().array() -= kj;
     a.block<3, 3>(6 * p + 3, 6 * ch + 3).diagonal().array() -= kj;
   }
-  // restrict to the joint tree's coordinates: J^T A by columns, then (J^T A) J by rows (the free rows only)
+  // restrict to the joint tree's coordinates: J^T A by columns (fixed bodies' columns are not needed), then
+  // (J^T A) J by rows (the free rows only)
   if (!tree.empty()) {
-    for (Eigen::Index k = 0; k < a.cols(); ++k) gatherJointForces(model.joints, w, tree, a.col(k));
+    for (int b = 0; b < nb; ++b)
+      for (int k = 6 * b; k < 6 * b + 6 && !model.bodies.isFixed[at(b)]; ++k) gatherJointForces(model.joints, w, tree, a.col(k));
     for (Eigen::Index k = 0; k < w.freeCoordinates.size() && w.freeCoordinates(k) < a.rows(); ++k)
       gatherJointForces(model.joints, w, tree, a.row(w.freeCoordinates(k)).transpose());
     for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
@@ -522,7 +525,7 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
       if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0) coupleBodies(w.endpointBody(0, e), w.endpointBody(1, e));
       for (int side = 0; side < 2; ++side) {
         const int body = w.endpointBody(1 - side, e);
-        if (w.endpointBody(side, e) >= 0 || body < 0) continue;
+        if (w.endpointBody(side, e) >= 0 || body < 0 || model.bodies.isFixed[at(body)]) continue;
         const AnchorSet& a = side == 0 ? el.endA : el.endB;
         for (int k = 0; k < 3; ++k)
           for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)]) w.couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
@@ -933,11 +936,12 @@ StepWork makeStepWork(const Model& model) {
   w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
   w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  // nodes tied by an element to a body: their coupling columns in bodyNodeBlock
+  // nodes tied by an element to a moving body: their coupling columns in bodyNodeBlock
   w.attachedColumn.setConstant(nn, -1);
   for (int e = 0; e < ne; ++e) {
     for (int side = 0; side < 2; ++side) {
-      if (w.endpointBody(side, e) >= 0 || w.endpointBody(1 - side, e) < 0) continue;
+      const int body = w.endpointBody(1 - side, e);
+      if (w.endpointBody(side, e) >= 0 || body < 0 || model.bodies.isFixed[at(body)]) continue;
       const AnchorSet& a = side == 0 ? model.elements.endA : model.elements.endB;
       for (int k = 0; k < 3; ++k) {
         const int node = a.nodes(k, e);
