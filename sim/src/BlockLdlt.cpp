@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
-
 #include <algorithm>
 
 namespace pneuma::sim {
@@ -46,7 +45,8 @@ void BlockLdlt::analyze(int blocks, const std::vector<std::array<int, 2>>& patte
   // a block stored as A(original row >= original col) is A(permuted) transposed when the permutation flips it
   m_aTransposed.assign(m_ai.size(), 0);
   for (int k = 0; k < blocks; ++k)
-    for (int p = m_ap[at(k)]; p < m_ap[at(k) + 1]; ++p) m_aTransposed[at(p)] = m_perm[at(m_ai[at(p)])] < m_perm[at(k)] ? 1 : 0;
+    for (int p = m_ap[at(k)]; p < m_ap[at(k) + 1]; ++p)
+      m_aTransposed[at(p)] = m_perm[at(m_ai[at(p)])] < m_perm[at(k)] ? 1 : 0;
 
   // elimination tree and column counts of L (Davis' ldl_symbolic)
   m_parent.assign(at(blocks), -1);
@@ -135,13 +135,15 @@ void BlockLdlt::solve(Eigen::VectorXd& x) const {
   // L z = b (column by column), then D
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d zi = m_x.segment<3>(3 * i);
-    for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p) m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)] * zi;
+    for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p)
+      m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)] * zi;
   }
   for (int i = 0; i < n; ++i) m_x.segment<3>(3 * i) = m_dInverse[at(i)] * m_x.segment<3>(3 * i).eval();
   // L^T x = z
   for (int i = n - 1; i >= 0; --i) {
     Eigen::Vector3d xi = m_x.segment<3>(3 * i);
-    for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p) xi.noalias() -= m_l[at(p)].transpose() * m_x.segment<3>(3 * m_li[at(p)]);
+    for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p)
+      xi.noalias() -= m_l[at(p)].transpose() * m_x.segment<3>(3 * m_li[at(p)]);
     m_x.segment<3>(3 * i) = xi;
   }
   for (int k = 0; k < n; ++k) x.segment<3>(3 * m_perm[at(k)]) = m_x.segment<3>(3 * k);

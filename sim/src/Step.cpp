@@ -309,7 +309,8 @@ void linearizeElements(const Model& model, double kScale, double dScale, StepWor
     const int na = w.endpointNode(0, e), nb = w.endpointNode(1, e);
     if (na >= 0 && nb >= 0) {
       const int i = w.linearNodeCount++;
-      w.linearNodes.col(i) << static_cast<int>(nodeOffset(model, na)), static_cast<int>(nodeOffset(model, nb));
+      w.linearNodes.col(i) << static_cast<int>(nodeOffset(model, na)),
+          static_cast<int>(nodeOffset(model, nb));
       w.linearNodeCoeffs.col(i) << ka, kg, w.elementDirection.col(e);
     } else {
       const int i = w.linearOtherCount++;
@@ -321,8 +322,8 @@ void linearizeElements(const Model& model, double kScale, double dScale, StepWor
 
 // out = kScale K u + dScale D u: the linearised stiffness and damping of elements, gut pressure and joints,
 // with the scales and elements packed by linearizeElements()
-void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w, const Eigen::VectorXd& u,
-                           Eigen::VectorXd& out) {
+void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w,
+                           const Eigen::VectorXd& u, Eigen::VectorXd& out) {
   const double kScale = w.linearKScale, dScale = w.linearDScale;
   out.setZero();
   // elements between two single nodes (most gut strands)
@@ -380,8 +381,10 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
 }
 
 // the dense body block of M + dt D + dt^2 K (6 #B square) and the coupling of the body entries to the
-// attached nodes' entries (6 #B x 3 #attached), both restricted to the joint tree (J^T . J on the free rows, J^T .)
-void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
+// attached nodes' entries (6 #B x 3 #attached), both restricted to the joint tree (J^T . J on the free rows,
+// J^T .)
+void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w,
+                        double dt) {
   const int nb = model.bodies.size();
   Eigen::MatrixXd& a = w.bodyBlock;
   Eigen::MatrixXd& c = w.bodyNodeBlock;
@@ -392,7 +395,8 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     a.block<3, 3>(6 * b, 6 * b) = model.bodies.mass(b) * Matrix3d::Identity();
     a.block<3, 3>(6 * b + 3, 6 * b + 3) = r * model.bodies.inertia[at(b)] * r.transpose();
   }
-  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints, w_k I for node k, sign -1 across the ends
+  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints, w_k I for node k, sign -1 across the
+  // ends
   const Elements& el = model.elements;
   Eigen::Matrix<double, 3, 6> ja, jb;
   for (int e = 0; e < el.size(); ++e) {
@@ -436,24 +440,28 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
   // (J^T A) J by rows (the free rows only)
   if (!tree.empty()) {
     for (int b = 0; b < nb; ++b)
-      for (int k = 6 * b; k < 6 * b + 6 && !model.bodies.isFixed[at(b)]; ++k) gatherJointForces(model.joints, w, tree, a.col(k));
+      for (int k = 6 * b; k < 6 * b + 6 && !model.bodies.isFixed[at(b)]; ++k)
+        gatherJointForces(model.joints, w, tree, a.col(k));
     for (Eigen::Index k = 0; k < w.freeCoordinates.size() && w.freeCoordinates(k) < a.rows(); ++k)
       gatherJointForces(model.joints, w, tree, a.row(w.freeCoordinates(k)).transpose());
     for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
   }
 }
 
-// streams the lower triangle of the implicit system without the gut's rank-one term, J^T (M + dt D + dt^2 K0) J,
-// as add(row, col, value) in full coordinates; the sequence of (row, col) depends on the model's topology only
+// streams the lower triangle of the implicit system without the gut's rank-one term, J^T (M + dt D + dt^2 K0)
+// J, as add(row, col, value) in full coordinates; the sequence of (row, col) depends on the model's topology
+// only
 template <typename Sink>
 void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
   // the free body entries come first among the free coordinates
   const int* freeBegin = w.freeCoordinates.data();
-  const Eigen::Index nbf = std::lower_bound(freeBegin, freeBegin + w.freeCoordinates.size(), w.bodyBlock.rows()) - freeBegin;
+  const Eigen::Index nbf =
+      std::lower_bound(freeBegin, freeBegin + w.freeCoordinates.size(), w.bodyBlock.rows()) - freeBegin;
   // bodies, where they can couple
   for (Eigen::Index c = 0; c < nbf; ++c)
     for (Eigen::Index r = c; r < nbf; ++r)
-      if (w.bodyMask(freeBegin[r] / 6, freeBegin[c] / 6)) add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
+      if (w.bodyMask(freeBegin[r] / 6, freeBegin[c] / 6))
+        add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
   // bodies and attached nodes, where they can couple
   for (std::size_t k = 0; k < w.attachedNodes.size(); ++k)
     for (int i = 0; i < 3; ++i)
@@ -467,7 +475,8 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
   // elements between nodes: w_k w_l s_k s_l K_e for every pair of node terms of the two endpoints
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
-    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
+    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e),
+                 kg = dt * dt * w.elementGeometric(e);
     const Vector3d d = w.elementDirection.col(e);
     const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
     for (int sa = 0; sa < 2; ++sa) {
@@ -482,7 +491,8 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
             if (na < 0 || nb < 0 || na < nb) continue;
             const double s = (sa == sb ? 1.0 : -1.0) * a.weights(ka3, e) * b.weights(kb3, e);
             for (int c = 0; c < 3; ++c)
-              for (int r = na == nb ? c : 0; r < 3; ++r) add(nodeOffset(model, na) + r, nodeOffset(model, nb) + c, s * ke(r, c));
+              for (int r = na == nb ? c : 0; r < 3; ++r)
+                add(nodeOffset(model, na) + r, nodeOffset(model, nb) + c, s * ke(r, c));
           }
         }
       }
@@ -492,7 +502,8 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
 
 // the preconditioner: a sparse LDLT factorization of the reduced system without the gut's rank-one term,
 // kept for several steps, plus that term by Sherman-Morrison; u = sqrt(kp) g over the free coordinates
-void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
+void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w,
+                  double dt) {
   // the free coordinates and the matrix pattern: once per integrator
   const bool onTree = !tree.empty();
   if (w.systemPattern.empty() || onTree != w.factorOnTree) {
@@ -505,7 +516,8 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
         w.freeIndex(i) = static_cast<int>(free.size());
         free.push_back(static_cast<int>(i));
       }
-    w.freeCoordinates = Eigen::Map<const Eigen::VectorXi>(free.data(), static_cast<Eigen::Index>(free.size()));
+    w.freeCoordinates =
+        Eigen::Map<const Eigen::VectorXi>(free.data(), static_cast<Eigen::Index>(free.size()));
     // which entries can be nonzero: a body couples to the bodies it shares an element or a joint with, an
     // attached node to the bodies of its elements; in the joint tree's coordinates each body stands for
     // itself and its ancestors (its motion is theirs plus its own)
@@ -518,17 +530,20 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
         for (int y = b2; y >= 0; y = parentOf[at(y)]) w.bodyMask(x, y) = w.bodyMask(y, x) = 1;
     };
     for (int b = 0; b < nb; ++b) coupleBodies(b, b);
-    for (int i = 0; i < model.joints.size(); ++i) coupleBodies(model.joints.parent[at(i)], model.joints.child[at(i)]);
+    for (int i = 0; i < model.joints.size(); ++i)
+      coupleBodies(model.joints.parent[at(i)], model.joints.child[at(i)]);
     w.couplingMask.setZero(nb, static_cast<Eigen::Index>(w.attachedNodes.size()));
     const Elements& el = model.elements;
     for (int e = 0; e < el.size(); ++e) {
-      if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0) coupleBodies(w.endpointBody(0, e), w.endpointBody(1, e));
+      if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0)
+        coupleBodies(w.endpointBody(0, e), w.endpointBody(1, e));
       for (int side = 0; side < 2; ++side) {
         const int body = w.endpointBody(1 - side, e);
         if (w.endpointBody(side, e) >= 0 || body < 0 || model.bodies.isFixed[at(body)]) continue;
         const AnchorSet& a = side == 0 ? el.endA : el.endB;
         for (int k = 0; k < 3; ++k)
-          for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)]) w.couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
+          for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)])
+            w.couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
       }
     }
     // every streamed entry in free coordinates, (-1, -1) when fixed or dependent
@@ -558,8 +573,12 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     const int k = w.systemPattern[slot++];
     if (k >= 0) values[k] += v;
   });
-  if (!w.system.factorize()) throw Error("implicit solve: the system matrix is not positive definite (likely cause: a negative stiffness or mass)");
-  // the gut pressure's rank-one stiffness kp g g^T: (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1 u)
+  if (!w.system.factorize())
+    throw Error(
+        "implicit solve: the system matrix is not positive definite (likely cause: a negative stiffness or "
+        "mass)");
+  // the gut pressure's rank-one stiffness kp g g^T: (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1
+  // u)
   const Eigen::Index nf = w.freeCoordinates.size();
   w.rankOne.setZero(nf);
   if (w.gutPressure > 0.0) {
@@ -590,10 +609,10 @@ void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd&
   for (Eigen::Index k = 0; k < nf; ++k) z(w.freeCoordinates(k)) = w.compactZ(k);
 }
 
-// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates, dt as packed by linearizeElements (t, z: scratch)
+// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates, dt as packed by linearizeElements (t, z:
+// scratch)
 void applySystem(const Model& model, const StepOptions& o, const StepWork& w, const std::vector<int>& tree,
-                 const Eigen::VectorXd& u,
-                 Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
+                 const Eigen::VectorXd& u, Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
   t = u;
   expandJointVelocities(model.joints, w, tree, t);
   applyStiffnessDamping(model, o, w, t, out);
@@ -633,22 +652,24 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   gatherJointForces(model.joints, w, tree, rhs);
   maskReduced(model.joints, w, tree, rhs);
 
-  // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner for a
-  // few steps: refresh it when it has aged, when the last solve needed many iterations, when the stiffness of
-  // several elements changed much (muscles going slack or taut, activation steps, fast rotation), or when dt or
-  // the coordinates changed
+  // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner
+  // for a few steps: refresh it when it has aged, when the last solve needed many iterations, when the
+  // stiffness of several elements changed much (muscles going slack or taut, activation steps, fast
+  // rotation), or when dt or the coordinates changed
   int changed = 0;
   for (Eigen::Index e = 0; e < w.factorAxial.size(); ++e) {
     // |K_e - K_e0| <= |a - a0| + |g - g0| + 2 max(a, a0) |d - d0| for K_e = a d d^T + g (I - d d^T)
-    const double a = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), g = dt * dt * w.elementGeometric(e);
+    const double a = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e),
+                 g = dt * dt * w.elementGeometric(e);
     const double a0 = w.factorAxial(e), g0 = w.factorTransverse(e);
-    const double change = std::abs(a - a0) + std::abs(g - g0) +
-                          2.0 * std::max(a, a0) * (w.elementDirection.col(e) - w.factorDirection.col(e)).norm();
+    const double change =
+        std::abs(a - a0) + std::abs(g - g0) +
+        2.0 * std::max(a, a0) * (w.elementDirection.col(e) - w.factorDirection.col(e)).norm();
     changed += change > 0.25 * std::max(a0, g0) && change > 0.0;
   }
   const bool stale = w.system.blocks() == 0 || w.factorAge >= o.preconditionerRefresh ||
-                     w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges || dt != w.factorDt ||
-                     !tree.empty() != w.factorOnTree;
+                     w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges ||
+                     dt != w.factorDt || !tree.empty() != w.factorOnTree;
   if (stale) factorSystem(model, o, tree, w, dt);
   ++w.factorAge;
   linearizeElements(model, dt * dt, dt, w);

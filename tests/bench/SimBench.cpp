@@ -1,19 +1,18 @@
 // Speed of the simulation core (Google Benchmark): the real-time factor per breath style on the
 // default model (simulated seconds per wall-clock second, one thread), and the cost of one step as the
 // gut mesh is refined 4x per level (synthetic toy torso, 162 -> 642 -> 2562 gut nodes).
-#include "DefaultModel.h"
-#include "ToyTorso.h"
-
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Simulation.h"
-
 #include <benchmark/benchmark.h>
 
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "DefaultModel.h"
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Simulation.h"
 
 namespace pneuma::sim {
 namespace {
@@ -34,7 +33,7 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
   o.dt = dt;
   o.settleTime = 100.0 * (dt > 0.0 ? dt : defaultTimeStep(integrator));
   Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle(style)), o);
-  const double chunk = 25.0 * sim.dt();  // [s] simulated per iteration
+  const double chunk = 25.0 * sim.dt();     // [s] simulated per iteration
   double cgIterations = 0.0, frames = 0.0;  // CG iterations of the step before each output frame
   const auto sample = [&](const Simulation& s) {
     cgIterations += s.stepWork().cgIterations;
@@ -48,7 +47,8 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
     state.SkipWithError(e.what());
     return;
   }
-  state.counters["rtf"] = benchmark::Counter(chunk * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["rtf"] =
+      benchmark::Counter(chunk * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["dt_ms"] = sim.dt() * 1e3;
   state.counters["cg_iterations"] = frames > 0.0 ? cgIterations / frames : 0.0;
 }
@@ -75,7 +75,8 @@ void stepTime(benchmark::State& state) {
 }
 
 const bool kRegistered = [] {
-  // every breath style with the implicit integrators (implicit-euler-joints at 10 and 20 ms); calm with symplectic Euler
+  // every breath style with the implicit integrators (implicit-euler-joints at 10 and 20 ms); calm with
+  // symplectic Euler
   struct Run {
     IntegratorKind integrator;
     double dt;  // [s], 0 = the integrator's default
@@ -89,13 +90,16 @@ const bool kRegistered = [] {
   }
   runs.push_back({IntegratorKind::SymplecticEuler, 0.0, "calm"});
   for (const Run& run : runs) {
-    const std::string dtName = run.dt > 0.0 ? "/dt_ms:" + std::to_string(static_cast<int>(run.dt * 1e3 + 0.5)) : "";
+    const std::string dtName =
+        run.dt > 0.0 ? "/dt_ms:" + std::to_string(static_cast<int>(run.dt * 1e3 + 0.5)) : "";
     benchmark::RegisterBenchmark(
         (std::string("RealTimeFactor/") + integratorName(run.integrator) + dtName + "/" + run.style).c_str(),
         [run](benchmark::State& st) { realTimeFactor(st, run.style, run.integrator, run.dt); })
         ->Unit(benchmark::kMillisecond);
   }
-  benchmark::RegisterBenchmark("StepTime/gut_subdivisions", stepTime)->DenseRange(2, 4)->Unit(benchmark::kMicrosecond);
+  benchmark::RegisterBenchmark("StepTime/gut_subdivisions", stepTime)
+      ->DenseRange(2, 4)
+      ->Unit(benchmark::kMicrosecond);
   return true;
 }();
 

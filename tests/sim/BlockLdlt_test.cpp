@@ -3,11 +3,10 @@
 // reports an indefinite matrix instead of returning garbage.
 #include "pneuma/sim/BlockLdlt.h"
 
-#include <Eigen/Cholesky>
-#include <Eigen/Core>
-
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <random>
@@ -38,13 +37,15 @@ SpringNetwork lattice(unsigned seed) {
   for (int z = 0; z < side; ++z)
     for (int y = 0; y < side; ++y)
       for (int x = 0; x < side; ++x)
-        for (const auto& [dx, dy, dz] : {std::array<int, 3>{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}}) {
+        for (const auto& [dx, dy, dz] :
+             {std::array<int, 3>{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}}) {
           if (x + dx >= side || y + dy >= side || z + dz >= side) continue;
           net.springs.push_back({id(x, y, z), id(x + dx, y + dy, z + dz)});
         }
   net.direction.resize(3, static_cast<Eigen::Index>(net.springs.size()));
   for (std::size_t s = 0; s < net.springs.size(); ++s)
-    net.direction.col(static_cast<Eigen::Index>(s)) = (p.col(net.springs[s][1]) - p.col(net.springs[s][0])).normalized();
+    net.direction.col(static_cast<Eigen::Index>(s)) =
+        (p.col(net.springs[s][1]) - p.col(net.springs[s][0])).normalized();
   net.mass = Eigen::VectorXd::NullaryExpr(net.nodes, [&] { return m(rng); });
   return net;
 }

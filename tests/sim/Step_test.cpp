@@ -1,18 +1,19 @@
 // The implicit integrators' linear solve (Step.h): the factorized preconditioner is the implicit system
 // itself (so a fresh factorization solves backward Euler's linear step exactly), and reusing it over
 // several steps changes only the CG iterations, not the motion.
-#include "DefaultModel.h"
-#include "ToyTorso.h"
-
-#include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Step.h"
 
 #include <gtest/gtest.h>
 
+#include "DefaultModel.h"
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+
 namespace pneuma::sim {
 namespace {
 
-// steps `model` through `seconds` of calm breathing with `o`; returns the largest CG count after the first step
+// steps `model` through `seconds` of calm breathing with `o`; returns the largest CG count after the first
+// step
 int breathe(const Model& model, const StepOptions& o, double dt, double seconds, State& s) {
   BreathStyleController calm(loadBreathStyle("calm"));
   StepWork w = makeStepWork(model);
@@ -65,7 +66,8 @@ TEST_P(ImplicitSolve, StaleFactorizationGivesTheSameMotion) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, ImplicitSolve,
-                         ::testing::Values(IntegratorKind::ImplicitEuler, IntegratorKind::ImplicitEulerJoints),
+                         ::testing::Values(IntegratorKind::ImplicitEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
                          [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 }  // namespace

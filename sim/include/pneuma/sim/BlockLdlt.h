@@ -13,7 +13,6 @@
 /// Memory is allocated by analyze() only; factorize() and solve() allocate nothing.
 
 #include <Eigen/Core>
-
 #include <array>
 #include <vector>
 
@@ -21,15 +20,16 @@ namespace pneuma::sim {
 
 class BlockLdlt {
  public:
-  /// Symbolic analysis: the ordering and the block pattern of L for a matrix of `blocks` x `blocks` 3x3 blocks
-  /// whose nonzero blocks are `pattern` (block row, block col) pairs; either triangle, duplicates allowed; the
-  /// diagonal is always included.
+  /// Symbolic analysis: the ordering and the block pattern of L for a matrix of `blocks` x `blocks` 3x3
+  /// blocks whose nonzero blocks are `pattern` (block row, block col) pairs; either triangle, duplicates
+  /// allowed; the diagonal is always included.
   void analyze(int blocks, const std::vector<std::array<int, 2>>& pattern);
 
   /// Index into values() of scalar entry (r, c) of A, r >= c (lower triangle; 0 <= r < 3 #blocks). The block
   /// (r / 3, c / 3) must be in the analysed pattern.
   int slot(int r, int c) const;
-  /// The lower triangle of A by entries (see slot()); the strict upper triangle of the diagonal blocks is unused.
+  /// The lower triangle of A by entries (see slot()); the strict upper triangle of the diagonal blocks is
+  /// unused.
   double* values() { return m_a.data()->data(); }
   /// Number of doubles in values().
   std::size_t valueCount() const { return 9 * m_a.size(); }
@@ -46,20 +46,20 @@ class BlockLdlt {
   int factorBlocks() const { return m_lp.empty() ? 0 : m_lp.back(); }
 
  private:
-  int m_n = 0;                           ///< number of block rows
-  std::vector<int> m_perm;               ///< permuted block -> original block (#blocks)
-  std::vector<int> m_permInverse;        ///< original block -> permuted block (#blocks)
-  std::vector<int> m_ap, m_ai;           ///< A's upper triangle by blocks, permuted, column-compressed
-  std::vector<Eigen::Matrix3d> m_a;      ///< its blocks (lower triangle of A, original orientation per block)
-  std::vector<char> m_aTransposed;       ///< 1 when a stored block is A(original) transposed by the permutation
-  std::vector<int> m_parent;             ///< elimination tree (#blocks, -1 at roots)
-  std::vector<int> m_lp, m_li;           ///< L's blocks below the diagonal, column-compressed
-  std::vector<Eigen::Matrix3d> m_l;      ///< their values
+  int m_n = 0;                       ///< number of block rows
+  std::vector<int> m_perm;           ///< permuted block -> original block (#blocks)
+  std::vector<int> m_permInverse;    ///< original block -> permuted block (#blocks)
+  std::vector<int> m_ap, m_ai;       ///< A's upper triangle by blocks, permuted, column-compressed
+  std::vector<Eigen::Matrix3d> m_a;  ///< its blocks (lower triangle of A, original orientation per block)
+  std::vector<char> m_aTransposed;   ///< 1 when a stored block is A(original) transposed by the permutation
+  std::vector<int> m_parent;         ///< elimination tree (#blocks, -1 at roots)
+  std::vector<int> m_lp, m_li;       ///< L's blocks below the diagonal, column-compressed
+  std::vector<Eigen::Matrix3d> m_l;  ///< their values
   std::vector<Eigen::Matrix3d> m_dInverse;  ///< D_k^-1 (#blocks)
   // factorization workspace (#blocks)
   std::vector<Eigen::Matrix3d> m_y;
   std::vector<int> m_flag, m_pattern, m_lnz;
-  mutable Eigen::VectorXd m_x;           ///< permuted right-hand side of solve()
+  mutable Eigen::VectorXd m_x;  ///< permuted right-hand side of solve()
 };
 
 }  // namespace pneuma::sim

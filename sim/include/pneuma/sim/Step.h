@@ -13,8 +13,8 @@
 ///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max).
 /// - ImplicitEuler: linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH 1998) over all
 ///   node and body velocities, solving (M + dt D + dt^2 K) dv = dt (f - dt K v) with a matrix-free
-///   preconditioned conjugate gradient (see "Linear solve" below). K holds the element stiffness along and across each
-///   taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
+///   preconditioned conjugate gradient (see "Linear solve" below). K holds the element stiffness along and
+///   across each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
 ///   joint springs; D holds element damping and joint friction. Why this one: the stiff parts of the
 ///   model (cartilage, the gut's near-incompressibility kappa, joint friction on light ribs) are
 ///   linear or nearly so, so backward Euler removes their step limit at the cost of a few CG passes
@@ -37,21 +37,23 @@
 /// mass-weighted projection removes the position drift.
 ///
 /// Linear solve (both implicit integrators): CG on A dv' = b, A = J^T (M + dt D + dt^2 K) J (J = I for
-/// ImplicitEuler), to a relative residual `cgTolerance` in the preconditioner norm (r^T P^-1 r <= tol^2 b^T P^-1 b),
-/// started from dv' = P^-1 b. A is matrix-free; the preconditioner P is A itself, assembled sparse over the free
-/// coordinates (3x3 blocks: gut nodes, body spins and the free bodies' linear velocities) without the gut's
-/// rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g), factored by BlockLdlt, with u u^T added back
-/// by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 / (1 + u^T A0^-1 u). The factorization is kept while it
-/// stays a good preconditioner and refreshed when the last solve needed more than `refactorIterations`, when more
-/// than `refactorElementChanges` elements changed their 3x3 stiffness by a quarter (muscles going slack or taut,
-/// activation steps, fast rotation), after `preconditionerRefresh` steps, or when dt or the coordinates change.
-/// A fresh factorization solves the step exactly (0 iterations); a stale one takes about 3 - 6.
+/// ImplicitEuler), to a relative residual `cgTolerance` in the preconditioner norm (r^T P^-1 r <= tol^2 b^T
+/// P^-1 b), started from dv' = P^-1 b. A is matrix-free; the preconditioner P is A itself, assembled sparse
+/// over the free coordinates (3x3 blocks: gut nodes, body spins and the free bodies' linear velocities)
+/// without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g), factored by BlockLdlt,
+/// with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 / (1 + u^T A0^-1 u). The
+/// factorization is kept while it stays a good preconditioner and refreshed when the last solve needed more
+/// than `refactorIterations`, when more than `refactorElementChanges` elements changed their 3x3 stiffness by
+/// a quarter (muscles going slack or taut, activation steps, fast rotation), after `preconditionerRefresh`
+/// steps, or when dt or the coordinates change. A fresh factorization solves the step exactly (0 iterations);
+/// a stale one about 3 (0 - 8; more in the step where many muscles switch before the refresh).
 /// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
-/// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch no
-/// strand) only the node masses resist, 70 eigenvalues of P^-1 A below 1e-2, which neither Jacobi nor a coarse
-/// space of node aggregates captures (measured: 148 -> 87-116 iterations with 10-80 aggregates). An exact
-/// factorization captures them; the system changes by a few elements per step, so a factorization serves 3 - 4
-/// steps, and the 3x3-block factorization (1281 free coordinates, 4.5k blocks in L) costs about 10 CG iterations.
+/// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch
+/// no strand) only the node masses resist, 70 eigenvalues of P^-1 A below 1e-2, which neither Jacobi nor a
+/// coarse space of node aggregates captures (measured: 148 -> 87-116 iterations with 10-80 aggregates). An
+/// exact factorization captures them; the system changes by a few elements per step, so a factorization
+/// serves 3 - 4 steps, and the 3x3-block factorization (1281 free coordinates, 4.1k blocks in L) costs about
+/// 10 CG iterations.
 
 #include "pneuma/sim/Activation.h"
 #include "pneuma/sim/BlockLdlt.h"
