@@ -153,14 +153,15 @@ void expandJointVelocities(const Joints& joints, const StepWork& w, const std::v
 
 // f <- J^T f: a force on a dependent linear velocity acts on the parent's com and, through the levers,
 // as torques r_p x f on the parent and -r_c x f on the child (children first)
-void gatherJointForces(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Eigen::VectorXd& f) {
+template <typename Vec>
+void gatherJointForces(const Joints& joints, const StepWork& w, const std::vector<int>& tree, Vec&& f) {
   for (auto it = tree.rbegin(); it != tree.rend(); ++it) {
     const int j = *it, p = joints.parent[at(j)], c = joints.child[at(j)];
-    const Vector3d fc = f.segment<3>(6 * c);
-    f.segment<3>(6 * p) += fc;
-    f.segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
-    f.segment<3>(6 * c + 3) -= w.treeLeverChild.col(j).cross(fc);
-    f.segment<3>(6 * c).setZero();
+    const Vector3d fc = f.template segment<3>(6 * c);
+    f.template segment<3>(6 * p) += fc;
+    f.template segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
+    f.template segment<3>(6 * c + 3) -= w.treeLeverChild.col(j).cross(fc);
+    f.template segment<3>(6 * c).setZero();
   }
 }
 
@@ -294,27 +295,53 @@ void integrateJointFriction(const Model& model, State& s, double dt, const StepO
   }
 }
 
-// out = kScale K u + dScale D u: the linearised stiffness and damping of elements, gut pressure and joints
-void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w,
-                           const Eigen::VectorXd& u, double kScale, double dScale, Eigen::VectorXd& out) {
-  out.setZero();
-  const Elements& el = model.elements;
-  for (int e = 0; e < el.size(); ++e) {
+// packs the elements that take part in kScale K + dScale D (taut or in tension) for applyStiffnessDamping:
+// elements between two single nodes with their solver offsets, the others by index
+void linearizeElements(const Model& model, double kScale, double dScale, StepWork& w) {
+  w.linearKScale = kScale;
+  w.linearDScale = dScale;
+  w.linearNodeCount = 0;
+  w.linearOtherCount = 0;
+  for (int e = 0; e < model.elements.size(); ++e) {
     const double ka = kScale * w.elementStiffness(e) + dScale * w.elementDamping(e);
     const double kg = kScale * w.elementGeometric(e);
     if (ka == 0.0 && kg == 0.0) continue;
-    const Vector3d d = w.elementDirection.col(e);
     const int na = w.endpointNode(0, e), nb = w.endpointNode(1, e);
     if (na >= 0 && nb >= 0) {
-      // fast path: both ends are single nodes (most gut strands)
-      const Eigen::Index oa = nodeOffset(model, na), ob = nodeOffset(model, nb);
-      const Vector3d du = Eigen::Map<const Vector3d>(u.data() + ob) - Eigen::Map<const Vector3d>(u.data() + oa);
-      const double along = d.dot(du);
-      const Vector3d y = ka * along * d + kg * (du - along * d);
-      Eigen::Map<Vector3d>(out.data() + oa) -= y;
-      Eigen::Map<Vector3d>(out.data() + ob) += y;
-      continue;
+      const int i = w.linearNodeCount++;
+      w.linearNodes.col(i) << static_cast<int>(nodeOffset(model, na)),
+          static_cast<int>(nodeOffset(model, nb));
+      w.linearNodeCoeffs.col(i) << ka, kg, w.elementDirection.col(e);
+    } else {
+      const int i = w.linearOtherCount++;
+      w.linearOther(i) = e;
+      w.linearOtherCoeffs.col(i) << ka, kg;
     }
+  }
+}
+
+// out = kScale K u + dScale D u: the linearised stiffness and damping of elements, gut pressure and joints,
+// with the scales and elements packed by linearizeElements()
+void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepWork& w,
+                           const Eigen::VectorXd& u, Eigen::VectorXd& out) {
+  const double kScale = w.linearKScale, dScale = w.linearDScale;
+  out.setZero();
+  // elements between two single nodes (most gut strands)
+  for (int i = 0; i < w.linearNodeCount; ++i) {
+    const double* c = w.linearNodeCoeffs.col(i).data();
+    const Eigen::Index oa = w.linearNodes(0, i), ob = w.linearNodes(1, i);
+    const Vector3d d(c[2], c[3], c[4]);
+    const Vector3d du = Eigen::Map<const Vector3d>(u.data() + ob) - Eigen::Map<const Vector3d>(u.data() + oa);
+    const double along = d.dot(du);
+    const Vector3d y = c[0] * along * d + c[1] * (du - along * d);
+    Eigen::Map<Vector3d>(out.data() + oa) -= y;
+    Eigen::Map<Vector3d>(out.data() + ob) += y;
+  }
+  // elements with a body or weighted-node end
+  for (int i = 0; i < w.linearOtherCount; ++i) {
+    const int e = w.linearOther(i);
+    const double ka = w.linearOtherCoeffs(0, i), kg = w.linearOtherCoeffs(1, i);
+    const Vector3d d = w.elementDirection.col(e);
     const Vector3d ra = w.leverA.col(e), rb = w.leverB.col(e);
     const Vector3d du = anchorVelocity(model, w, 1, e, rb, u) - anchorVelocity(model, w, 0, e, ra, u);
     const double along = d.dot(du);
@@ -322,8 +349,10 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     addAnchorGeneralized(model, w, 0, e, ra, -y, out);
     addAnchorGeneralized(model, w, 1, e, rb, y, out);
   }
-  // rank-one gut pressure stiffness kappa V0 / V^2 g g^T while the pressure pushes (V < V0)
-  if (w.gutPressure > 0.0 && kScale != 0.0) {
+  // rank-one gut pressure stiffness kappa V0 / V^2 g g^T, kept while the gut is over-full (V >= V0, where
+  // Eq. 5 clamps the force to 0): the step then sees the pressure that compressing the gut raises; without
+  // it one step of a suddenly contracting rectus squeezed the gut by 10 % at dt 20 ms
+  if (w.restGutVolume > 0.0 && kScale != 0.0) {
     const double kp = kScale * effectiveKappa(model, o) * w.restGutVolume / (w.gutVolume * w.gutVolume);
     double gu = 0.0;
     for (int n = 0; n < model.nodes.size(); ++n) gu += w.gutGradient.col(n).dot(u.segment<3>(nodeOffset(model, n)));
@@ -353,46 +382,23 @@ void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, 
     out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
 }
 
-// block-Jacobi preconditioner of the gut nodes: the inverse 3x3 diagonal block of M + dt D + dt^2 K at every
-// node (element terms with the squared barycentric weights, the gut pressure's kp g_n g_n^T); zero when fixed
-void buildPreconditioner(const Model& model, const StepOptions& o, const StepWork& w, double dt,
-                         std::vector<Matrix3d>& blocks) {
-  for (int n = 0; n < model.nodes.size(); ++n) blocks[at(n)] = model.nodes.mass(n) * Matrix3d::Identity();
-  const Elements& el = model.elements;
-  for (int e = 0; e < el.size(); ++e) {
-    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
-    if (ka == 0.0 && kg == 0.0) continue;
-    const Vector3d d = w.elementDirection.col(e);
-    const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
-    for (int side = 0; side < 2; ++side) {
-      if (w.endpointBody(side, e) >= 0) continue;
-      const AnchorSet& a = side == 0 ? el.endA : el.endB;
-      for (int i = 0; i < 3; ++i) {
-        const int n = a.nodes(i, e);
-        if (n >= 0) blocks[at(n)] += (a.weights(i, e) * a.weights(i, e)) * ke;
-      }
-    }
-  }
-  if (w.gutPressure > 0.0) {
-    const double kp = dt * dt * effectiveKappa(model, o) * w.restGutVolume / (w.gutVolume * w.gutVolume);
-    for (int n = 0; n < model.nodes.size(); ++n) blocks[at(n)] += kp * w.gutGradient.col(n) * w.gutGradient.col(n).transpose();
-  }
-  for (int n = 0; n < model.nodes.size(); ++n)
-    blocks[at(n)] = model.nodes.isFixed(n) ? Matrix3d::Zero() : Matrix3d(blocks[at(n)].inverse());
-}
-
-// the dense body block of M + dt D + dt^2 K (6 #B square), factored: the preconditioner of the stiff,
-// light ribcage; fixed bodies get identity rows
-void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w, double dt) {
+// the dense body block of M + dt D + dt^2 K (6 #B square) and the coupling of the body entries to the
+// attached nodes' entries (6 #B x 3 #attached), both restricted to the joint tree (J^T . J on the free rows,
+// J^T .)
+void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w,
+                        double dt) {
   const int nb = model.bodies.size();
   Eigen::MatrixXd& a = w.bodyBlock;
+  Eigen::MatrixXd& c = w.bodyNodeBlock;
   a.setZero();
+  c.setZero();
   for (int b = 0; b < nb; ++b) {
     const Matrix3d& r = w.rotation[at(b)];
     a.block<3, 3>(6 * b, 6 * b) = model.bodies.mass(b) * Matrix3d::Identity();
     a.block<3, 3>(6 * b + 3, 6 * b + 3) = r * model.bodies.inertia[at(b)] * r.transpose();
   }
-  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints and sign -1 across the two ends
+  // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints, w_k I for node k, sign -1 across the
+  // ends
   const Elements& el = model.elements;
   Eigen::Matrix<double, 3, 6> ja, jb;
   for (int e = 0; e < el.size(); ++e) {
@@ -407,59 +413,211 @@ void factorBodyBlock(const Model& model, const StepOptions& o, const std::vector
     if (ba >= 0) a.block<6, 6>(6 * ba, 6 * ba) += ja.transpose() * ke * ja;
     if (bb >= 0) a.block<6, 6>(6 * bb, 6 * bb) += jb.transpose() * ke * jb;
     if (ba >= 0 && bb >= 0) {
-      const Eigen::Matrix<double, 6, 6> c = ja.transpose() * ke * jb;
-      a.block<6, 6>(6 * ba, 6 * bb) -= c;
-      a.block<6, 6>(6 * bb, 6 * ba) -= c.transpose();
+      const Eigen::Matrix<double, 6, 6> cab = ja.transpose() * ke * jb;
+      a.block<6, 6>(6 * ba, 6 * bb) -= cab;
+      a.block<6, 6>(6 * bb, 6 * ba) -= cab.transpose();
+      continue;
+    }
+    // one moving body end, nodes at the other
+    const int side = ba >= 0 ? 1 : 0, b = ba >= 0 ? ba : bb;
+    if (model.bodies.isFixed[at(b)]) continue;
+    const AnchorSet& nodes = side == 0 ? el.endA : el.endB;
+    const Eigen::Matrix<double, 6, 3> jk = (ba >= 0 ? ja : jb).transpose() * ke;
+    for (int k = 0; k < 3; ++k) {
+      const int n = nodes.nodes(k, e);
+      if (n >= 0) c.block<6, 3>(6 * b, 3 * w.attachedColumn(n)) -= nodes.weights(k, e) * jk;
     }
   }
   // joint springs and friction on relative angular velocity
   const Joints& j = model.joints;
   for (int i = 0; i < j.size(); ++i) {
     const double kj = dt * dt * j.stiffness(i) + dt * j.friction(i) * o.jointFrictionScale;
-    const int p = j.parent[at(i)], c = j.child[at(i)];
-    a.block<3, 3>(6 * c + 3, 6 * c + 3).diagonal().array() += kj;
+    const int p = j.parent[at(i)], ch = j.child[at(i)];
+    a.block<3, 3>(6 * ch + 3, 6 * ch + 3).diagonal().array() += kj;
     a.block<3, 3>(6 * p + 3, 6 * p + 3).diagonal().array() += kj;
-    a.block<3, 3>(6 * c + 3, 6 * p + 3).diagonal().array() -= kj;
-    a.block<3, 3>(6 * p + 3, 6 * c + 3).diagonal().array() -= kj;
+    a.block<3, 3>(6 * ch + 3, 6 * p + 3).diagonal().array() -= kj;
+    a.block<3, 3>(6 * p + 3, 6 * ch + 3).diagonal().array() -= kj;
   }
-  // restrict to the joint tree's coordinates: J^T A J, with J the body part of expandJointVelocities
+  // restrict to the joint tree's coordinates: J^T A by columns (fixed bodies' columns are not needed), then
+  // (J^T A) J by rows (the free rows only)
   if (!tree.empty()) {
-    Eigen::MatrixXd& jt = w.bodyTreeMap;
-    jt.setIdentity();
-    for (Eigen::Index k = 0; k < jt.cols(); ++k) expandJointVelocities(model.joints, w, tree, jt.col(k));
-    a = (jt.transpose() * a * jt).eval();
+    for (int b = 0; b < nb; ++b)
+      for (int k = 6 * b; k < 6 * b + 6 && !model.bodies.isFixed[at(b)]; ++k)
+        gatherJointForces(model.joints, w, tree, a.col(k));
+    for (Eigen::Index k = 0; k < w.freeCoordinates.size() && w.freeCoordinates(k) < a.rows(); ++k)
+      gatherJointForces(model.joints, w, tree, a.row(w.freeCoordinates(k)).transpose());
+    for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
   }
-  // fixed bodies and dependent linear velocities get identity rows
-  for (int b = 0; b < nb; ++b) {
-    if (!model.bodies.isFixed[at(b)]) continue;
-    a.middleRows(6 * b, 6).setZero();
-    a.middleCols(6 * b, 6).setZero();
-    a.block<6, 6>(6 * b, 6 * b).setIdentity();
-  }
-  for (int jj : tree) {
-    const int c = model.joints.child[at(jj)];
-    a.middleRows(6 * c, 3).setZero();
-    a.middleCols(6 * c, 3).setZero();
-    a.block<3, 3>(6 * c, 6 * c).setIdentity();
-  }
-  w.bodyFactor.compute(a);
 }
 
-// z = P^-1 r: the factored body block for bodies, block Jacobi for nodes
-void applyPreconditioner(const StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-  const Eigen::Index nb6 = w.bodyBlock.rows();
-  for (std::size_t n = 0; n < w.nodeBlockInverse.size(); ++n)
-    z.segment<3>(nb6 + 3 * static_cast<Eigen::Index>(n)) = w.nodeBlockInverse[n] * r.segment<3>(nb6 + 3 * static_cast<Eigen::Index>(n));
-  if (nb6 > 0) z.head(nb6) = w.bodyFactor.solve(r.head(nb6));
+// streams the lower triangle of the implicit system without the gut's rank-one term, J^T (M + dt D + dt^2 K0)
+// J, as add(row, col, value) in full coordinates; the sequence of (row, col) depends on the model's topology
+// only
+template <typename Sink>
+void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
+  // the free body entries come first among the free coordinates
+  const int* freeBegin = w.freeCoordinates.data();
+  const Eigen::Index nbf =
+      std::lower_bound(freeBegin, freeBegin + w.freeCoordinates.size(), w.bodyBlock.rows()) - freeBegin;
+  // bodies, where they can couple
+  for (Eigen::Index c = 0; c < nbf; ++c)
+    for (Eigen::Index r = c; r < nbf; ++r)
+      if (w.bodyMask(freeBegin[r] / 6, freeBegin[c] / 6))
+        add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
+  // bodies and attached nodes, where they can couple
+  for (std::size_t k = 0; k < w.attachedNodes.size(); ++k)
+    for (int i = 0; i < 3; ++i)
+      for (Eigen::Index c = 0; c < nbf; ++c)
+        if (w.couplingMask(freeBegin[c] / 6, static_cast<Eigen::Index>(k)))
+          add(nodeOffset(model, w.attachedNodes[k]) + i, freeBegin[c],
+              w.bodyNodeBlock(freeBegin[c], 3 * static_cast<Eigen::Index>(k) + i));
+  // node masses
+  for (int n = 0; n < model.nodes.size(); ++n)
+    for (int i = 0; i < 3; ++i) add(nodeOffset(model, n) + i, nodeOffset(model, n) + i, model.nodes.mass(n));
+  // elements between nodes: w_k w_l s_k s_l K_e for every pair of node terms of the two endpoints
+  const Elements& el = model.elements;
+  for (int e = 0; e < el.size(); ++e) {
+    const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e),
+                 kg = dt * dt * w.elementGeometric(e);
+    const Vector3d d = w.elementDirection.col(e);
+    const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
+    for (int sa = 0; sa < 2; ++sa) {
+      if (w.endpointBody(sa, e) >= 0) continue;
+      const AnchorSet& a = sa == 0 ? el.endA : el.endB;
+      for (int sb = 0; sb < 2; ++sb) {
+        if (w.endpointBody(sb, e) >= 0) continue;
+        const AnchorSet& b = sb == 0 ? el.endA : el.endB;
+        for (int ka3 = 0; ka3 < 3; ++ka3) {
+          for (int kb3 = 0; kb3 < 3; ++kb3) {
+            const int na = a.nodes(ka3, e), nb = b.nodes(kb3, e);
+            if (na < 0 || nb < 0 || na < nb) continue;
+            const double s = (sa == sb ? 1.0 : -1.0) * a.weights(ka3, e) * b.weights(kb3, e);
+            for (int c = 0; c < 3; ++c)
+              for (int r = na == nb ? c : 0; r < 3; ++r)
+                add(nodeOffset(model, na) + r, nodeOffset(model, nb) + c, s * ke(r, c));
+          }
+        }
+      }
+    }
+  }
 }
 
-// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates (t: scratch)
-void applySystem(const Model& model, const StepOptions& o, const StepWork& w, const std::vector<int>& tree, double dt,
-                 const Eigen::VectorXd& u,
-                 Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
+// the preconditioner: a sparse LDLT factorization of the reduced system without the gut's rank-one term,
+// kept for several steps, plus that term by Sherman-Morrison; u = sqrt(kp) g over the free coordinates
+void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w,
+                  double dt) {
+  // the free coordinates and the matrix pattern: once per integrator
+  const bool onTree = !tree.empty();
+  if (w.systemPattern.empty() || onTree != w.factorOnTree) {
+    Eigen::VectorXd mask = Eigen::VectorXd::Ones(w.cgX.size());
+    maskReduced(model.joints, w, tree, mask);
+    w.freeIndex.setConstant(mask.size(), -1);
+    std::vector<int> free;
+    for (Eigen::Index i = 0; i < mask.size(); ++i)
+      if (mask(i) != 0.0) {
+        w.freeIndex(i) = static_cast<int>(free.size());
+        free.push_back(static_cast<int>(i));
+      }
+    w.freeCoordinates =
+        Eigen::Map<const Eigen::VectorXi>(free.data(), static_cast<Eigen::Index>(free.size()));
+    // which entries can be nonzero: a body couples to the bodies it shares an element or a joint with, an
+    // attached node to the bodies of its elements; in the joint tree's coordinates each body stands for
+    // itself and its ancestors (its motion is theirs plus its own)
+    const int nb = model.bodies.size();
+    std::vector<int> parentOf(at(nb), -1);
+    for (int j : tree) parentOf[at(model.joints.child[at(j)])] = model.joints.parent[at(j)];
+    w.bodyMask.setZero(nb, nb);
+    const auto coupleBodies = [&](int b1, int b2) {
+      for (int x = b1; x >= 0; x = parentOf[at(x)])
+        for (int y = b2; y >= 0; y = parentOf[at(y)]) w.bodyMask(x, y) = w.bodyMask(y, x) = 1;
+    };
+    for (int b = 0; b < nb; ++b) coupleBodies(b, b);
+    for (int i = 0; i < model.joints.size(); ++i)
+      coupleBodies(model.joints.parent[at(i)], model.joints.child[at(i)]);
+    w.couplingMask.setZero(nb, static_cast<Eigen::Index>(w.attachedNodes.size()));
+    const Elements& el = model.elements;
+    for (int e = 0; e < el.size(); ++e) {
+      if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0)
+        coupleBodies(w.endpointBody(0, e), w.endpointBody(1, e));
+      for (int side = 0; side < 2; ++side) {
+        const int body = w.endpointBody(1 - side, e);
+        if (w.endpointBody(side, e) >= 0 || body < 0 || model.bodies.isFixed[at(body)]) continue;
+        const AnchorSet& a = side == 0 ? el.endA : el.endB;
+        for (int k = 0; k < 3; ++k)
+          for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)])
+            w.couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
+      }
+    }
+    // every streamed entry in free coordinates, (-1, -1) when fixed or dependent
+    std::vector<std::array<int, 2>> entries;
+    streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double) {
+      entries.push_back({w.freeIndex(r), w.freeIndex(c)});
+      if (entries.back()[0] < 0 || entries.back()[1] < 0) entries.back() = {-1, -1};
+    });
+    const Eigen::Index nf = w.freeCoordinates.size();
+    std::vector<std::array<int, 2>> blocks;
+    for (const auto& [r, c] : entries)
+      if (r >= 0) blocks.push_back({r / 3, c / 3});
+    w.system.analyze(static_cast<int>(nf / 3), blocks);
+    // the value slot of every streamed entry, -1 when dropped
+    w.systemPattern.clear();
+    for (const auto& [r, c] : entries) w.systemPattern.push_back(r >= 0 ? w.system.slot(r, c) : -1);
+    w.factorOnTree = onTree;
+    w.compactR.setZero(nf);
+    w.compactZ.setZero(nf);
+  }
+  // values, then the numeric factorization
+  assembleBodyBlocks(model, o, tree, w, dt);
+  w.system.clearValues();
+  double* values = w.system.values();
+  std::size_t slot = 0;
+  streamSystem(model, w, dt, [&](Eigen::Index, Eigen::Index, double v) {
+    const int k = w.systemPattern[slot++];
+    if (k >= 0) values[k] += v;
+  });
+  if (!w.system.factorize())
+    throw Error(
+        "implicit solve: the system matrix is not positive definite (likely cause: a negative stiffness or "
+        "mass)");
+  // the gut pressure's rank-one stiffness kp g g^T = u u^T by Sherman-Morrison:
+  // (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1 u)
+  const Eigen::Index nf = w.freeCoordinates.size();
+  w.rankOne.setZero(nf);
+  if (w.restGutVolume > 0.0) {
+    const double su = dt * std::sqrt(effectiveKappa(model, o) * w.restGutVolume) / w.gutVolume;
+    for (Eigen::Index k = 0; k < nf; ++k) {
+      const Eigen::Index i = w.freeCoordinates(k) - 6 * static_cast<Eigen::Index>(model.bodies.size());
+      if (i >= 0) w.rankOne(k) = su * w.gutGradient(i % 3, i / 3);
+    }
+  }
+  w.rankOneSolve = w.rankOne;
+  w.system.solve(w.rankOneSolve);
+  w.rankOneScale = 1.0 / (1.0 + w.rankOne.dot(w.rankOneSolve));
+  w.factorDt = dt;
+  w.factorAge = 0;
+  w.factorAxial = dt * dt * w.elementStiffness + dt * w.elementDamping;
+  w.factorTransverse = dt * dt * w.elementGeometric;
+  w.factorDirection = w.elementDirection;
+}
+
+// z = P^-1 r with the factored system (zero on the masked coordinates)
+void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+  const Eigen::Index nf = w.freeCoordinates.size();
+  for (Eigen::Index k = 0; k < nf; ++k) w.compactR(k) = r(w.freeCoordinates(k));
+  w.compactZ = w.compactR;
+  w.system.solve(w.compactZ);
+  w.compactZ -= (w.rankOneScale * w.rankOne.dot(w.compactZ)) * w.rankOneSolve;
+  z.setZero();
+  for (Eigen::Index k = 0; k < nf; ++k) z(w.freeCoordinates(k)) = w.compactZ(k);
+}
+
+// out = J^T (M + dt D + dt^2 K) J u in the joint tree's coordinates, dt as packed by linearizeElements (t, z:
+// scratch)
+void applySystem(const Model& model, const StepOptions& o, const StepWork& w, const std::vector<int>& tree,
+                 const Eigen::VectorXd& u, Eigen::VectorXd& t, Eigen::VectorXd& z, Eigen::VectorXd& out) {
   t = u;
   expandJointVelocities(model.joints, w, tree, t);
-  applyStiffnessDamping(model, o, w, t, dt * dt, dt, out);
+  applyStiffnessDamping(model, o, w, t, out);
   applyMass(model, w, t, z);
   out += z;
   gatherJointForces(model.joints, w, tree, out);
@@ -488,26 +646,45 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
     p.segment<3>(nodeOffset(model, n)) = s.nodeVelocity.col(n);
     rhs.segment<3>(nodeOffset(model, n)) = w.nodeForce.col(n);
   }
-  applyStiffnessDamping(model, o, w, p, dt * dt, 0.0, q);
+  linearizeElements(model, dt * dt, 0.0, w);
+  applyStiffnessDamping(model, o, w, p, q);
   rhs = dt * rhs - q;
   gatherJointForces(model.joints, w, tree, rhs);
   maskReduced(model.joints, w, tree, rhs);
 
-  // preconditioned conjugate gradient, warm-started from the previous step's dv
-  buildPreconditioner(model, o, w, dt, w.nodeBlockInverse);
-  if (w.stepsSinceFactor++ % o.preconditionerRefresh == 0) factorBodyBlock(model, o, tree, w, dt);
-  maskReduced(model.joints, w, tree, x);
-  applySystem(model, o, w, tree, dt, x, t, z, q);
+  // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner
+  // for a few steps: refresh it when it has aged, when the last solve needed many iterations, when the
+  // stiffness of several elements changed much (muscles going slack or taut, activation steps, fast
+  // rotation), or when dt or the coordinates changed
+  int changed = 0;
+  for (Eigen::Index e = 0; e < w.factorAxial.size(); ++e) {
+    // |K_e - K_e0| <= |a - a0| + |g - g0| + 2 max(a, a0) |d - d0| for K_e = a d d^T + g (I - d d^T)
+    const double a = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e),
+                 g = dt * dt * w.elementGeometric(e);
+    const double a0 = w.factorAxial(e), g0 = w.factorTransverse(e);
+    const double change =
+        std::abs(a - a0) + std::abs(g - g0) +
+        2.0 * std::max(a, a0) * (w.elementDirection.col(e) - w.factorDirection.col(e)).norm();
+    changed += change > 0.25 * std::max(a0, g0) && change > 0.0;
+  }
+  const bool stale = w.system.blocks() == 0 || w.factorAge >= o.preconditionerRefresh ||
+                     w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges ||
+                     dt != w.factorDt || !tree.empty() != w.factorOnTree;
+  if (stale) factorSystem(model, o, tree, w, dt);
+  ++w.factorAge;
+  linearizeElements(model, dt * dt, dt, w);
+  // start from x = P^-1 rhs (exact right after a refactorization); rhs^T P^-1 rhs scales the stop test:
+  // a relative residual, or the residual's energy norm r^T P^-1 r below 1e-12 J
+  applyPreconditioner(w, rhs, x);
+  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(x), 1e-24);
+  applySystem(model, o, w, tree, x, t, z, q);
   r = rhs - q;
   applyPreconditioner(w, r, z);
   p = z;
   double rz = r.dot(z);
-  // stop on a relative residual, or when the residual's energy norm r^T P r is below 1e-12 J
-  applyPreconditioner(w, rhs, q);
-  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(q), 1e-24);
   int it = 0;
   for (; it < o.cgMaxIterations && rz > stop; ++it) {
-    applySystem(model, o, w, tree, dt, p, t, z, q);
+    applySystem(model, o, w, tree, p, t, z, q);
     const double alpha = rz / p.dot(q);
     x += alpha * p;
     r -= alpha * q;
@@ -635,7 +812,8 @@ void integratePositions(const Model& model, State& s, double dt, StepWork& w) {
 
 std::string describeBlowUpCause(double dt) {
   std::ostringstream os;
-  os << "likely cause: dt = " << dt << " s too large for the stiffness (lower dt, or use implicit-euler-joints)";
+  os << "likely cause: dt = " << dt << " s too large for the stiffness or the forces (lower dt or the gains; "
+     << "symplectic-euler needs dt of about 10 us)";
   return os.str();
 }
 
@@ -703,6 +881,8 @@ void validateStepOptions(const StepOptions& o) {
   if (!(o.jointTolerance > 0.0)) fail("jointTolerance", o.jointTolerance, "must be > 0");
   if (o.cgMaxIterations < 1) fail("cgMaxIterations", o.cgMaxIterations, "must be >= 1");
   if (o.preconditionerRefresh < 1) fail("preconditionerRefresh", o.preconditionerRefresh, "must be >= 1");
+  if (o.refactorIterations < 0) fail("refactorIterations", o.refactorIterations, "must be >= 0");
+  if (o.refactorElementChanges < 0) fail("refactorElementChanges", o.refactorElementChanges, "must be >= 0");
   if (!(o.cgTolerance > 0.0)) fail("cgTolerance", o.cgTolerance, "must be > 0");
 }
 
@@ -719,6 +899,10 @@ StepWork makeStepWork(const Model& model) {
   w.elementStiffness = Eigen::VectorXd::Zero(ne);
   w.elementGeometric = Eigen::VectorXd::Zero(ne);
   w.elementDamping = Eigen::VectorXd::Zero(ne);
+  w.linearNodes = Eigen::Matrix2Xi::Zero(2, ne);
+  w.linearNodeCoeffs = Eigen::Matrix<double, 5, Eigen::Dynamic>::Zero(5, ne);
+  w.linearOther = Eigen::VectorXi::Zero(ne);
+  w.linearOtherCoeffs = Eigen::Matrix2Xd::Zero(2, ne);
   w.inverseInertiaBody.resize(at(nb));
   for (int b = 0; b < nb; ++b)
     w.inverseInertiaBody[at(b)] = model.bodies.isFixed[at(b)] ? Matrix3d::Zero() : Matrix3d(model.bodies.inertia[at(b)].inverse());
@@ -773,8 +957,22 @@ StepWork makeStepWork(const Model& model) {
   w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
   w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  w.bodyTreeMap = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
-  w.nodeBlockInverse.assign(at(nn), Matrix3d::Zero());
+  // nodes tied by an element to a moving body: their coupling columns in bodyNodeBlock
+  w.attachedColumn.setConstant(nn, -1);
+  for (int e = 0; e < ne; ++e) {
+    for (int side = 0; side < 2; ++side) {
+      const int body = w.endpointBody(1 - side, e);
+      if (w.endpointBody(side, e) >= 0 || body < 0 || model.bodies.isFixed[at(body)]) continue;
+      const AnchorSet& a = side == 0 ? model.elements.endA : model.elements.endB;
+      for (int k = 0; k < 3; ++k) {
+        const int node = a.nodes(k, e);
+        if (node < 0 || w.attachedColumn(node) >= 0) continue;
+        w.attachedColumn(node) = static_cast<int>(w.attachedNodes.size());
+        w.attachedNodes.push_back(node);
+      }
+    }
+  }
+  w.bodyNodeBlock = Eigen::MatrixXd::Zero(6 * nb, 3 * static_cast<Eigen::Index>(w.attachedNodes.size()));
   for (Eigen::VectorXd* v : {&w.cgX, &w.cgR, &w.cgZ, &w.cgP, &w.cgQ, &w.cgB, &w.cgT}) *v = Eigen::VectorXd::Zero(n);
   return w;
 }

@@ -1,28 +1,28 @@
 // Speed of the simulation core (Google Benchmark): the real-time factor per breath style on the
 // default model (simulated seconds per wall-clock second, one thread), and the cost of one step as the
 // gut mesh is refined 4x per level (synthetic toy torso, 162 -> 642 -> 2562 gut nodes).
-#include "DefaultModel.h"
-#include "ToyTorso.h"
-
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Simulation.h"
-
 #include <benchmark/benchmark.h>
 
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
+
+#include "DefaultModel.h"
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Simulation.h"
 
 namespace pneuma::sim {
 namespace {
 
 using test::defaultModel;
 
-// real-time factor of a breath style on the default model, after 100 settling steps (1 s at the implicit
-// integrators' 10 ms; rtf is a rate over the CPU time of the loop, i.e. wall time on an idle core; stepping,
-// metrics and recording at 60 Hz are all included); one iteration is 25 steps
-void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator) {
+// real-time factor of a breath style on the default model at time step dt [s] (0: the integrator's default),
+// after 100 settling steps (rtf is a rate over the CPU time of the loop, i.e. wall time on an idle core;
+// stepping, metrics and recording at 60 Hz are all included); one iteration is 25 steps
+void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator, double dt) {
   const auto model = defaultModel();
   if (!model) {
     state.SkipWithError("default model missing: build it with 'pneuma-cli model build'");
@@ -30,9 +30,10 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
   }
   SimulationOptions o;
   o.step.integrator = integrator;
-  o.settleTime = 100.0 * defaultTimeStep(integrator);
+  o.dt = dt;
+  o.settleTime = 100.0 * (dt > 0.0 ? dt : defaultTimeStep(integrator));
   Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle(style)), o);
-  const double chunk = 25.0 * sim.dt();  // [s] simulated per iteration
+  const double chunk = 25.0 * sim.dt();     // [s] simulated per iteration
   double cgIterations = 0.0, frames = 0.0;  // CG iterations of the step before each output frame
   const auto sample = [&](const Simulation& s) {
     cgIterations += s.stepWork().cgIterations;
@@ -46,7 +47,8 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
     state.SkipWithError(e.what());
     return;
   }
-  state.counters["rtf"] = benchmark::Counter(chunk * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["rtf"] =
+      benchmark::Counter(chunk * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["dt_ms"] = sim.dt() * 1e3;
   state.counters["cg_iterations"] = frames > 0.0 ? cgIterations / frames : 0.0;
 }
@@ -73,17 +75,29 @@ void stepTime(benchmark::State& state) {
 }
 
 const bool kRegistered = [] {
-  // every breath style with the default integrator; calm with the reference one
-  std::vector<std::pair<IntegratorKind, const char*>> runs;
-  for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) runs.emplace_back(IntegratorKind::ImplicitEulerJoints, style);
-  runs.emplace_back(IntegratorKind::SymplecticEuler, "calm");
-  for (const auto& [integrator, style] : runs)
-    benchmark::RegisterBenchmark((std::string("RealTimeFactor/") + integratorName(integrator) + "/" + style).c_str(),
-                                 [integrator = integrator, style = style](benchmark::State& st) {
-                                   realTimeFactor(st, style, integrator);
-                                 })
+  // every breath style with the default integrator at 10 ms (its default) and 20 ms; calm with symplectic Euler
+  struct Run {
+    IntegratorKind integrator;
+    double dt;  // [s], 0 = the integrator's default
+    const char* style;
+  };
+  std::vector<Run> runs;
+  for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) {
+    runs.push_back({IntegratorKind::ImplicitEulerJoints, 0.01, style});
+    runs.push_back({IntegratorKind::ImplicitEulerJoints, 0.02, style});
+  }
+  runs.push_back({IntegratorKind::SymplecticEuler, 0.0, "calm"});
+  for (const Run& run : runs) {
+    const std::string dtName =
+        run.dt > 0.0 ? "/dt_ms:" + std::to_string(static_cast<int>(run.dt * 1e3 + 0.5)) : "";
+    benchmark::RegisterBenchmark(
+        (std::string("RealTimeFactor/") + integratorName(run.integrator) + dtName + "/" + run.style).c_str(),
+        [run](benchmark::State& st) { realTimeFactor(st, run.style, run.integrator, run.dt); })
         ->Unit(benchmark::kMillisecond);
-  benchmark::RegisterBenchmark("StepTime/gut_subdivisions", stepTime)->DenseRange(2, 4)->Unit(benchmark::kMicrosecond);
+  }
+  benchmark::RegisterBenchmark("StepTime/gut_subdivisions", stepTime)
+      ->DenseRange(2, 4)
+      ->Unit(benchmark::kMicrosecond);
   return true;
 }();
 

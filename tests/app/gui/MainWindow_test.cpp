@@ -352,14 +352,14 @@ TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
 
 TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {
   ToyWindow w;
-  // gut kappa far beyond what the time step can integrate
+  // muscle gains far beyond what the time step can integrate
   auto fields = w.window.parameters()->findChildren<QLineEdit*>();
-  QLineEdit* kappa = nullptr;
+  QLineEdit* gain = nullptr;
   for (QLineEdit* f : fields)
-    if (f->property("label").toString().contains("kPa")) kappa = f;
-  ASSERT_NE(kappa, nullptr);
-  kappa->setText("1e9");
-  emit kappa->editingFinished();
+    if (f->property("label").toString().contains("Active gain")) gain = f;
+  ASSERT_NE(gain, nullptr);
+  gain->setText("1e6");
+  emit gain->editingFinished();
   EXPECT_FALSE(w.window.runUntil(5.0));
   EXPECT_TRUE(w.window.lastError().contains("blew up")) << w.window.lastError().toStdString();
   ASSERT_NE(w.window.shown(), nullptr);

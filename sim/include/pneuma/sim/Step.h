@@ -10,37 +10,57 @@
 /// Integrators
 /// - SymplecticEuler: the paper's reference scheme (Section 6.1), v += F/m dt, then x += v dt, for
 ///   nodes and bodies (quaternions integrated with the new angular velocity). Explicit, so dt is
-///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max).
+///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max). Default dt 10 us: on
+///   the default model its limit is the diaphragm damping on the light dome nodes (dt < 2 m / sum b) and the
+///   10-25 g ribs; 20 us blows up within 0.1 s (real-time factor about 0.1).
 /// - ImplicitEulerJoints (the default): linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH
 ///   1998), solving (M + dt D + dt^2 K) dv = dt (f - dt K v) in the coordinates of the joint tree: the linear
 ///   velocity of every body hanging on a ball joint is eliminated, v_c = v_p + w_p x r_p - w_c x r_c
-///   (J: reduced -> full velocities), and a matrix-free conjugate gradient, warm-started from the previous
-///   dv', solves J^T (M + dt D + dt^2 K) J dv' = J^T rhs. K holds the element stiffness along and across
-///   each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx) and the spine
-///   joint springs; D holds element damping and joint friction. Preconditioner: the dense body block of
-///   the reduced system, LDLT-factored every `preconditionerRefresh` steps (the light, stiffly coupled
-///   ribcage), and block Jacobi (3x3 per node, with the gut pressure's diagonal blocks) for the gut nodes.
+///   (J: reduced -> full velocities), and a preconditioned conjugate gradient solves
+///   J^T (M + dt D + dt^2 K) J dv' = J^T rhs (see "Linear solve" below). K holds the element stiffness along
+///   and across each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx; kept
+///   while the gut is over-full and Eq. 5's force is 0, so a step that compresses the gut meets the pressure
+///   it raises: without it a suddenly contracting rectus squeezed the gut by 10 % in one step at dt 20 ms)
+///   and the spine joint springs; D holds element damping and joint friction.
 ///   Why this one: the stiff parts of the model (cartilage, the gut's near-incompressibility kappa, joint
 ///   friction on 10-25 g ribs) are linear or nearly so, so backward Euler removes their step limit at the
 ///   cost of a few CG passes that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so
 ///   its numerical damping of high frequencies is harmless, while a position-based (XPBD) scheme would not
 ///   follow the paper's force laws (Eq. 2, 4, 5) as directly. The joints hold inside the linear solve, so
 ///   joint friction (Eq. 3) couples a rib's spin to the spine about the joint rather than about the rib's
-///   com: friction only dissipates (tested at 120 N m s/rad, 10x the calibrated mu) and the result does
-///   not depend on dt (deep breathing: 916 / 912 / 915 mL at dt 10 / 5 / 2 ms). An earlier variant that solved in
-///   the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
+///   com: friction only dissipates (tested at 150 N m s/rad, 10x the calibrated mu) and the result does
+///   not depend on dt (deep breathing: 916 / 912 / 915 mL at dt 10 / 5 / 2 ms). An earlier variant that
+///   solved in the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
 ///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 10 ms
-///   (20 ms still runs, but the gut volume error grows to 4 % and calm breathing by about 9 %).
+///   (at 20 ms calm breathing is about 6 % larger; docs/cli.md "Performance" has the accuracy by dt).
 /// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
 /// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
 /// mass-weighted projection removes the position drift.
+///
+/// Linear solve (ImplicitEulerJoints): CG on A dv' = b, A = J^T (M + dt D + dt^2 K) J, to a relative residual
+/// `cgTolerance` in the preconditioner norm (r^T P^-1 r <= tol^2 b^T P^-1 b), started from dv' = P^-1 b. A is
+/// matrix-free; the preconditioner P is A itself, assembled sparse over the free coordinates (3x3 blocks: gut
+/// nodes, body spins and the free bodies' linear velocities) without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g), factored by BlockLdlt,
+/// with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 / (1 + u^T A0^-1 u). The
+/// factorization is kept while it stays a good preconditioner and refreshed when the last solve needed more
+/// than `refactorIterations`, when more than `refactorElementChanges` elements changed their 3x3 stiffness by
+/// a quarter (muscles going slack or taut, activation steps, fast rotation), after `preconditionerRefresh`
+/// steps, or when dt or the coordinates change. A fresh factorization solves the step exactly (0 iterations);
+/// a stale one about 3 (0 - 8; more in the step where many muscles switch before the refresh).
+/// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
+/// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch
+/// no strand) only the node masses resist, 70 eigenvalues of P^-1 A below 1e-2, which neither Jacobi nor a
+/// coarse space of node aggregates captures (measured: 148 -> 87-116 iterations with 10-80 aggregates). An
+/// exact factorization captures them; the system changes by a few elements per step, so a factorization
+/// serves 3 - 4 steps, and the 3x3-block factorization (1281 free coordinates, 4.1k blocks in L) costs about
+/// 10 CG iterations.
 
 #include "pneuma/sim/Activation.h"
+#include "pneuma/sim/BlockLdlt.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/State.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include <array>
@@ -71,8 +91,12 @@ struct StepOptions {
   std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kpe and b per group
   int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
   double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
-  int cgMaxIterations = 60;           ///< [-] implicit Euler: max CG iterations
-  int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the body-block preconditioner every n steps
+  int cgMaxIterations = 200;          ///< [-] implicit Euler: max CG iterations (typically 0-8; up to ~90 in the step
+                                      ///< where many muscles go slack at once, before the refactorization)
+  int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the preconditioner at least every n steps
+  int refactorIterations = 4;         ///< [-] implicit Euler: refactor when the last solve needed more CG iterations
+  int refactorElementChanges = 4;     ///< [-] implicit Euler: refactor when the 3x3 stiffness of more elements changed
+                                      ///< by a quarter (slack/taut, activation, rotation) since the last factorization
   double cgTolerance = 1e-4;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
 };
 
@@ -93,6 +117,15 @@ struct StepWork {
   Eigen::VectorXd elementStiffness;    ///< [N/m] |dF/dl| of taut elements, 0 when slack (#E)
   Eigen::VectorXd elementGeometric;    ///< [N/m] transverse stiffness |F| / l of elements in tension (#E)
   Eigen::VectorXd elementDamping;      ///< [N s/m] b of taut elements, 0 when slack (#E)
+  double linearKScale = 0.0;           ///< [s^2] scale of K in the packed linearisation (dt^2)
+  double linearDScale = 0.0;           ///< [s] scale of D in it (dt, or 0 for the right-hand side)
+  int linearNodeCount = 0;             ///< [-] packed elements between two single nodes
+  Eigen::Matrix2Xi linearNodes;        ///< their implicit solver offsets, A and B (2 x #E, first linearNodeCount used)
+  Eigen::Matrix<double, 5, Eigen::Dynamic> linearNodeCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l, then
+                                                              ///< [-] the direction (5 x #E)
+  int linearOtherCount = 0;            ///< [-] packed elements with a body or weighted-node end
+  Eigen::VectorXi linearOther;         ///< their element indices (#E, first linearOtherCount used)
+  Eigen::Matrix2Xd linearOtherCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l (2 x #E)
   Eigen::Matrix2Xi endpointBody;       ///< body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
   Eigen::Matrix2Xi endpointNode;       ///< the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
   Eigen::VectorXi fixedDofs;           ///< indices of fixed-body and fixed-node entries of the implicit solver vectors
@@ -107,15 +140,32 @@ struct StepWork {
   Eigen::Matrix3Xd gutGradient;        ///< [m^2] dV/dx per node (3 x #N)
   double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
   int cgIterations = 0;                ///< [-] CG iterations of the last implicit step
-  Eigen::MatrixXd bodyBlock;           ///< body block of the implicit system, dense (6 #B x 6 #B)
-  Eigen::LDLT<Eigen::MatrixXd> bodyFactor;  ///< its factorization, the CG preconditioner for body entries
-  long long stepsSinceFactor = 0;      ///< [-] counts implicit steps to refresh bodyFactor
-  std::vector<Eigen::Matrix3d> nodeBlockInverse;  ///< [1/kg] inverse 3x3 node blocks of M + dt D + dt^2 K (#N)
-  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX keeps
-                                                      ///< dv' of the last step as the next warm start
+  Eigen::MatrixXd bodyBlock;           ///< [kg, kg m, kg m^2] body block of the implicit system, J^T . J (6 #B x 6 #B)
+  Eigen::MatrixXd bodyNodeBlock;       ///< [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
+  std::vector<int> attachedNodes;      ///< nodes sharing an element with a body (#attached)
+  Eigen::VectorXi attachedColumn;      ///< node -> its index in attachedNodes, or -1 (#N)
+  Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> bodyMask;      ///< 1 where two bodies' entries can couple
+                                                                     ///< in the implicit system (#B x #B)
+  Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> couplingMask;  ///< 1 where a body's entries can couple to
+                                                                     ///< an attached node (#B x #attached)
+  Eigen::VectorXi freeIndex;           ///< implicit solver entry -> free coordinate, or -1 (fixed or dependent)
+  Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
+  BlockLdlt system;                    ///< the preconditioner's matrix and factorization (#free / 3 blocks square)
+  std::vector<int> systemPattern;      ///< value slot in system.values() of every streamed entry (see Step.cpp)
+  Eigen::VectorXd rankOne;             ///< [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
+  Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
+  double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
+  Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
+  double factorDt = 0.0;               ///< [s] dt of the factorization
+  Eigen::VectorXd factorAxial;         ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
+  Eigen::VectorXd factorTransverse;    ///< [kg] dt^2 |F| / l at the factorization (#E)
+  Eigen::Matrix3Xd factorDirection;    ///< [-] elementDirection at the factorization (3 x #E)
+  int factorAge = 0;                   ///< [-] steps solved with the current factorization
+  bool factorOnTree = false;           ///< the factorization is in the joint tree's coordinates
+  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX holds
+                                                      ///< dv' of the last step
   std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
   Eigen::Matrix3Xd treeLeverParent, treeLeverChild;  ///< [m] joint anchor minus com, world, at the step start (3 x #J)
-  Eigen::MatrixXd bodyTreeMap;         ///< [-, m] body part of the tree map J (6 #B x 6 #B), scratch
 };
 
 /// Allocates the scratch memory for `model` and computes its rest gut volume.

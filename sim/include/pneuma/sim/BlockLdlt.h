@@ -1,0 +1,65 @@
+#pragma once
+/// @file BlockLdlt.h
+/// Sparse LDL^T factorization of a symmetric positive definite matrix made of 3x3 blocks, the direct
+/// solver behind the implicit integrators' preconditioner (Step.h).
+///   P A P^T = L D L^T,  L unit lower triangular by blocks, D block diagonal (3x3 SPD blocks),
+///   P the approximate minimum degree ordering (Eigen::AMDOrdering) of the block graph.
+/// Algorithm: the up-looking factorization of Davis' LDL (T. A. Davis, "Algorithm 849: A concise sparse
+/// Cholesky factorization package", ACM TOMS 31(4), 2005) with every scalar replaced by a 3x3 block:
+/// row k of L solves L(0:k, 0:k) D Y = A(0:k, k) along the elimination tree, L(k, i) = Y_i^T D_i^-1,
+/// D_k = A(k, k) - sum_i L(k, i) Y_i. Why blocks: the mechanics has three coordinates per node or per body
+/// rotation, so each block entry replaces nine indexed scalar entries by one fixed-size 3x3 product; the
+/// factorization and the two triangular solves then run about three times faster than a scalar sparse LDL^T.
+/// Memory is allocated by analyze() only; factorize() and solve() allocate nothing.
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace pneuma::sim {
+
+class BlockLdlt {
+ public:
+  /// Symbolic analysis: the ordering and the block pattern of L for a matrix of `blocks` x `blocks` 3x3
+  /// blocks whose nonzero blocks are `pattern` (block row, block col) pairs; either triangle, duplicates
+  /// allowed; the diagonal is always included.
+  void analyze(int blocks, const std::vector<std::array<int, 2>>& pattern);
+
+  /// Index into values() of scalar entry (r, c) of A, r >= c (lower triangle; 0 <= r < 3 #blocks). The block
+  /// (r / 3, c / 3) must be in the analysed pattern.
+  int slot(int r, int c) const;
+  /// The lower triangle of A by entries (see slot()); the strict upper triangle of the diagonal blocks is
+  /// unused.
+  double* values() { return m_a.data()->data(); }
+  /// Number of doubles in values().
+  std::size_t valueCount() const { return 9 * m_a.size(); }
+  /// Sets every entry of A to zero (the pattern stays).
+  void clearValues();
+
+  /// Numeric factorization of the current values. @return false when a pivot block is not positive definite.
+  bool factorize();
+  /// x <- A^-1 x (3 #blocks).
+  void solve(Eigen::VectorXd& x) const;
+
+  int blocks() const { return m_n; }
+  /// Number of 3x3 blocks of L below the diagonal.
+  int factorBlocks() const { return m_lp.empty() ? 0 : m_lp.back(); }
+
+ private:
+  int m_n = 0;                       ///< number of block rows
+  std::vector<int> m_perm;           ///< permuted block -> original block (#blocks)
+  std::vector<int> m_permInverse;    ///< original block -> permuted block (#blocks)
+  std::vector<int> m_ap, m_ai;       ///< A's upper triangle by blocks, permuted, column-compressed
+  std::vector<Eigen::Matrix3d> m_a;  ///< its blocks (lower triangle of A, original orientation per block)
+  std::vector<char> m_aTransposed;   ///< 1 when a stored block is A(original) transposed by the permutation
+  std::vector<int> m_parent;         ///< elimination tree (#blocks, -1 at roots)
+  std::vector<int> m_lp, m_li;       ///< L's blocks below the diagonal, column-compressed
+  std::vector<Eigen::Matrix3d> m_l;  ///< their values
+  std::vector<Eigen::Matrix3d> m_dInverse;  ///< D_k^-1 (#blocks)
+  // factorization workspace (#blocks)
+  std::vector<Eigen::Matrix3d> m_y;
+  std::vector<int> m_flag, m_pattern, m_lnz;
+  mutable Eigen::VectorXd m_x;  ///< permuted right-hand side of solve()
+};
+
+}  // namespace pneuma::sim
