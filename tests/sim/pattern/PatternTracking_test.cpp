@@ -33,7 +33,7 @@ class PatternTracking : public ::testing::TestWithParam<const char*> {
 
 }  // namespace
 
-// the calibration staircase identifies each lever's lag: the rib friction (Eq. 3, 12 N m s/rad) makes the
+// the calibration staircase identifies each lever's lag: the rib friction (Eq. 3, 15 N m s/rad) makes the
 // intercostals, which turn the ribs, a slower lever than the diaphragm, which mainly pushes the gut down;
 // every lag is far below a breath (1 s at 60 b/m) and above the 10 ms step
 TEST(PatternDriveCalibration, IdentifiesTheRibcageAsTheSlowerLeverOnTheDefaultModel) {

@@ -74,7 +74,7 @@ double groupResponse(const DriveCalibration& calibration, ElementGroup g, double
 /// Feedback settings.
 struct PatternControllerOptions {
   /// [-] proportional gain on the fraction error. With the rib friction of the recalibrated model
-  /// (12 N m s/rad) the chest lags its activation by about 0.2 s, and the lag left over by the
+  /// (15 N m s/rad) the chest lags its activation by about 0.2 s, and the lag left over by the
   /// feed-forward needs a stiffer loop than the old fast plant did: K_p 1.2 and K_i 30 /s left panic at
   /// 8.5 % and startle's hold at 8.2 %, K_p 3 and K_i 100 /s give 2.9 % and 4.4 % (little margin on the
   /// 5 % hold target, see docs/patterns.md); at K_i 150 /s the hold rings (5.6 %).
