@@ -29,10 +29,10 @@
 ///   follow the paper's force laws (Eq. 2, 4, 5) as directly. The joints hold inside the linear solve, so
 ///   joint friction (Eq. 3) couples a rib's spin to the spine about the joint rather than about the rib's
 ///   com: friction only dissipates (tested at 150 N m s/rad, 10x the calibrated mu) and the result does
-///   not depend on dt (deep breathing: 916 / 912 / 915 mL at dt 10 / 5 / 2 ms). An earlier variant that
+///   not depend on dt (deep breathing: 921 / 919 / 924 mL at dt 10 / 5 / 2 ms). An earlier variant that
 ///   solved in the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
 ///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 10 ms
-///   (at 20 ms calm breathing is about 6 % larger; docs/cli.md "Performance" has the accuracy by dt).
+///   (docs/cli.md "Performance" has the accuracy by dt).
 /// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
 /// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
 /// mass-weighted projection removes the position drift.
