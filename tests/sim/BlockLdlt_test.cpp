@@ -1,4 +1,4 @@
-// BlockLdlt, the 3x3-block sparse LDL^T behind the implicit integrators' preconditioner: on the
+// BlockLdlt, the 3x3-block sparse LDL^T behind the implicit integrator's preconditioner: on the
 // linearised implicit system of a spring network (M + dt^2 K, SPD) it solves like a dense LDL^T, and it
 // reports an indefinite matrix instead of returning garbage.
 #include "pneuma/sim/BlockLdlt.h"

@@ -1,7 +1,7 @@
 #pragma once
 /// @file BlockLdlt.h
 /// Sparse LDL^T factorization of a symmetric positive definite matrix made of 3x3 blocks, the direct
-/// solver behind the implicit integrators' preconditioner (Step.h).
+/// solver behind the implicit integrator's preconditioner (Step.h).
 ///   P A P^T = L D L^T,  L unit lower triangular by blocks, D block diagonal (3x3 SPD blocks),
 ///   P the approximate minimum degree ordering (Eigen::AMDOrdering) of the block graph.
 /// Algorithm: the up-looking factorization of Davis' LDL (T. A. Davis, "Algorithm 849: A concise sparse
