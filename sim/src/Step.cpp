@@ -506,9 +506,8 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
 // kept for several steps, plus that term by Sherman-Morrison; u = sqrt(kp) g over the free coordinates
 void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w,
                   double dt) {
-  // the free coordinates and the matrix pattern: once per integrator
-  const bool onTree = !tree.empty();
-  if (w.systemPattern.empty() || onTree != w.factorOnTree) {
+  // the free coordinates and the matrix pattern: once per model
+  if (w.systemPattern.empty()) {
     Eigen::VectorXd mask = Eigen::VectorXd::Ones(w.cgX.size());
     maskReduced(model.joints, w, tree, mask);
     w.freeIndex.setConstant(mask.size(), -1);
@@ -562,7 +561,6 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     // the value slot of every streamed entry, -1 when dropped
     w.systemPattern.clear();
     for (const auto& [r, c] : entries) w.systemPattern.push_back(r >= 0 ? w.system.slot(r, c) : -1);
-    w.factorOnTree = onTree;
     w.compactR.setZero(nf);
     w.compactZ.setZero(nf);
   }
@@ -655,7 +653,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   // preconditioned conjugate gradient on M + dt D + dt^2 K; a stale factorization is a good preconditioner
   // for a few steps: refresh it when it has aged, when the last solve needed many iterations, when the
   // stiffness of several elements changed much (muscles going slack or taut, activation steps, fast
-  // rotation), or when dt or the coordinates changed
+  // rotation), or when dt changed
   int changed = 0;
   for (Eigen::Index e = 0; e < w.factorAxial.size(); ++e) {
     // |K_e - K_e0| <= |a - a0| + |g - g0| + 2 max(a, a0) |d - d0| for K_e = a d d^T + g (I - d d^T)
@@ -669,7 +667,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   }
   const bool stale = w.system.blocks() == 0 || w.factorAge >= o.preconditionerRefresh ||
                      w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges ||
-                     dt != w.factorDt || !tree.empty() != w.factorOnTree;
+                     dt != w.factorDt;
   if (stale) factorSystem(model, o, tree, w, dt);
   ++w.factorAge;
   linearizeElements(model, dt * dt, dt, w);

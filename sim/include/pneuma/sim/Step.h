@@ -45,7 +45,7 @@
 /// factorization is kept while it stays a good preconditioner and refreshed when the last solve needed more
 /// than `refactorIterations`, when more than `refactorElementChanges` elements changed their 3x3 stiffness by
 /// a quarter (muscles going slack or taut, activation steps, fast rotation), after `preconditionerRefresh`
-/// steps, or when dt or the coordinates change. A fresh factorization solves the step exactly (0 iterations);
+/// steps, or when dt changes. A fresh factorization solves the step exactly (0 iterations);
 /// a stale one about 3 (0 - 8; more in the step where many muscles switch before the refresh).
 /// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
 /// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch
@@ -161,7 +161,6 @@ struct StepWork {
   Eigen::VectorXd factorTransverse;    ///< [kg] dt^2 |F| / l at the factorization (#E)
   Eigen::Matrix3Xd factorDirection;    ///< [-] elementDirection at the factorization (3 x #E)
   int factorAge = 0;                   ///< [-] steps solved with the current factorization
-  bool factorOnTree = false;           ///< the factorization is in the joint tree's coordinates
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX holds
                                                       ///< dv' of the last step
   std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
