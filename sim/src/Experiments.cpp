@@ -51,17 +51,6 @@ std::size_t settledFrame(const StyleRun& r) {
   return ref;
 }
 
-// [m] range (max - min) of landmark column `landmark`'s y (anterior) after settling; 0 when it is missing
-double apExcursion(const StyleRun& r, int landmark) {
-  if (landmark < 0) return 0.0;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t i = settledFrame(r); i < r.trace.size(); ++i) {
-    lo = std::min(lo, r.trace.landmarks[i](1, landmark));
-    hi = std::max(hi, r.trace.landmarks[i](1, landmark));
-  }
-  return hi > lo ? hi - lo : 0.0;
-}
-
 // a controller holding every muscle relaxed
 class RelaxedController : public Controller {
  public:
@@ -145,8 +134,11 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
                           kZordan + ", Sec. 8.1 'panting breathing'", "mL",
                           (calm->summary.tidalVolume - panting->summary.tidalVolume) * kMl, 1e-9, kBig));
       // the motion seen from the side (Fig. 5's silhouette): anterior-posterior excursions of chest and belly
-      const double pantRatio = apExcursion(*panting, panting->xiphoid) / std::max(apExcursion(*panting, panting->umbilicus), 1e-12);
-      const double calmRatio = apExcursion(*calm, calm->xiphoid) / std::max(apExcursion(*calm, calm->umbilicus), 1e-12);
+      const auto apRatio = [](const StyleRun& r) {
+        return landmarkRange(r.trace, r.xiphoid, r.settleTime).y() /
+               std::max(landmarkRange(r.trace, r.umbilicus, r.settleTime).y(), 1e-12);
+      };
+      const double pantRatio = apRatio(*panting), calmRatio = apRatio(*calm);
       out.push_back(check("panting.chest_dominant", "xiphoid/umbilicus anterior-posterior excursion ratio, panting minus calm",
                           "> 0 (motion mostly in the chest)", kZordan + ", Sec. 8.1 'panting breathing'", "-",
                           pantRatio - calmRatio, 1e-12, kBig));

@@ -26,15 +26,19 @@ std::size_t firstIndex(const Trace& t, double from) {
 }
 }  // namespace
 
-double landmarkExcursion(const Trace& trace, int index, double from) {
+Eigen::Vector3d landmarkRange(const Trace& trace, int index, double from) {
   const std::size_t i0 = firstIndex(trace, from);
-  if (index < 0 || i0 >= trace.size()) return 0.0;
+  if (index < 0 || i0 >= trace.size()) return Eigen::Vector3d::Zero();
   Eigen::Vector3d lo = trace.landmarks[i0].col(index), hi = lo;
   for (std::size_t i = i0; i < trace.size(); ++i) {
     lo = lo.cwiseMin(trace.landmarks[i].col(index));
     hi = hi.cwiseMax(trace.landmarks[i].col(index));
   }
-  return (hi - lo).maxCoeff();
+  return hi - lo;
+}
+
+double landmarkExcursion(const Trace& trace, int index, double from) {
+  return landmarkRange(trace, index, from).maxCoeff();
 }
 
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from) {

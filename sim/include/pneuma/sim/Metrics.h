@@ -70,8 +70,12 @@ struct Summary {
 /// Fills the volume, rate, gut-error and excursion fields; the caller sets rtf, steps and dt.
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from);
 
+/// Range [m] of landmark `index`'s x, y and z over frames with time >= `from`: max - min per coordinate
+/// (zero when the index or the frames are missing).
+Eigen::Vector3d landmarkRange(const Trace& trace, int index, double from);
+
 /// Excursion [m] of landmark `index` over frames with time >= `from`: the length of the range
-/// (max - min) along the axis of largest range, i.e. max over x, y, z of (max - min) of that coordinate.
+/// (max - min) along the axis of largest range, i.e. landmarkRange().maxCoeff().
 double landmarkExcursion(const Trace& trace, int index, double from);
 
 }  // namespace pneuma::sim
