@@ -308,6 +308,32 @@ inline State randomVelocityState(const Model& m, double nodeSpeed, double spin, 
   return s;
 }
 
+/// The energy tests' run: `model` from `state` with every muscle relaxed, stepped by step() and measured
+/// by computeMetrics() after each step. energy() [J] is kinetic plus elastic energy of the latest metrics.
+class RelaxedRun {
+ public:
+  RelaxedRun(const Model& model, const StepOptions& options, State state)
+      : m_model(model), m_options(options), m_state(std::move(state)), m_work(makeStepWork(model)) {
+    computeMetrics(m_model, m_state, m_relaxed, m_options, m_work, m_metrics);
+  }
+  /// Advances by `dt` [s] and measures.
+  void step(double dt) {
+    sim::step(m_model, m_state, dt, m_relaxed, m_options, m_work);
+    computeMetrics(m_model, m_state, m_relaxed, m_options, m_work, m_metrics);
+  }
+  double energy() const { return m_metrics.kineticEnergy + m_metrics.elasticEnergy; }
+  const Metrics& metrics() const { return m_metrics; }
+  double time() const { return m_state.time; }
+
+ private:
+  const Model& m_model;
+  StepOptions m_options;
+  State m_state;
+  StepWork m_work;
+  Activations m_relaxed = relaxedActivations();
+  Metrics m_metrics;
+};
+
 /// [s] time step of the integrator tests on the toy models: its bodies are heavier than the default model's
 /// ribs, so the explicit scheme runs at 0.25 ms here (the default model needs defaultTimeStep(): 10 us).
 inline double toyTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : defaultTimeStep(k); }

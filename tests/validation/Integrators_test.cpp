@@ -50,22 +50,17 @@ TEST(ImplicitEulerJoints, StrongRibFrictionOnlyDissipates) {
   o.integrator = IntegratorKind::ImplicitEulerJoints;
   o.gravity = false;
   o.jointFrictionScale = 10.0;  // 150 N m s/rad at the rib-spine joints, 10x the calibrated mu
-  State s = test::randomVelocityState(m, 0.0, 0.5);
-  StepWork w = makeStepWork(m);
-  Metrics met;
-  const Activations relaxed = relaxedActivations();
-  computeMetrics(m, s, relaxed, o, w, met);
-  const double e0 = met.kineticEnergy + met.elasticEnergy;
+  test::RelaxedRun run(m, o, test::randomVelocityState(m, 0.0, 0.5));
+  const double e0 = run.energy();
   double peak = 0.0;
   const double dt = defaultTimeStep(o.integrator);
-  while (s.time < 1.5) {
-    step(m, s, dt, relaxed, o, w);
-    computeMetrics(m, s, relaxed, o, w, met);
-    peak = std::max(peak, met.kineticEnergy + met.elasticEnergy);
-    ASSERT_LT(met.maxJointError, 1e-4) << "joint error at t = " << s.time;
+  while (run.time() < 1.5) {
+    run.step(dt);
+    peak = std::max(peak, run.energy());
+    ASSERT_LT(run.metrics().maxJointError, 1e-4) << "joint error at t = " << run.time();
   }
   EXPECT_LT(peak, e0) << "energy grew above its initial value";
-  EXPECT_LT(met.kineticEnergy + met.elasticEnergy, 0.2 * e0);
+  EXPECT_LT(run.energy(), 0.2 * e0);
 }
 
 // the same deep breathing at dt 10 ms and 5 ms: tidal volume within 3 % (a consistent integrator converges)
