@@ -28,6 +28,13 @@ void requireRange(const std::string& field, double v, double lo, double hi, bool
 
 GroupActivation& slot(Activations& a, ElementGroup g) { return a[static_cast<std::size_t>(g)]; }
 
+// [-] 0 -> 1 over `rise` seconds after t = 0: s(x) = 3x^2 - 2x^3, x = t / rise clamped to [0, 1]; a step when rise = 0
+double smoothRise(double t, double rise) {
+  if (rise <= 0.0) return t >= 0.0 ? 1.0 : 0.0;
+  const double x = std::clamp(t / rise, 0.0, 1.0);
+  return x * x * (3.0 - 2.0 * x);
+}
+
 }  // namespace
 
 void validateBreathStyle(const BreathStyle& s) {
@@ -37,6 +44,9 @@ void validateBreathStyle(const BreathStyle& s) {
   requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
   requireRange(p + "diaphragm_r", s.diaphragmR, 0.0, 1.5, true);
   requireRange(p + "diaphragm_alpha", s.diaphragmAlpha, 0.0, 1.0, true);
+  const double period = 60.0 / s.breathsPerMinute;  // [s]
+  requireRange(p + "diaphragm_rise_time_s", s.diaphragmRiseTime, 0.0,
+               period * std::min(s.inhaleFraction, 1.0 - s.inhaleFraction), false);
   requireRange(p + "intercostal_alpha", s.intercostalAlpha, 0.0, 1.0, true);
   requireRange(p + "intercostal_amplitude", s.intercostalAmplitude, 0.0, 1.5, false);
   requireRange(p + "intercostal_mean - intercostal_amplitude", s.intercostalMean - s.intercostalAmplitude, 0.0, 1.5,
@@ -72,6 +82,7 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
     number("inhale_fraction", s.inhaleFraction, false);
     number("diaphragm_r", s.diaphragmR, true);
     number("diaphragm_alpha", s.diaphragmAlpha, false);
+    number("diaphragm_rise_time_s", s.diaphragmRiseTime, false);
     number("intercostal_mean", s.intercostalMean, true);
     number("intercostal_amplitude", s.intercostalAmplitude, true);
     number("intercostal_alpha", s.intercostalAlpha, false);
@@ -102,6 +113,7 @@ std::string serializeBreathStyle(const BreathStyle& s) {
                             {"inhale_fraction", s.inhaleFraction},
                             {"diaphragm_r", s.diaphragmR},
                             {"diaphragm_alpha", s.diaphragmAlpha},
+                            {"diaphragm_rise_time_s", s.diaphragmRiseTime},
                             {"intercostal_mean", s.intercostalMean},
                             {"intercostal_amplitude", s.intercostalAmplitude},
                             {"intercostal_alpha", s.intercostalAlpha},
@@ -158,8 +170,11 @@ Activations BreathStyleController::activations(double t, const Metrics& /*latest
   const double c = std::cos(2.0 * kPi * phase);
 
   Activations a = relaxedActivations();
-  // diaphragm: step function, on during inhale
-  slot(a, ElementGroup::Diaphragm) = inhale ? GroupActivation{s.diaphragmR, s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
+  // diaphragm: step function, on during inhale, its edges smoothed over the rise time
+  const double sinceInhale = phase * period, sinceExhale = sinceInhale - s.inhaleFraction * period;  // [s]
+  const double on = isRest ? 0.0 : inhale ? smoothRise(sinceInhale, s.diaphragmRiseTime)
+                                          : 1.0 - smoothRise(sinceExhale, s.diaphragmRiseTime);
+  slot(a, ElementGroup::Diaphragm) = on > 0.0 ? GroupActivation{s.diaphragmR, on * s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
   // intercostals: out-of-phase sinusoids, outer contract (r drops) on inhale, inner on exhale
   slot(a, ElementGroup::IntercostalExternal) = {s.intercostalMean + s.intercostalAmplitude * c, s.intercostalAlpha};
   slot(a, ElementGroup::IntercostalInternal) = {s.intercostalMean - s.intercostalAmplitude * c, s.intercostalAlpha};

@@ -857,7 +857,7 @@ bool integratorFromName(const std::string& name, IntegratorKind& out) {
   return false;
 }
 
-double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 1e-5 : 1e-2; }
+double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 1e-5 : 1.0 / 60.0; }
 
 void validateStepOptions(const StepOptions& o) {
   auto fail = [](const std::string& field, double v, const char* rule) {

@@ -128,7 +128,7 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   const BreathStyle panting = loadBreathStyle("panting");
   BreathStyleController c(panting);
   const Metrics none;
-  const Activations a = c.activations(0.1, none);  // inhale
+  const Activations a = c.activations(0.3, none);  // inhale, after the diaphragm's 0.2 s rise
   EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha, panting.diaphragmAlpha);
   EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha);
   EXPECT_LT(panting.diaphragmAlpha, 1.0);
@@ -137,6 +137,30 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   BreathStyle bad = panting;
   bad.intercostalAlpha = 1.5;
   EXPECT_THROW(validateBreathStyle(bad), Error);
+}
+
+// the diaphragm's step rises and falls as s(x) = 3x^2 - 2x^3 over the rise time, so its activation is continuous
+// across the inhale and exhale edges; the rise must fit into both phases
+TEST(BreathStyle, DiaphragmStepRisesAndFallsSmoothly) {
+  BreathStyle calm = loadBreathStyle("calm");  // period 4 s, inhale 1.6 s
+  calm.diaphragmRiseTime = 0.2;
+  BreathStyleController c(calm);
+  const Metrics none;
+  const auto alpha = [&](double t) { return c.activations(t, none)[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha; };
+  EXPECT_DOUBLE_EQ(alpha(0.0), 0.0);
+  EXPECT_NEAR(alpha(0.05), calm.diaphragmAlpha * (3 * 0.0625 - 2 * 0.015625), 1e-12);
+  EXPECT_NEAR(alpha(0.1), 0.5 * calm.diaphragmAlpha, 1e-12);
+  EXPECT_DOUBLE_EQ(alpha(1.0), calm.diaphragmAlpha);
+  EXPECT_NEAR(alpha(1.6 - 1e-9), calm.diaphragmAlpha, 1e-9);
+  EXPECT_NEAR(alpha(1.6 + 1e-9), calm.diaphragmAlpha, 1e-6);
+  EXPECT_NEAR(alpha(1.7), 0.5 * calm.diaphragmAlpha, 1e-12);
+  EXPECT_DOUBLE_EQ(alpha(1.9), 0.0);
+  EXPECT_DOUBLE_EQ(c.activations(1.0, none)[static_cast<std::size_t>(ElementGroup::Diaphragm)].r, calm.diaphragmR);
+  BreathStyle tooSlow = calm;
+  tooSlow.diaphragmRiseTime = 1.7;  // longer than the 1.6 s inhale
+  EXPECT_THROW(validateBreathStyle(tooSlow), Error);
+  tooSlow.diaphragmRiseTime = -0.1;
+  EXPECT_THROW(validateBreathStyle(tooSlow), Error);
 }
 
 // Summary: a pure sine of amplitude A at f gives tidal volume 2 A and 60 f b/m
@@ -187,6 +211,7 @@ TEST(Recorder, RandomAccessAndRestore) {
   o.settleTime = 0.0;
   o.outputRate = 50.0;
   o.recordSeconds = 0.5;
+  o.dt = 0.01;  // [s] frames on whole steps of the 50 Hz output
   Simulation sim(toy(), calm(), o);
   sim.advance(1.0);
   const Recorder& r = sim.recorder();
