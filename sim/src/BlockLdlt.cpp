@@ -1,6 +1,6 @@
 #include "pneuma/sim/BlockLdlt.h"
 
-#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
 #include <algorithm>
@@ -121,10 +121,12 @@ bool BlockLdlt::factorize() {
       m_l[at(end)] = lki;
       ++m_lnz[at(i)];
     }
-    // the pivot block must be symmetric positive definite
-    const Eigen::LLT<Matrix3d> pivot(0.5 * (d + d.transpose()));
-    if (pivot.info() != Eigen::Success) return false;
-    m_dInverse[at(k)] = pivot.solve(Matrix3d::Identity());
+    // the pivot block must be symmetric positive definite (Sylvester: positive leading minors); then its
+    // closed-form inverse
+    const Matrix3d pivot = 0.5 * (d + d.transpose());
+    const double minor2 = pivot(0, 0) * pivot(1, 1) - pivot(0, 1) * pivot(1, 0);
+    if (!(pivot(0, 0) > 0.0 && minor2 > 0.0 && pivot.determinant() > 0.0)) return false;
+    m_dInverse[at(k)] = pivot.inverse();
   }
   return true;
 }

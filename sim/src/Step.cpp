@@ -671,25 +671,28 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   if (stale) factorSystem(model, o, tree, w, dt);
   ++w.factorAge;
   linearizeElements(model, dt * dt, dt, w);
-  // start from x = P^-1 rhs (exact right after a refactorization); rhs^T P^-1 rhs scales the stop test:
-  // a relative residual, or the residual's energy norm r^T P^-1 r below 1e-12 J
+  // start from x = P^-1 rhs, which is the solution right after a refactorization (P is then the system
+  // itself); else rhs^T P^-1 rhs scales the stop test: a relative residual, or the residual's energy norm
+  // r^T P^-1 r below 1e-12 J
   applyPreconditioner(w, rhs, x);
-  const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(x), 1e-24);
-  applySystem(model, o, w, tree, x, t, z, q);
-  r = rhs - q;
-  applyPreconditioner(w, r, z);
-  p = z;
-  double rz = r.dot(z);
   int it = 0;
-  for (; it < o.cgMaxIterations && rz > stop; ++it) {
-    applySystem(model, o, w, tree, p, t, z, q);
-    const double alpha = rz / p.dot(q);
-    x += alpha * p;
-    r -= alpha * q;
+  if (!stale) {
+    const double stop = std::max(o.cgTolerance * o.cgTolerance * rhs.dot(x), 1e-24);
+    applySystem(model, o, w, tree, x, t, z, q);
+    r = rhs - q;
     applyPreconditioner(w, r, z);
-    const double rzNew = r.dot(z);
-    p = z + (rzNew / rz) * p;
-    rz = rzNew;
+    p = z;
+    double rz = r.dot(z);
+    for (; it < o.cgMaxIterations && rz > stop; ++it) {
+      applySystem(model, o, w, tree, p, t, z, q);
+      const double alpha = rz / p.dot(q);
+      x += alpha * p;
+      r -= alpha * q;
+      applyPreconditioner(w, r, z);
+      const double rzNew = r.dot(z);
+      p = z + (rzNew / rz) * p;
+      rz = rzNew;
+    }
   }
   w.cgIterations = it;
 
