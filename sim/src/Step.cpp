@@ -158,11 +158,30 @@ void gatherJointForces(const Joints& joints, const StepWork& w, const std::vecto
   for (auto it = tree.rbegin(); it != tree.rend(); ++it) {
     const int j = *it, p = joints.parent[at(j)], c = joints.child[at(j)];
     const Vector3d fc = f.template segment<3>(6 * c);
+    if (fc.isZero(0.0)) continue;  // columns of the assembled system are sparse
     f.template segment<3>(6 * p) += fc;
     f.template segment<3>(6 * p + 3) += w.treeLeverParent.col(j).cross(fc);
     f.template segment<3>(6 * c + 3) -= w.treeLeverChild.col(j).cross(fc);
     f.template segment<3>(6 * c).setZero();
   }
+}
+
+// J_i^T K_e J_j (6 x 6) for the point Jacobians J = [I, -[r]x] of levers ri, rj and the element stiffness
+// K_e = ka d d^T + kg (I - d d^T): (ka - kg) g_i g_j^T + kg J_i^T J_j with g = J^T d = [d; r x d] and
+// J_i^T J_j = [I, -[rj]x; [ri]x, -[ri]x [rj]x]
+Eigen::Matrix<double, 6, 6> pointStiffness(const Vector3d& d, double ka, double kg, const Vector3d& ri,
+                                           const Vector3d& rj) {
+  Eigen::Matrix<double, 6, 1> gi, gj;
+  gi << d, ri.cross(d);
+  gj << d, rj.cross(d);
+  Eigen::Matrix<double, 6, 6> m = (ka - kg) * gi * gj.transpose();
+  if (kg == 0.0) return m;
+  const Matrix3d si = skew(ri), sj = skew(rj);
+  m.block<3, 3>(0, 0).diagonal().array() += kg;
+  m.block<3, 3>(0, 3) -= kg * sj;
+  m.block<3, 3>(3, 0) += kg * si;
+  m.block<3, 3>(3, 3) -= kg * si * sj;
+  return m;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -398,31 +417,29 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     a.block<3, 3>(6 * b + 3, 6 * b + 3) = r * model.bodies.inertia[at(b)] * r.transpose();
   }
   // elements: J_i^T K_e J_j with J = [I, -[lever]x] for body endpoints, w_k I for node k, sign -1 across the
-  // ends
+  // ends (fixed bodies do not move)
   const Elements& el = model.elements;
-  Eigen::Matrix<double, 3, 6> ja, jb;
   for (int e = 0; e < el.size(); ++e) {
     const int ba = w.endpointBody(0, e), bb = w.endpointBody(1, e);
     if (ba < 0 && bb < 0) continue;
     const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e), kg = dt * dt * w.elementGeometric(e);
     if (ka == 0.0 && kg == 0.0) continue;
-    const Vector3d d = w.elementDirection.col(e);
-    const Matrix3d ke = ka * d * d.transpose() + kg * (Matrix3d::Identity() - d * d.transpose());
-    ja << Matrix3d::Identity(), -skew(w.leverA.col(e));
-    jb << Matrix3d::Identity(), -skew(w.leverB.col(e));
-    if (ba >= 0) a.block<6, 6>(6 * ba, 6 * ba) += ja.transpose() * ke * ja;
-    if (bb >= 0) a.block<6, 6>(6 * bb, 6 * bb) += jb.transpose() * ke * jb;
-    if (ba >= 0 && bb >= 0) {
-      const Eigen::Matrix<double, 6, 6> cab = ja.transpose() * ke * jb;
+    const Vector3d d = w.elementDirection.col(e), ra = w.leverA.col(e), rb = w.leverB.col(e);
+    const bool movingA = ba >= 0 && !model.bodies.isFixed[at(ba)], movingB = bb >= 0 && !model.bodies.isFixed[at(bb)];
+    if (movingA) a.block<6, 6>(6 * ba, 6 * ba) += pointStiffness(d, ka, kg, ra, ra);
+    if (movingB) a.block<6, 6>(6 * bb, 6 * bb) += pointStiffness(d, ka, kg, rb, rb);
+    if (movingA && movingB) {
+      const Eigen::Matrix<double, 6, 6> cab = pointStiffness(d, ka, kg, ra, rb);
       a.block<6, 6>(6 * ba, 6 * bb) -= cab;
       a.block<6, 6>(6 * bb, 6 * ba) -= cab.transpose();
-      continue;
     }
-    // one moving body end, nodes at the other
-    const int side = ba >= 0 ? 1 : 0, b = ba >= 0 ? ba : bb;
-    if (model.bodies.isFixed[at(b)]) continue;
-    const AnchorSet& nodes = side == 0 ? el.endA : el.endB;
-    const Eigen::Matrix<double, 6, 3> jk = (ba >= 0 ? ja : jb).transpose() * ke;
+    // a moving body at one end, nodes at the other: -J_b^T K_e w_k = -[K_e; [lever]x K_e] w_k
+    if ((ba >= 0) == (bb >= 0) || !(movingA || movingB)) continue;
+    const int b = movingA ? ba : bb;
+    const AnchorSet& nodes = movingA ? el.endB : el.endA;
+    const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
+    Eigen::Matrix<double, 6, 3> jk;
+    jk << ke, skew(movingA ? ra : rb) * ke;
     for (int k = 0; k < 3; ++k) {
       const int n = nodes.nodes(k, e);
       if (n >= 0) c.block<6, 3>(6 * b, 3 * w.attachedColumn(n)) -= nodes.weights(k, e) * jk;
@@ -439,13 +456,14 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     a.block<3, 3>(6 * p + 3, 6 * ch + 3).diagonal().array() -= kj;
   }
   // restrict to the joint tree's coordinates: J^T A by columns (fixed bodies' columns are not needed), then
-  // (J^T A) J by rows (the free rows only)
+  // J^T A J as the gathered columns of its transpose (the free columns only)
   if (!tree.empty()) {
     for (int b = 0; b < nb; ++b)
       for (int k = 6 * b; k < 6 * b + 6 && !model.bodies.isFixed[at(b)]; ++k)
         gatherJointForces(model.joints, w, tree, a.col(k));
+    a.transposeInPlace();  // (J^T A)^T = A J: its columns, gathered, are those of J^T A J
     for (Eigen::Index k = 0; k < w.freeCoordinates.size() && w.freeCoordinates(k) < a.rows(); ++k)
-      gatherJointForces(model.joints, w, tree, a.row(w.freeCoordinates(k)).transpose());
+      gatherJointForces(model.joints, w, tree, a.col(w.freeCoordinates(k)));
     for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
   }
 }
