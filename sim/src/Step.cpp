@@ -473,22 +473,13 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
 // only
 template <typename Sink>
 void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
-  // the free body entries come first among the free coordinates
-  const int* freeBegin = w.freeCoordinates.data();
-  const Eigen::Index nbf =
-      std::lower_bound(freeBegin, freeBegin + w.freeCoordinates.size(), w.bodyBlock.rows()) - freeBegin;
   // bodies, where they can couple
-  for (Eigen::Index c = 0; c < nbf; ++c)
-    for (Eigen::Index r = c; r < nbf; ++r)
-      if (w.bodyMask(freeBegin[r] / 6, freeBegin[c] / 6))
-        add(freeBegin[r], freeBegin[c], w.bodyBlock(freeBegin[r], freeBegin[c]));
-  // bodies and attached nodes, where they can couple
-  for (std::size_t k = 0; k < w.attachedNodes.size(); ++k)
-    for (int i = 0; i < 3; ++i)
-      for (Eigen::Index c = 0; c < nbf; ++c)
-        if (w.couplingMask(freeBegin[c] / 6, static_cast<Eigen::Index>(k)))
-          add(nodeOffset(model, w.attachedNodes[k]) + i, freeBegin[c],
-              w.bodyNodeBlock(freeBegin[c], 3 * static_cast<Eigen::Index>(k) + i));
+  for (Eigen::Index i = 0; i < w.bodyEntries.cols(); ++i)
+    add(w.bodyEntries(0, i), w.bodyEntries(1, i), w.bodyBlock(w.bodyEntries(0, i), w.bodyEntries(1, i)));
+  // attached nodes and bodies, where they can couple
+  for (Eigen::Index i = 0; i < w.couplingEntries.cols(); ++i)
+    add(w.couplingEntries(0, i), w.couplingEntries(1, i),
+        w.bodyNodeBlock(w.couplingEntries(1, i), w.couplingEntries(2, i)));
   // node masses
   for (int n = 0; n < model.nodes.size(); ++n)
     for (int i = 0; i < 3; ++i) add(nodeOffset(model, n) + i, nodeOffset(model, n) + i, model.nodes.mass(n));
@@ -543,15 +534,16 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     const int nb = model.bodies.size();
     std::vector<int> parentOf(at(nb), -1);
     for (int j : tree) parentOf[at(model.joints.child[at(j)])] = model.joints.parent[at(j)];
-    w.bodyMask.setZero(nb, nb);
+    Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> bodyMask, couplingMask;  // #B x #B, #B x #attached
+    bodyMask.setZero(nb, nb);
     const auto coupleBodies = [&](int b1, int b2) {
       for (int x = b1; x >= 0; x = parentOf[at(x)])
-        for (int y = b2; y >= 0; y = parentOf[at(y)]) w.bodyMask(x, y) = w.bodyMask(y, x) = 1;
+        for (int y = b2; y >= 0; y = parentOf[at(y)]) bodyMask(x, y) = bodyMask(y, x) = 1;
     };
     for (int b = 0; b < nb; ++b) coupleBodies(b, b);
     for (int i = 0; i < model.joints.size(); ++i)
       coupleBodies(model.joints.parent[at(i)], model.joints.child[at(i)]);
-    w.couplingMask.setZero(nb, static_cast<Eigen::Index>(w.attachedNodes.size()));
+    couplingMask.setZero(nb, static_cast<Eigen::Index>(w.attachedNodes.size()));
     const Elements& el = model.elements;
     for (int e = 0; e < el.size(); ++e) {
       if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0)
@@ -562,9 +554,26 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
         const AnchorSet& a = side == 0 ? el.endA : el.endB;
         for (int k = 0; k < 3; ++k)
           for (int b = body; b >= 0 && a.nodes(k, e) >= 0; b = parentOf[at(b)])
-            w.couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
+            couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
       }
     }
+    // the masks as lists of entries over the free body coordinates (which come first)
+    std::vector<int> bodyEntries, couplingEntries;
+    std::size_t freeBodies = 0;
+    while (freeBodies < free.size() && free[freeBodies] < 6 * nb) ++freeBodies;
+    for (std::size_t c = 0; c < freeBodies; ++c)
+      for (std::size_t r = c; r < freeBodies; ++r)
+        if (bodyMask(free[r] / 6, free[c] / 6)) bodyEntries.insert(bodyEntries.end(), {free[r], free[c]});
+    for (std::size_t k = 0; k < w.attachedNodes.size(); ++k) {
+      const int column = 3 * static_cast<int>(k), row = static_cast<int>(nodeOffset(model, w.attachedNodes[k]));
+      for (int i = 0; i < 3; ++i)
+        for (std::size_t c = 0; c < freeBodies; ++c)
+          if (couplingMask(free[c] / 6, column / 3))
+            couplingEntries.insert(couplingEntries.end(), {row + i, free[c], column + i});
+    }
+    w.bodyEntries = Eigen::Map<const Eigen::Matrix2Xi>(bodyEntries.data(), 2, static_cast<Eigen::Index>(bodyEntries.size() / 2));
+    w.couplingEntries =
+        Eigen::Map<const Eigen::Matrix3Xi>(couplingEntries.data(), 3, static_cast<Eigen::Index>(couplingEntries.size() / 3));
     // every streamed entry in free coordinates, (-1, -1) when fixed or dependent
     std::vector<std::array<int, 2>> entries;
     streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double) {

@@ -147,10 +147,10 @@ struct StepWork {
   Eigen::MatrixXd bodyNodeBlock;       ///< [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
   std::vector<int> attachedNodes;      ///< nodes sharing an element with a body (#attached)
   Eigen::VectorXi attachedColumn;      ///< node -> its index in attachedNodes, or -1 (#N)
-  Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> bodyMask;      ///< 1 where two bodies' entries can couple
-                                                                     ///< in the implicit system (#B x #B)
-  Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> couplingMask;  ///< 1 where a body's entries can couple to
-                                                                     ///< an attached node (#B x #attached)
+  Eigen::Matrix2Xi bodyEntries;        ///< (row, col) entries of bodyBlock that can be nonzero, free coordinates,
+                                       ///< lower triangle (2 x #entries)
+  Eigen::Matrix3Xi couplingEntries;    ///< (node entry, body entry, bodyNodeBlock column) of the body-node couplings
+                                       ///< that can be nonzero (3 x #entries)
   Eigen::VectorXi freeIndex;           ///< implicit solver entry -> free coordinate, or -1 (fixed or dependent)
   Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
   BlockLdlt system;                    ///< the preconditioner's matrix and factorization (#free / 3 blocks square)
