@@ -73,14 +73,13 @@ void BlockLdlt::analyze(int blocks, const std::vector<std::array<int, 2>>& patte
 }
 
 int BlockLdlt::slot(int r, int c) const {
-  const int pr = m_permInverse[at(r / 3)], pc = m_permInverse[at(c / 3)];
+  const int pr = m_permInverse[at(r)], pc = m_permInverse[at(c)];
   const int col = std::max(pr, pc), row = std::min(pr, pc);
   const auto begin = m_ai.begin() + m_ap[at(col)], end = m_ai.begin() + m_ap[at(col) + 1];
-  const int p = static_cast<int>(std::lower_bound(begin, end, row) - m_ai.begin());
-  return 9 * p + r % 3 + 3 * (c % 3);
+  return static_cast<int>(std::lower_bound(begin, end, row) - m_ai.begin());
 }
 
-void BlockLdlt::clearValues() { std::fill(values(), values() + valueCount(), 0.0); }
+void BlockLdlt::clearValues() { std::fill(m_a.begin(), m_a.end(), Eigen::Matrix3d::Zero()); }
 
 bool BlockLdlt::factorize() {
   using Eigen::Matrix3d;

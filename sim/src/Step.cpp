@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 namespace pneuma::sim {
@@ -469,23 +470,25 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
 }
 
 // streams the lower triangle of the implicit system without the gut's rank-one term, J^T (M + dt D + dt^2 K0)
-// J, as add(row, col, value) in full coordinates; the sequence of (row, col) depends on the model's topology
+// J, by 3 x 3 blocks as add(row, col, block) with row >= col the first entries of the block in full
+// coordinates (a diagonal block is passed whole); the sequence of (row, col) depends on the model's topology
 // only
 template <typename Sink>
 void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
   // bodies, where they can couple
   for (Eigen::Index i = 0; i < w.bodyEntries.cols(); ++i)
-    add(w.bodyEntries(0, i), w.bodyEntries(1, i), w.bodyBlock(w.bodyEntries(0, i), w.bodyEntries(1, i)));
-  // attached nodes and bodies, where they can couple
+    add(w.bodyEntries(0, i), w.bodyEntries(1, i), w.bodyBlock.block<3, 3>(w.bodyEntries(0, i), w.bodyEntries(1, i)));
+  // attached nodes and bodies, where they can couple (bodyNodeBlock holds body rows, node columns)
   for (Eigen::Index i = 0; i < w.couplingEntries.cols(); ++i)
     add(w.couplingEntries(0, i), w.couplingEntries(1, i),
-        w.bodyNodeBlock(w.couplingEntries(1, i), w.couplingEntries(2, i)));
+        w.bodyNodeBlock.block<3, 3>(w.couplingEntries(1, i), w.couplingEntries(2, i)).transpose());
   // node masses
   for (int n = 0; n < model.nodes.size(); ++n)
-    for (int i = 0; i < 3; ++i) add(nodeOffset(model, n) + i, nodeOffset(model, n) + i, model.nodes.mass(n));
+    add(nodeOffset(model, n), nodeOffset(model, n), model.nodes.mass(n) * Matrix3d::Identity());
   // elements between nodes: w_k w_l s_k s_l K_e for every pair of node terms of the two endpoints
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
+    if (w.endpointBody(0, e) >= 0 && w.endpointBody(1, e) >= 0) continue;
     const double ka = dt * dt * w.elementStiffness(e) + dt * w.elementDamping(e),
                  kg = dt * dt * w.elementGeometric(e);
     const Vector3d d = w.elementDirection.col(e);
@@ -501,9 +504,7 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
             const int na = a.nodes(ka3, e), nb = b.nodes(kb3, e);
             if (na < 0 || nb < 0 || na < nb) continue;
             const double s = (sa == sb ? 1.0 : -1.0) * a.weights(ka3, e) * b.weights(kb3, e);
-            for (int c = 0; c < 3; ++c)
-              for (int r = na == nb ? c : 0; r < 3; ++r)
-                add(nodeOffset(model, na) + r, nodeOffset(model, nb) + c, s * ke(r, c));
+            add(nodeOffset(model, na), nodeOffset(model, nb), s * ke);
           }
         }
       }
@@ -557,48 +558,46 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
             couplingMask(b, w.attachedColumn(a.nodes(k, e))) = 1;
       }
     }
-    // the masks as lists of entries over the free body coordinates (which come first)
+    // the masks as lists of 3 x 3 blocks over the free body coordinates (which come first, by whole blocks)
     std::vector<int> bodyEntries, couplingEntries;
     std::size_t freeBodies = 0;
-    while (freeBodies < free.size() && free[freeBodies] < 6 * nb) ++freeBodies;
-    for (std::size_t c = 0; c < freeBodies; ++c)
-      for (std::size_t r = c; r < freeBodies; ++r)
+    while (freeBodies < free.size() && free[freeBodies] < 6 * nb) freeBodies += 3;
+    for (std::size_t c = 0; c < freeBodies; c += 3)
+      for (std::size_t r = c; r < freeBodies; r += 3)
         if (bodyMask(free[r] / 6, free[c] / 6)) bodyEntries.insert(bodyEntries.end(), {free[r], free[c]});
     for (std::size_t k = 0; k < w.attachedNodes.size(); ++k) {
       const int column = 3 * static_cast<int>(k), row = static_cast<int>(nodeOffset(model, w.attachedNodes[k]));
-      for (int i = 0; i < 3; ++i)
-        for (std::size_t c = 0; c < freeBodies; ++c)
-          if (couplingMask(free[c] / 6, column / 3))
-            couplingEntries.insert(couplingEntries.end(), {row + i, free[c], column + i});
+      for (std::size_t c = 0; c < freeBodies; c += 3)
+        if (couplingMask(free[c] / 6, static_cast<Eigen::Index>(k)))
+          couplingEntries.insert(couplingEntries.end(), {row, free[c], column});
     }
     w.bodyEntries = Eigen::Map<const Eigen::Matrix2Xi>(bodyEntries.data(), 2, static_cast<Eigen::Index>(bodyEntries.size() / 2));
     w.couplingEntries =
         Eigen::Map<const Eigen::Matrix3Xi>(couplingEntries.data(), 3, static_cast<Eigen::Index>(couplingEntries.size() / 3));
-    // every streamed entry in free coordinates, (-1, -1) when fixed or dependent
-    std::vector<std::array<int, 2>> entries;
-    streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, double) {
-      entries.push_back({w.freeIndex(r), w.freeIndex(c)});
-      if (entries.back()[0] < 0 || entries.back()[1] < 0) entries.back() = {-1, -1};
+    // every streamed block in free blocks, (-1, -1) when fixed or dependent (free coordinates come in whole
+    // blocks: a node's three, a jointed body's rotation, a free body's translation and rotation)
+    std::vector<std::array<int, 2>> blocks;
+    streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, const auto&) {
+      const int fr = w.freeIndex(r), fc = w.freeIndex(c);
+      blocks.push_back(fr >= 0 && fc >= 0 ? std::array<int, 2>{fr / 3, fc / 3} : std::array<int, 2>{-1, -1});
     });
     const Eigen::Index nf = w.freeCoordinates.size();
-    std::vector<std::array<int, 2>> blocks;
-    for (const auto& [r, c] : entries)
-      if (r >= 0) blocks.push_back({r / 3, c / 3});
-    w.system.analyze(static_cast<int>(nf / 3), blocks);
-    // the value slot of every streamed entry, -1 when dropped
+    std::vector<std::array<int, 2>> pattern;
+    std::copy_if(blocks.begin(), blocks.end(), std::back_inserter(pattern), [](const auto& b) { return b[0] >= 0; });
+    w.system.analyze(static_cast<int>(nf / 3), pattern);
+    // the value slot of every streamed block, -1 when dropped
     w.systemPattern.clear();
-    for (const auto& [r, c] : entries) w.systemPattern.push_back(r >= 0 ? w.system.slot(r, c) : -1);
+    for (const auto& [r, c] : blocks) w.systemPattern.push_back(r >= 0 ? w.system.slot(r, c) : -1);
     w.compactR.setZero(nf);
     w.compactZ.setZero(nf);
   }
   // values, then the numeric factorization
   assembleBodyBlocks(model, o, tree, w, dt);
   w.system.clearValues();
-  double* values = w.system.values();
   std::size_t slot = 0;
-  streamSystem(model, w, dt, [&](Eigen::Index, Eigen::Index, double v) {
+  streamSystem(model, w, dt, [&](Eigen::Index, Eigen::Index, const auto& block) {
     const int k = w.systemPattern[slot++];
-    if (k >= 0) values[k] += v;
+    if (k >= 0) w.system.value(k) += block;
   });
   if (!w.system.factorize())
     throw Error(

@@ -57,23 +57,20 @@ Eigen::MatrixXd assemble(const SpringNetwork& net, double k, double dt, BlockLdl
   ldlt.analyze(net.nodes, pattern);
   ldlt.clearValues();
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * net.nodes, 3 * net.nodes);
-  const auto add = [&](int r, int c, double v) {
-    dense(r, c) += v;
-    if (r != c) dense(c, r) += v;
-    ldlt.values()[ldlt.slot(r, c)] += v;
+  // block (r, c), r >= c, of the lower triangle
+  const auto add = [&](int r, int c, const Eigen::Matrix3d& v) {
+    dense.block<3, 3>(3 * r, 3 * c) += v;
+    if (r != c) dense.block<3, 3>(3 * c, 3 * r) += v.transpose();
+    ldlt.value(ldlt.slot(r, c)) += v;
   };
-  for (int n = 0; n < net.nodes; ++n)
-    for (int i = 0; i < 3; ++i) add(3 * n + i, 3 * n + i, net.mass(n));
+  for (int n = 0; n < net.nodes; ++n) add(n, n, net.mass(n) * Eigen::Matrix3d::Identity());
   for (std::size_t s = 0; s < net.springs.size(); ++s) {
     const Eigen::Matrix3d ke = dt * dt * k * net.direction.col(static_cast<Eigen::Index>(s)) *
                                net.direction.col(static_cast<Eigen::Index>(s)).transpose();
     const int a = net.springs[s][0], b = net.springs[s][1];
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) {
-        if (r >= c) add(3 * a + r, 3 * a + c, ke(r, c));
-        if (r >= c) add(3 * b + r, 3 * b + c, ke(r, c));
-        add(3 * b + r, 3 * a + c, -ke(r, c));  // b > a: the coupling block is in the lower triangle
-      }
+    add(a, a, ke);
+    add(b, b, ke);
+    add(b, a, -ke);  // b > a: the coupling block is in the lower triangle
   }
   return dense;
 }
@@ -103,7 +100,7 @@ TEST(BlockLdlt, RefactorsNewValuesOnTheSamePattern) {
   // the same pattern with other values: the second factorization must not remember the first
   BlockLdlt fresh;
   const Eigen::MatrixXd a = assemble(net, 5e3, 0.01, fresh);
-  std::copy(fresh.values(), fresh.values() + fresh.valueCount(), ldlt.values());
+  for (int i = 0; i < fresh.valueBlocks(); ++i) ldlt.value(i) = fresh.value(i);
   ASSERT_TRUE(ldlt.factorize());
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3 * net.nodes, -1.0, 1.0);
   Eigen::VectorXd x = b;

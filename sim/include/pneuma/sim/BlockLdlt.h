@@ -25,14 +25,14 @@ class BlockLdlt {
   /// allowed; the diagonal is always included.
   void analyze(int blocks, const std::vector<std::array<int, 2>>& pattern);
 
-  /// Index into values() of scalar entry (r, c) of A, r >= c (lower triangle; 0 <= r < 3 #blocks). The block
-  /// (r / 3, c / 3) must be in the analysed pattern.
+  /// Slot of block (r, c) of A, r >= c (block row and column, 0 <= r < #blocks), for value(); the block must be in
+  /// the analysed pattern.
   int slot(int r, int c) const;
-  /// The lower triangle of A by entries (see slot()); the strict upper triangle of the diagonal blocks is
-  /// unused.
-  double* values() { return m_a.data()->data(); }
-  /// Number of doubles in values().
-  std::size_t valueCount() const { return 9 * m_a.size(); }
+  /// Block (r, c) of A's lower triangle at `slot` (rows of block row r, columns of block column c); of a diagonal
+  /// block only the lower triangle is read.
+  Eigen::Matrix3d& value(int slot) { return m_a[static_cast<std::size_t>(slot)]; }
+  /// Number of stored blocks of A (slots 0 .. valueBlocks() - 1).
+  int valueBlocks() const { return static_cast<int>(m_a.size()); }
   /// Sets every entry of A to zero (the pattern stays).
   void clearValues();
 

@@ -147,14 +147,14 @@ struct StepWork {
   Eigen::MatrixXd bodyNodeBlock;       ///< [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
   std::vector<int> attachedNodes;      ///< nodes sharing an element with a body (#attached)
   Eigen::VectorXi attachedColumn;      ///< node -> its index in attachedNodes, or -1 (#N)
-  Eigen::Matrix2Xi bodyEntries;        ///< (row, col) entries of bodyBlock that can be nonzero, free coordinates,
-                                       ///< lower triangle (2 x #entries)
-  Eigen::Matrix3Xi couplingEntries;    ///< (node entry, body entry, bodyNodeBlock column) of the body-node couplings
-                                       ///< that can be nonzero (3 x #entries)
+  Eigen::Matrix2Xi bodyEntries;        ///< (row, col) of the 3 x 3 blocks of bodyBlock that can be nonzero, first
+                                       ///< entries in free coordinates, lower triangle (2 x #blocks)
+  Eigen::Matrix3Xi couplingEntries;    ///< (node entry, body entry, bodyNodeBlock column) of the 3 x 3 body-node
+                                       ///< coupling blocks that can be nonzero (3 x #blocks)
   Eigen::VectorXi freeIndex;           ///< implicit solver entry -> free coordinate, or -1 (fixed or dependent)
   Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
   BlockLdlt system;                    ///< the preconditioner's matrix and factorization (#free / 3 blocks square)
-  std::vector<int> systemPattern;      ///< value slot in system.values() of every streamed entry (see Step.cpp)
+  std::vector<int> systemPattern;      ///< system's value slot of every streamed 3 x 3 block, -1 if dropped (see Step.cpp)
   Eigen::VectorXd rankOne;             ///< [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
   Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
   double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
