@@ -321,17 +321,23 @@ void linearizeElements(const Model& model, double kScale, double dScale, StepWor
   w.linearKScale = kScale;
   w.linearDScale = dScale;
   w.linearNodeCount = 0;
+  w.linearBodyCount = 0;
   w.linearOtherCount = 0;
   for (int e = 0; e < model.elements.size(); ++e) {
     const double ka = kScale * w.elementStiffness(e) + dScale * w.elementDamping(e);
     const double kg = kScale * w.elementGeometric(e);
     if (ka == 0.0 && kg == 0.0) continue;
     const int na = w.endpointNode(0, e), nb = w.endpointNode(1, e);
+    const int ba = w.endpointBody(0, e), bb = w.endpointBody(1, e);
     if (na >= 0 && nb >= 0) {
       const int i = w.linearNodeCount++;
       w.linearNodes.col(i) << static_cast<int>(nodeOffset(model, na)),
           static_cast<int>(nodeOffset(model, nb));
       w.linearNodeCoeffs.col(i) << ka, kg, w.elementDirection.col(e);
+    } else if (ba >= 0 && bb >= 0) {
+      const int i = w.linearBodyCount++;
+      w.linearBodies.col(i) << 6 * ba, 6 * bb;
+      w.linearBodyCoeffs.col(i) << ka, kg, w.elementDirection.col(e), w.leverA.col(e), w.leverB.col(e);
     } else {
       const int i = w.linearOtherCount++;
       w.linearOther(i) = e;
@@ -357,7 +363,22 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     Eigen::Map<Vector3d>(out.data() + oa) -= y;
     Eigen::Map<Vector3d>(out.data() + ob) += y;
   }
-  // elements with a body or weighted-node end
+  // elements between two bodies (intercostals, shoulder): the anchor velocity is v + w x r
+  for (int i = 0; i < w.linearBodyCount; ++i) {
+    const double* c = w.linearBodyCoeffs.col(i).data();
+    const Eigen::Index oa = w.linearBodies(0, i), ob = w.linearBodies(1, i);
+    const Vector3d d(c[2], c[3], c[4]), ra(c[5], c[6], c[7]), rb(c[8], c[9], c[10]);
+    const Vector3d va = Eigen::Map<const Vector3d>(u.data() + oa) + Eigen::Map<const Vector3d>(u.data() + oa + 3).cross(ra);
+    const Vector3d vb = Eigen::Map<const Vector3d>(u.data() + ob) + Eigen::Map<const Vector3d>(u.data() + ob + 3).cross(rb);
+    const Vector3d du = vb - va;
+    const double along = d.dot(du);
+    const Vector3d y = c[0] * along * d + c[1] * (du - along * d);
+    Eigen::Map<Vector3d>(out.data() + oa) -= y;
+    Eigen::Map<Vector3d>(out.data() + oa + 3) -= ra.cross(y);
+    Eigen::Map<Vector3d>(out.data() + ob) += y;
+    Eigen::Map<Vector3d>(out.data() + ob + 3) += rb.cross(y);
+  }
+  // elements with a weighted-node end or a body and a node end
   for (int i = 0; i < w.linearOtherCount; ++i) {
     const int e = w.linearOther(i);
     const double ka = w.linearOtherCoeffs(0, i), kg = w.linearOtherCoeffs(1, i);
@@ -374,9 +395,10 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
   // it one step of a suddenly contracting rectus squeezed the gut by 10 % at dt 20 ms
   if (w.restGutVolume > 0.0 && kScale != 0.0) {
     const double kp = kScale * effectiveKappa(model, o) * w.restGutVolume / (w.gutVolume * w.gutVolume);
-    double gu = 0.0;
-    for (int n = 0; n < model.nodes.size(); ++n) gu += w.gutGradient.col(n).dot(u.segment<3>(nodeOffset(model, n)));
-    for (int n = 0; n < model.nodes.size(); ++n) out.segment<3>(nodeOffset(model, n)) += (kp * gu) * w.gutGradient.col(n);
+    const Eigen::Index nodes = 3 * static_cast<Eigen::Index>(model.nodes.size());
+    const Eigen::Map<const Eigen::VectorXd> g(w.gutGradient.data(), nodes);
+    const double gu = g.dot(u.tail(nodes));
+    out.tail(nodes) += (kp * gu) * g;
   }
   // joint springs and friction act on the relative angular velocity
   const Joints& j = model.joints;
@@ -928,6 +950,8 @@ StepWork makeStepWork(const Model& model) {
   w.elementDamping = Eigen::VectorXd::Zero(ne);
   w.linearNodes = Eigen::Matrix2Xi::Zero(2, ne);
   w.linearNodeCoeffs = Eigen::Matrix<double, 5, Eigen::Dynamic>::Zero(5, ne);
+  w.linearBodies = Eigen::Matrix2Xi::Zero(2, ne);
+  w.linearBodyCoeffs = Eigen::Matrix<double, 11, Eigen::Dynamic>::Zero(11, ne);
   w.linearOther = Eigen::VectorXi::Zero(ne);
   w.linearOtherCoeffs = Eigen::Matrix2Xd::Zero(2, ne);
   w.inverseInertiaBody.resize(at(nb));

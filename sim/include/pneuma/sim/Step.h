@@ -126,7 +126,11 @@ struct StepWork {
   Eigen::Matrix2Xi linearNodes;        ///< their implicit solver offsets, A and B (2 x #E, first linearNodeCount used)
   Eigen::Matrix<double, 5, Eigen::Dynamic> linearNodeCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l, then
                                                               ///< [-] the direction (5 x #E)
-  int linearOtherCount = 0;            ///< [-] packed elements with a body or weighted-node end
+  int linearBodyCount = 0;             ///< [-] packed elements between two bodies
+  Eigen::Matrix2Xi linearBodies;       ///< their implicit solver offsets 6 b, A and B (2 x #E, first linearBodyCount used)
+  Eigen::Matrix<double, 11, Eigen::Dynamic> linearBodyCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l, then
+                                                               ///< [-] the direction and [m] the levers A and B (11 x #E)
+  int linearOtherCount = 0;            ///< [-] packed elements with a weighted-node end or a body and a node end
   Eigen::VectorXi linearOther;         ///< their element indices (#E, first linearOtherCount used)
   Eigen::Matrix2Xd linearOtherCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l (2 x #E)
   Eigen::Matrix2Xi endpointBody;       ///< body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
