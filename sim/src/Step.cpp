@@ -42,39 +42,62 @@ MuscleParams muscleParams(const Model& model, int e, const Activations& act, con
   return p;
 }
 
-// world position, velocity and lever arm (point - com, bodies only) of anchor i
-void anchorKinematics(const AnchorSet& a, int i, const State& s, const StepWork& w, Vector3d& p, Vector3d& v,
-                      Vector3d& lever) {
-  const int b = a.body[at(i)];
+// world position, velocity and lever arm (point - com, bodies only) of endpoint `side` of element i
+// (w: its classification as a body point, a single node, or weighted nodes)
+void anchorKinematics(const AnchorSet& a, int side, int i, const State& s, const StepWork& w, Vector3d& p,
+                      Vector3d& v, Vector3d& lever) {
+  const int b = w.endpointBody(side, i);
   if (b >= 0) {
     lever = w.rotation[at(b)] * a.local.col(i);
     p = s.bodyPosition.col(b) + lever;
     v = s.bodyVelocity.col(b) + s.bodyAngularVelocity.col(b).cross(lever);
     return;
   }
+  lever.setZero();
+  const int n = w.endpointNode(side, i);
+  if (n >= 0) {
+    p = s.nodePosition.col(n);
+    v = s.nodeVelocity.col(n);
+    return;
+  }
   p.setZero();
   v.setZero();
-  lever.setZero();
   for (int k = 0; k < 3; ++k) {
-    const int n = a.nodes(k, i);
-    if (n < 0) continue;
-    p += a.weights(k, i) * s.nodePosition.col(n);
-    v += a.weights(k, i) * s.nodeVelocity.col(n);
+    const int nk = a.nodes(k, i);
+    if (nk < 0) continue;
+    p += a.weights(k, i) * s.nodePosition.col(nk);
+    v += a.weights(k, i) * s.nodeVelocity.col(nk);
   }
 }
 
-// adds force f [N] acting at anchor i to the body (force and torque about the com) or to its nodes
-void applyAnchorForce(const AnchorSet& a, int i, const Vector3d& lever, const Vector3d& f, StepWork& w) {
-  const int b = a.body[at(i)];
+// adds force f [N] acting at endpoint `side` of element i to the body (force and torque about the com) or to
+// its nodes
+void applyAnchorForce(const AnchorSet& a, int side, int i, const Vector3d& lever, const Vector3d& f, StepWork& w) {
+  const int b = w.endpointBody(side, i);
   if (b >= 0) {
     w.bodyForce.col(b) += f;
     w.bodyTorque.col(b) += lever.cross(f);
     return;
   }
-  for (int k = 0; k < 3; ++k) {
-    const int n = a.nodes(k, i);
-    if (n >= 0) w.nodeForce.col(n) += a.weights(k, i) * f;
+  const int n = w.endpointNode(side, i);
+  if (n >= 0) {
+    w.nodeForce.col(n) += f;
+    return;
   }
+  for (int k = 0; k < 3; ++k)
+    if (a.nodes(k, i) >= 0) w.nodeForce.col(a.nodes(k, i)) += a.weights(k, i) * f;
+}
+
+// world position [m] of endpoint `side` of element i in `s` (w: the endpoint classification)
+Vector3d anchorPosition(const AnchorSet& a, int side, int i, const State& s, const StepWork& w) {
+  const int b = w.endpointBody(side, i);
+  if (b >= 0) return s.bodyPosition.col(b) + s.bodyOrientation[at(b)] * a.local.col(i);
+  const int n = w.endpointNode(side, i);
+  if (n >= 0) return s.nodePosition.col(n);
+  Vector3d p = Vector3d::Zero();
+  for (int k = 0; k < 3; ++k)
+    if (a.nodes(k, i) >= 0) p += a.weights(k, i) * s.nodePosition.col(a.nodes(k, i));
+  return p;
 }
 
 // ---- generalized-velocity helpers for the implicit solve: u = [v_b, w_b]_b ++ [v_n]_n ----
@@ -203,8 +226,8 @@ void accumulateElementForces(const Model& model, const State& s, const Activatio
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
     Vector3d pa, va, ra, pb, vb, rb;
-    anchorKinematics(el.endA, e, s, w, pa, va, ra);
-    anchorKinematics(el.endB, e, s, w, pb, vb, rb);
+    anchorKinematics(el.endA, 0, e, s, w, pa, va, ra);
+    anchorKinematics(el.endB, 1, e, s, w, pb, vb, rb);
     const Vector3d delta = pb - pa;
     const double l = std::max(delta.norm(), 1e-12);
     const Vector3d d = delta / l;
@@ -231,8 +254,8 @@ void accumulateElementForces(const Model& model, const State& s, const Activatio
     w.elementStiffness(e) = k;
     w.elementDamping(e) = b;
     w.elementGeometric(e) = std::max(-f, 0.0) / l;
-    applyAnchorForce(el.endA, e, ra, -f * d, w);
-    applyAnchorForce(el.endB, e, rb, f * d, w);
+    applyAnchorForce(el.endA, 0, e, ra, -f * d, w);
+    applyAnchorForce(el.endB, 1, e, rb, f * d, w);
   }
 }
 
@@ -782,18 +805,33 @@ void updateJointMasses(const Model& model, StepWork& w) {
   }
 }
 
-// sequential impulses: the relative velocity of the two anchor points of every joint goes to zero
+// [m/s] relative velocity of joint i's two anchor points (child minus parent)
+Vector3d jointVelocityError(const Model& model, const State& s, const StepWork& w, int i, Vector3d& rp, Vector3d& rc) {
+  const int p = model.joints.parent[at(i)], c = model.joints.child[at(i)];
+  rp = w.rotation[at(p)] * w.jointLocalParent.col(i);
+  rc = w.rotation[at(c)] * w.jointLocalChild.col(i);
+  return (s.bodyVelocity.col(c) + s.bodyAngularVelocity.col(c).cross(rc)) -
+         (s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(rp));
+}
+
+// sequential impulses: the relative velocity of the two anchor points of every joint goes to zero; nothing to do
+// when they already move together to kJointVelocityTolerance (the usual case: the implicit step solves the tree
+// joints, and the last step left every joint so)
 void solveJointVelocities(const Model& model, State& s, const StepOptions& o, StepWork& w) {
+  constexpr double kJointVelocityTolerance = 1e-5;  // [m/s] 0.17 um of separation over a 1/60 s step
   const Joints& j = model.joints;
+  Vector3d rp, rc;
+  double worst = 0.0;
+  for (int i = 0; i < j.size(); ++i) worst = std::max(worst, jointVelocityError(model, s, w, i, rp, rc).norm());
+  if (worst <= kJointVelocityTolerance) return;
   updateJointMasses(model, w);
   const int iterations = std::max(1, o.jointIterations / 3);
-  for (int it = 0; it < iterations; ++it) {
+  for (int it = 0; it < iterations && worst > kJointVelocityTolerance; ++it) {
+    worst = 0.0;
     for (int i = 0; i < j.size(); ++i) {
       const int p = j.parent[at(i)], c = j.child[at(i)];
-      const Vector3d rp = w.rotation[at(p)] * w.jointLocalParent.col(i);
-      const Vector3d rc = w.rotation[at(c)] * w.jointLocalChild.col(i);
-      const Vector3d vrel = (s.bodyVelocity.col(c) + s.bodyAngularVelocity.col(c).cross(rc)) -
-                            (s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(rp));
+      const Vector3d vrel = jointVelocityError(model, s, w, i, rp, rc);
+      worst = std::max(worst, vrel.norm());
       const Vector3d impulse = -w.jointMassInverse[at(i)] * vrel;
       if (!model.bodies.isFixed[at(c)]) {
         s.bodyVelocity.col(c) += impulse / model.bodies.mass(c);
@@ -816,10 +854,11 @@ void rotateBody(State& s, int b, const Vector3d& dtheta) {
 }
 
 // mass-weighted position projection until every joint error is below the tolerance (velocities kept);
-// the effective masses of the velocity stage are reused (the pose changed by one small step)
+// the effective masses are those of the pose before the first correction
 void projectJointPositions(const Model& model, State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
   w.maxJointError = 0.0;
+  bool massesCurrent = false;
   for (int it = 0; it < o.jointIterations; ++it) {
     double worst = 0.0;
     for (int i = 0; i < j.size(); ++i) {
@@ -830,6 +869,8 @@ void projectJointPositions(const Model& model, State& s, const StepOptions& o, S
       const double e = err.norm();
       worst = std::max(worst, e);
       if (e < 0.1 * o.jointTolerance) continue;
+      if (!massesCurrent) updateJointMasses(model, w);
+      massesCurrent = true;
       const Vector3d impulse = -w.jointMassInverse[at(i)] * err;
       for (const auto& [b, r, sign] : {std::tuple<int, Vector3d, double>{c, rc, 1.0}, {p, rp, -1.0}}) {
         if (model.bodies.isFixed[at(b)]) continue;
@@ -1098,12 +1139,9 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
     if (options.gravity)
       gravity -= model.nodes.mass(n) * model.gravity.dot(state.nodePosition.col(n) - model.nodes.rest.col(n));
   }
-  Eigen::Matrix3Xd pa, pb;
-  anchorPositions(el.endA, state, pa);
-  anchorPositions(el.endB, state, pb);
   double elastic = 0.0;
   for (int e = 0; e < el.size(); ++e) {
-    const double l = (pb.col(e) - pa.col(e)).norm();
+    const double l = (anchorPosition(el.endB, 1, e, state, work) - anchorPosition(el.endA, 0, e, state, work)).norm();
     const MuscleParams p = muscleParams(model, e, act, options);
     elastic += isMuscleGroup(el.group[at(e)]) ? muscleEnergy(l, p) : springEnergy(l, p.restLength, p.kpe);
   }
