@@ -38,7 +38,7 @@ Simulation::Simulation(std::shared_ptr<const Model> model, std::unique_ptr<Contr
 void Simulation::setOptions(const SimulationOptions& options) {
   validateSimulationOptions(options);
   m_options = options;
-  m_dt = options.dt > 0.0 ? options.dt : defaultTimeStep(options.step.integrator);
+  updateTimeStep();
   m_recorder.setCapacity(
       options.recordSeconds > 0.0 ? static_cast<std::size_t>(std::ceil(options.recordSeconds * options.outputRate)) + 1
                                   : 0);
@@ -48,6 +48,12 @@ void Simulation::setController(std::unique_ptr<Controller> controller) {
   if (!controller) throw Error("Simulation::setController: no controller");
   validateActivations(controller->activations(0.0, m_latest));
   m_controller = std::move(controller);
+  updateTimeStep();
+}
+
+void Simulation::updateTimeStep() {
+  m_dt = m_options.dt > 0.0 ? m_options.dt
+                            : std::min(defaultTimeStep(m_options.step.integrator), m_controller->maxTimeStep());
 }
 
 void Simulation::reset() {

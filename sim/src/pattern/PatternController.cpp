@@ -105,6 +105,7 @@ class StaircaseController : public Controller {
   }
   std::string describe() const override { return "drive calibration staircase"; }
   std::unique_ptr<Controller> clone() const override { return std::make_unique<StaircaseController>(*this); }
+  double maxTimeStep() const override { return kDriveTimeStep; }
 
  private:
   ElementGroup m_group;

@@ -25,7 +25,8 @@ namespace pneuma::sim {
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
   StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
-  double dt = 0.0;              ///< [s] time step; 0 = defaultTimeStep(step.integrator)
+  double dt = 0.0;              ///< [s] time step; 0 = defaultTimeStep(step.integrator), or the controller's
+                                ///< maxTimeStep() when smaller
   double settleTime = 2.0;      ///< [s] settling phase before the controller starts, >= 0
   double outputRate = 60.0;     ///< [Hz] metrics and recording rate, > 0
   double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
@@ -75,6 +76,8 @@ class Simulation {
   double realTimeFactor() const;
 
  private:
+  // m_dt from the options and the controller's maxTimeStep()
+  void updateTimeStep();
   // one timed step (control, physics, blow-up check); true when an output frame was emitted
   bool timedStep();
   // metrics, trace and recorder for the current state

@@ -45,6 +45,14 @@
 
 namespace pneuma::sim::pattern {
 
+/// [s] The drive's time step (Controller::maxTimeStep() of PatternController and of the calibration
+/// staircase): the gains, the identified lags and the hold tests belong to the plant stepped at 10 ms with
+/// the feedback at the 60 Hz output frames. At the default 1/60 s the integral moves the activations by
+/// K_i T = 1.7 times the error every frame, about 100 diaphragm elements near alpha 0.05 switch between
+/// slack and taut from frame to frame, and the suspensions of disgust (6.8 %) and startle (5.9 %) leave the
+/// 5 % bound (docs/patterns.md, "Time step").
+inline constexpr double kDriveTimeStep = 0.01;
+
 /// [-] activation levels at which calibrateDrive() measures each group's static response (0 first).
 inline constexpr std::array<double, 9> kCalibrationAlphas{0.0, 0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0};
 /// [-] volume-fraction change of one group alone at each of kCalibrationAlphas (the first entry is 0).
@@ -105,7 +113,8 @@ struct TrackingStats {
 /// settles within the level.
 /// The first group's baseline is V_rest. 5 x 9 s of simulated time, about 8 s of wall time on the
 /// default model.
-/// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run
+/// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run; a dt of 0
+///                 steps at kDriveTimeStep, as the drive itself
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options = {},
                                 double contractionR = 0.6);
 
@@ -125,6 +134,8 @@ class PatternController : public Controller {
   Activations activations(double t, const Metrics& latest) override;
   std::string describe() const override;
   std::unique_ptr<Controller> clone() const override;
+  /// kDriveTimeStep.
+  double maxTimeStep() const override { return kDriveTimeStep; }
 
   /// Pushes layers live (the app's affect selector); see LayerStack::push().
   void push(const std::vector<Layer>& playOrder, SwitchMode mode);
