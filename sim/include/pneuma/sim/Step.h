@@ -100,7 +100,8 @@ struct StepOptions {
   int refactorIterations = 4;         ///< [-] implicit Euler: refactor when the last solve needed more CG iterations
   int refactorElementChanges = 4;     ///< [-] implicit Euler: refactor when the 3x3 stiffness of more elements changed
                                       ///< by a quarter (slack/taut, activation, rotation) since the last factorization
-  double cgTolerance = 1e-3;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm)
+  double cgTolerance = 1e-2;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm);
+                                      ///< 1e-2 changes validate figures by at most 0.3 % against 1e-4 (docs/cli.md)
 };
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
