@@ -69,7 +69,9 @@ void addModelOption(CLI::App& cmd, std::string& model) {
 }
 
 void addIntegratorOption(CLI::App& cmd, std::string& name) {
-  cmd.add_option("--integrator", name, "One of " + sim::integratorNames() + " (default implicit-euler)");
+  cmd.add_option("--integrator", name,
+                 "One of " + sim::integratorNames() + " (default " +
+                     sim::integratorName(sim::StepOptions{}.integrator) + ")");
 }
 
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind) {

@@ -225,7 +225,9 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
   cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams (default 0)");
   addIntegratorOption(*cmd, args->integrator);
-  cmd->add_option("--dt", args->dt, "Time step [s] (default: the integrator's default)");
+  cmd->add_option("--dt", args->dt,
+                  "Time step [s] (default: the integrator's, 1/60 s for implicit-euler-joints; 10 ms for affect and "
+                  "pattern runs)");
   cmd->add_option("--settle", args->settle, "Settling time before the controller starts [s] (default 2)");
   args->isGiven = [cmd](const char* flag) { return cmd->count(flag) > 0; };
   cmd->callback([args] { runSimulate(*args); });
