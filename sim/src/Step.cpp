@@ -538,6 +538,14 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
                  kg = dt * dt * w.elementGeometric(e);
     const Vector3d d = w.elementDirection.col(e);
     const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
+    // two distinct single nodes (most elements): K_e on both diagonals, -K_e between them
+    const int n0 = w.endpointNode(0, e), n1 = w.endpointNode(1, e);
+    if (n0 >= 0 && n1 >= 0 && n0 != n1) {
+      add(nodeOffset(model, n0), nodeOffset(model, n0), ke);
+      add(nodeOffset(model, n1), nodeOffset(model, n1), ke);
+      add(nodeOffset(model, std::max(n0, n1)), nodeOffset(model, std::min(n0, n1)), -ke);
+      continue;
+    }
     for (int sa = 0; sa < 2; ++sa) {
       if (w.endpointBody(sa, e) >= 0) continue;
       const AnchorSet& a = sa == 0 ? el.endA : el.endB;
