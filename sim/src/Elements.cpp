@@ -7,31 +7,6 @@
 
 namespace pneuma::sim {
 
-double muscleForce(double l, double ldot, const MuscleParams& p) {
-  const double elastic = -p.alpha * p.kac * (l - p.r * p.restLength) - p.kpe * (l - p.restLength);
-  return std::min(elastic - p.damping * ldot, 0.0);
-}
-
-double muscleSlackLength(const MuscleParams& p) {
-  const double k = p.alpha * p.kac + p.kpe;
-  if (k <= 0.0) return p.restLength;
-  return (p.alpha * p.kac * p.r + p.kpe) * p.restLength / k;
-}
-
-double muscleEnergy(double l, const MuscleParams& p) {
-  const double stretch = l - muscleSlackLength(p);
-  return stretch > 0.0 ? 0.5 * (p.alpha * p.kac + p.kpe) * stretch * stretch : 0.0;
-}
-
-double springForce(double l, double ldot, double restLength, double k, double damping) {
-  return -k * (l - restLength) - damping * ldot;
-}
-
-double springEnergy(double l, double restLength, double k) {
-  const double stretch = l - restLength;
-  return 0.5 * k * stretch * stretch;
-}
-
 double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles) {
   // tetrahedra from the vertex centroid to each face (exact for a closed surface; the centroid only
   // reduces round-off)

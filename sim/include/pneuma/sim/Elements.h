@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+
 namespace pneuma::sim {
 
 /// Parameters of one muscle element under a given activation (Eq. 2).
@@ -23,21 +25,36 @@ struct MuscleParams {
 ///   F = min[-alpha kac (l - r l0) - kpe (l - l0) - b ldot, 0]            [N]
 /// Tension only; the damping term may be "virtually positive" (resist shortening) as long as the
 /// total stays <= 0. @param l length [m], @param ldot lengthening rate [m/s].
-double muscleForce(double l, double ldot, const MuscleParams& p);
+inline double muscleForce(double l, double ldot, const MuscleParams& p) {
+  const double elastic = -p.alpha * p.kac * (l - p.r * p.restLength) - p.kpe * (l - p.restLength);
+  return std::min(elastic - p.damping * ldot, 0.0);
+}
 
 /// Slack length [m] of a muscle: the length at which its elastic part, -alpha kac (l - r l0) - kpe (l - l0),
 /// is zero: l_s = (alpha kac r + kpe) l0 / (alpha kac + kpe); l0 when alpha kac + kpe = 0.
-double muscleSlackLength(const MuscleParams& p);
+inline double muscleSlackLength(const MuscleParams& p) {
+  const double k = p.alpha * p.kac + p.kpe;
+  if (k <= 0.0) return p.restLength;
+  return (p.alpha * p.kac * p.r + p.kpe) * p.restLength / k;
+}
 
 /// Elastic energy [J] of a muscle (the potential of Eq. 2 without damping): 1/2 (alpha kac + kpe) (l - l_s)^2
 /// for l > l_s, else 0.
-double muscleEnergy(double l, const MuscleParams& p);
+inline double muscleEnergy(double l, const MuscleParams& p) {
+  const double stretch = l - muscleSlackLength(p);
+  return stretch > 0.0 ? 0.5 * (p.alpha * p.kac + p.kpe) * stretch * stretch : 0.0;
+}
 
 /// Structural (cartilage) spring force, two-sided and damped: F = -k (l - l0) - b ldot   [N].
-double springForce(double l, double ldot, double restLength, double k, double damping);
+inline double springForce(double l, double ldot, double restLength, double k, double damping) {
+  return -k * (l - restLength) - damping * ldot;
+}
 
 /// Elastic energy [J] of a structural spring: 1/2 k (l - l0)^2.
-double springEnergy(double l, double restLength, double k);
+inline double springEnergy(double l, double restLength, double k) {
+  const double stretch = l - restLength;
+  return 0.5 * k * stretch * stretch;
+}
 
 /// Volume [m^3] enclosed by a closed triangle surface with outward normals: the sum over faces of the
 /// signed tetrahedra from the vertex centroid c to each face (Section 6.2),
