@@ -1,5 +1,7 @@
 #include "pneuma/sim/BlockLdlt.h"
 
+#include "BlockLdltKernels.h"
+
 #include <Eigen/LU>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
@@ -65,9 +67,10 @@ void BlockLdlt::analyze(int blocks, const std::vector<std::array<int, 2>>& patte
   m_lp.assign(at(blocks) + 1, 0);
   for (int k = 0; k < blocks; ++k) m_lp[at(k) + 1] = m_lp[at(k)] + m_lnz[at(k)];
   m_li.assign(at(m_lp.back()), 0);
-  m_l.assign(at(m_lp.back()), Eigen::Matrix3d::Zero());
+  m_l.assign(at(m_lp.back()), Block::Zero());
   m_dInverse.assign(at(blocks), Eigen::Matrix3d::Zero());
-  m_y.assign(at(blocks), Eigen::Matrix3d::Zero());
+  m_y.assign(at(blocks), Block::Zero());
+  setVectorKernel(true);
   m_pattern.assign(at(blocks), 0);
   m_x.setZero(3 * blocks);
 }
@@ -80,6 +83,15 @@ int BlockLdlt::slot(int r, int c) const {
 }
 
 void BlockLdlt::clearValues() { std::fill(m_a.begin(), m_a.end(), Eigen::Matrix3d::Zero()); }
+
+void BlockLdlt::setVectorKernel(bool allowed) {
+#ifdef PNEUMA_AVX2_KERNELS
+  m_avx2 = allowed && kernels::hasAvx2();
+#else
+  m_avx2 = false;
+  (void)allowed;
+#endif
+}
 
 bool BlockLdlt::factorize() {
   using Eigen::Matrix3d;
@@ -99,7 +111,7 @@ bool BlockLdlt::factorize() {
         d.triangularView<Eigen::StrictlyUpper>() = a.triangularView<Eigen::StrictlyLower>().transpose();
         continue;
       }
-      m_y[at(i)] = m_aTransposed[at(p)] ? Matrix3d(a.transpose()) : a;
+      m_y[at(i)].topRows<3>() = m_aTransposed[at(p)] ? Matrix3d(a.transpose()) : a;
       int len = 0;
       for (; m_flag[at(i)] != k; i = m_parent[at(i)]) {
         m_pattern[at(len++)] = i;
@@ -110,14 +122,18 @@ bool BlockLdlt::factorize() {
     // sparse triangular solve along the pattern; y_i = D_i L(k, i)^T
     for (; top < n; ++top) {
       const int i = m_pattern[at(top)];
-      const Matrix3d yi = m_y[at(i)];
+      const Matrix3d yi = m_y[at(i)].topRows<3>();
       m_y[at(i)].setZero();
-      const int end = m_lp[at(i)] + m_lnz[at(i)];
-      for (int p = m_lp[at(i)]; p < end; ++p) m_y[at(m_li[at(p)])].noalias() -= m_l[at(p)] * yi;
+      const int begin = m_lp[at(i)], end = begin + m_lnz[at(i)];
+      if (m_avx2)
+        kernels::subtractProductsAvx2(m_y.data()->data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
+                                      end - begin, yi.data());
+      else
+        for (int p = begin; p < end; ++p) m_y[at(m_li[at(p)])].topRows<3>().noalias() -= m_l[at(p)].topRows<3>() * yi;
       const Matrix3d lki = yi.transpose() * m_dInverse[at(i)];
       d.noalias() -= lki * yi;
       m_li[at(end)] = k;
-      m_l[at(end)] = lki;
+      m_l[at(end)].topRows<3>() = lki;
       ++m_lnz[at(i)];
     }
     // the pivot block must be symmetric positive definite (Sylvester: positive leading minors); then its
@@ -137,14 +153,14 @@ void BlockLdlt::solve(Eigen::VectorXd& x) const {
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d zi = m_x.segment<3>(3 * i);
     for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p)
-      m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)] * zi;
+      m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
   }
   for (int i = 0; i < n; ++i) m_x.segment<3>(3 * i) = m_dInverse[at(i)] * m_x.segment<3>(3 * i).eval();
   // L^T x = z
   for (int i = n - 1; i >= 0; --i) {
     Eigen::Vector3d xi = m_x.segment<3>(3 * i);
     for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p)
-      xi.noalias() -= m_l[at(p)].transpose() * m_x.segment<3>(3 * m_li[at(p)]);
+      xi.noalias() -= m_l[at(p)].topRows<3>().transpose() * m_x.segment<3>(3 * m_li[at(p)]);
     m_x.segment<3>(3 * i) = xi;
   }
   for (int k = 0; k < n; ++k) x.segment<3>(3 * m_perm[at(k)]) = m_x.segment<3>(3 * k);

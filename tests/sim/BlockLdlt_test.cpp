@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace pneuma::sim {
@@ -75,11 +76,16 @@ Eigen::MatrixXd assemble(const SpringNetwork& net, double k, double dt, BlockLdl
   return dense;
 }
 
-TEST(BlockLdlt, SolvesAStiffSpringNetworkLikeADenseLdlt) {
+// both kernels of the factorization's inner loop (the portable one, and AVX2 + FMA where the CPU has it)
+class BlockLdltKernel : public ::testing::TestWithParam<bool> {};
+
+TEST_P(BlockLdltKernel, SolvesAStiffSpringNetworkLikeADenseLdlt) {
   // stiff springs at a large step: dt^2 k / m up to 4e4, the regime of the gut strands at dt = 20 ms
   const SpringNetwork net = lattice(7);
   BlockLdlt ldlt;
   const Eigen::MatrixXd a = assemble(net, 1e4, 0.02, ldlt);
+  ldlt.setVectorKernel(GetParam());
+  if (GetParam() && !ldlt.vectorKernel()) GTEST_SKIP() << "this CPU or build has no AVX2 + FMA";
   ASSERT_TRUE(ldlt.factorize());
   EXPECT_LT(ldlt.factorBlocks(), net.nodes * (net.nodes - 1) / 2) << "the factor should stay sparse";
   std::mt19937 rng(11);
@@ -91,6 +97,11 @@ TEST(BlockLdlt, SolvesAStiffSpringNetworkLikeADenseLdlt) {
   EXPECT_LT((x - reference).norm(), 1e-10 * reference.norm());
   EXPECT_LT((a * x - b).norm(), 1e-10 * b.norm());
 }
+
+INSTANTIATE_TEST_SUITE_P(Kernels, BlockLdltKernel, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? std::string("Avx2") : std::string("Portable");
+                         });
 
 TEST(BlockLdlt, RefactorsNewValuesOnTheSamePattern) {
   const SpringNetwork net = lattice(3);
