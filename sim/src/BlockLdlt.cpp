@@ -72,7 +72,7 @@ void BlockLdlt::analyze(int blocks, const std::vector<std::array<int, 2>>& patte
   m_y.assign(at(blocks), Block::Zero());
   setVectorKernel(true);
   m_pattern.assign(at(blocks), 0);
-  m_x.setZero(3 * blocks);
+  m_x.setZero(3 * blocks + 1);  // + 1: the AVX2 backward substitution reads one entry past a segment
 }
 
 int BlockLdlt::slot(int r, int c) const {
@@ -152,15 +152,24 @@ void BlockLdlt::solve(Eigen::VectorXd& x) const {
   // L z = b (column by column), then D
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d zi = m_x.segment<3>(3 * i);
-    for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p)
-      m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
+    const int begin = m_lp[at(i)], end = m_lp[at(i) + 1];
+    if (m_avx2)
+      kernels::forwardColumnAvx2(m_x.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin, end - begin,
+                                 zi.data());
+    else
+      for (int p = begin; p < end; ++p) m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
   }
   for (int i = 0; i < n; ++i) m_x.segment<3>(3 * i) = m_dInverse[at(i)] * m_x.segment<3>(3 * i).eval();
   // L^T x = z
   for (int i = n - 1; i >= 0; --i) {
     Eigen::Vector3d xi = m_x.segment<3>(3 * i);
-    for (int p = m_lp[at(i)]; p < m_lp[at(i) + 1]; ++p)
-      xi.noalias() -= m_l[at(p)].topRows<3>().transpose() * m_x.segment<3>(3 * m_li[at(p)]);
+    const int begin = m_lp[at(i)], end = m_lp[at(i) + 1];
+    if (m_avx2)
+      kernels::backwardColumnAvx2(xi.data(), m_x.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
+                                  end - begin);
+    else
+      for (int p = begin; p < end; ++p)
+        xi.noalias() -= m_l[at(p)].topRows<3>().transpose() * m_x.segment<3>(3 * m_li[at(p)]);
     m_x.segment<3>(3 * i) = xi;
   }
   for (int k = 0; k < n; ++k) x.segment<3>(3 * m_perm[at(k)]) = m_x.segment<3>(3 * k);

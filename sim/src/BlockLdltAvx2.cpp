@@ -24,6 +24,43 @@ void subtractProductsAvx2(double* y, const double* l, const int* rows, int count
   }
 }
 
+void forwardColumnAvx2(double* x, const double* l, const int* rows, int count, const double* z) {
+  // l's columns are full registers; x's segment is read and written as 2 + 1 entries (a 4-entry access would
+  // overlap the next segment and stall store forwarding)
+  const __m256d z0 = _mm256_broadcast_sd(z), z1 = _mm256_broadcast_sd(z + 1), z2 = _mm256_broadcast_sd(z + 2);
+  for (int q = 0; q < count; ++q) {
+    const double* lq = l + 12 * q;
+    double* xq = x + 3 * rows[q];
+    __m256d product = _mm256_mul_pd(_mm256_loadu_pd(lq), z0);
+    product = _mm256_fmadd_pd(_mm256_loadu_pd(lq + 4), z1, product);
+    product = _mm256_fmadd_pd(_mm256_loadu_pd(lq + 8), z2, product);
+    _mm_storeu_pd(xq, _mm_sub_pd(_mm_loadu_pd(xq), _mm256_castpd256_pd128(product)));
+    _mm_store_sd(xq + 2, _mm_sub_sd(_mm_load_sd(xq + 2), _mm256_extractf128_pd(product, 1)));
+  }
+}
+
+namespace {
+double sum4(__m256d v) {
+  const __m128d pair = _mm_add_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
+  return _mm_cvtsd_f64(_mm_add_sd(pair, _mm_unpackhi_pd(pair, pair)));
+}
+}  // namespace
+
+void backwardColumnAvx2(double* xi, const double* x, const double* l, const int* rows, int count) {
+  // column k of l[q] dotted with x's segment, summed over q; lane 3 multiplies l's zero row
+  __m256d acc0 = _mm256_setzero_pd(), acc1 = _mm256_setzero_pd(), acc2 = _mm256_setzero_pd();
+  for (int q = 0; q < count; ++q) {
+    const double* lq = l + 12 * q;
+    const __m256d xq = _mm256_loadu_pd(x + 3 * rows[q]);
+    acc0 = _mm256_fmadd_pd(_mm256_loadu_pd(lq), xq, acc0);
+    acc1 = _mm256_fmadd_pd(_mm256_loadu_pd(lq + 4), xq, acc1);
+    acc2 = _mm256_fmadd_pd(_mm256_loadu_pd(lq + 8), xq, acc2);
+  }
+  xi[0] -= sum4(acc0);
+  xi[1] -= sum4(acc1);
+  xi[2] -= sum4(acc2);
+}
+
 bool hasAvx2() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 
 }  // namespace pneuma::sim::kernels

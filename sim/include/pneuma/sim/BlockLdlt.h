@@ -13,8 +13,9 @@
 /// Memory is allocated by analyze() only; factorize() and solve() allocate nothing.
 /// Speed: the factorization's inner loop, Y_j -= L_j Y_i over a column of L, takes about 75 % of its time; L
 /// and Y are stored as 3x3 blocks padded to 4 rows, so that on x86-64 CPUs with AVX2 and FMA
-/// (BlockLdltAvx2.cpp, chosen at run time) each block product is 9 four-lane multiply-adds. That halved the
-/// factorization on the build machine; padding alone, with the SSE2 of the portable build, gained nothing.
+/// (BlockLdltAvx2.cpp, chosen at run time) each block product is 9 four-lane multiply-adds, and each block of
+/// the two substitutions 3. That halved the factorization on the build machine; padding alone, with the SSE2
+/// of the portable build, gained nothing.
 
 #include <Eigen/Core>
 #include <array>
@@ -40,10 +41,11 @@ class BlockLdlt {
   /// Sets every entry of A to zero (the pattern stays).
   void clearValues();
 
-  /// Kernel of factorize()'s inner loop: AVX2 + FMA when allowed (the default) and the CPU has it, else the
-  /// portable Eigen loop. Both give the same factor up to rounding (FMA rounds once per multiply-add).
+  /// Kernels of the inner loops of factorize() and solve(): AVX2 + FMA when allowed (the default) and the CPU
+  /// has it, else portable Eigen loops. Both agree up to rounding (FMA rounds once per multiply-add); a machine
+  /// gives bit-identical runs either way.
   void setVectorKernel(bool allowed);
-  /// True when factorize() runs the AVX2 + FMA kernel.
+  /// True when factorize() and solve() run the AVX2 + FMA kernels.
   bool vectorKernel() const { return m_avx2; }
 
   /// Numeric factorization of the current values. @return false when a pivot block is not positive definite.
