@@ -21,7 +21,9 @@ using test::defaultModel;
 
 // real-time factor of a breath style on the default model at time step dt [s] (0: the integrator's default),
 // after 100 settling steps (rtf is a rate over the CPU time of the loop, i.e. wall time on an idle core;
-// stepping, metrics and recording at 60 Hz are all included); one iteration is 25 steps
+// stepping, metrics and recording at 60 Hz are all included); one iteration is 25 steps. The recorder keeps 1 s,
+// as in `pneuma-cli bench`: its memory is then reused, the steady state of any run. While a fresh 300 s timeline
+// fills, each frame also touches new memory (14 KB; about 50 us per frame in page faults on the build machine).
 void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator, double dt) {
   const auto model = defaultModel();
   if (!model) {
@@ -32,6 +34,7 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
   o.step.integrator = integrator;
   o.dt = dt;
   o.settleTime = 100.0 * (dt > 0.0 ? dt : defaultTimeStep(integrator));
+  o.recordSeconds = 1.0;
   Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle(style)), o);
   const double chunk = 25.0 * sim.dt();     // [s] simulated per iteration
   double cgIterations = 0.0, frames = 0.0;  // CG iterations of the step before each output frame

@@ -41,14 +41,18 @@ struct Check {
 
 /// Durations and the simulation options shared by the experiments.
 struct ExperimentSettings {
-  SimulationOptions simulation;       ///< integrator, dt, settle time; output rate 30 Hz
+  SimulationOptions simulation;       ///< integrator, dt, settle time; output rate 30 Hz; 1 s recorder window (the
+                                      ///< experiments read the trace, not the recorder's timeline)
   double styleDuration = 12.0;        ///< [s] periodic styles after settling (>= 2 cycles of deep breathing)
   double forcedExhaleDuration = 8.0;  ///< [s] the single 6 s forced-exhale manoeuvre and its end
   double impactSettle = 2.0;          ///< [s] relaxed settling before the impact
   double impactDuration = 1.5;        ///< [s] simulated after the impact
   double impactSpeed = 2.0;           ///< [m/s] posterior speed given to the struck wall nodes
   double impactRadius = 0.06;         ///< [m] wall nodes within this distance of the umbilicus are struck
-  ExperimentSettings() { simulation.outputRate = 30.0; }
+  ExperimentSettings() {
+    simulation.outputRate = 30.0;
+    simulation.recordSeconds = 1.0;
+  }
 };
 
 /// A breath-style run.
