@@ -122,17 +122,26 @@ void runBench(const BenchArgs& args) {
       j["styles"].push_back({{"style", s.name}, {"real_time_factor", rtf}, {"step_time_ms", stepTime * 1e3}});
     }
 
-    // step time against element count (calm breathing)
-    const auto calm = std::find_if(styles.begin(), styles.end(), [](const sim::BreathStyle& s) { return s.name == "calm"; });
-    std::printf("\n%-16s %18s %16s\n", "elements", "real-time factor", "step time [ms]");
-    for (int stride : {8, 4, 2, 1}) {
-      auto m = std::make_shared<const sim::Model>(thinned(*model, stride));
-      const auto [rtf, stepTime] = measure(m, calm != styles.end() ? *calm : styles.front(), options, args.seconds);
-      std::printf("%-16d %18.2f %16.3f\n", m->elements.size(), rtf, stepTime * 1e3);
-      j["elements"].push_back({{"elements", m->elements.size()}, {"real_time_factor", rtf}, {"step_time_ms", stepTime * 1e3}});
-    }
   } catch (const sim::Error& e) {
     fail(kExitFailed, e.what());
+  }
+
+  // step time against element count (calm breathing); a thinned model keeps every 8th, 4th or 2nd strand of its
+  // abdominal wall, so the gut pressure bulges it and it may blow up within seconds: measure a fixed 2 s and
+  // report a blow-up in its row
+  constexpr double kThinnedSeconds = 2.0;  // [s]
+  const auto calm = std::find_if(styles.begin(), styles.end(), [](const sim::BreathStyle& s) { return s.name == "calm"; });
+  std::printf("\n%-16s %18s %16s   (%g s each)\n", "elements", "real-time factor", "step time [ms]", kThinnedSeconds);
+  for (int stride : {8, 4, 2, 1}) {
+    auto m = std::make_shared<const sim::Model>(thinned(*model, stride));
+    try {
+      const auto [rtf, stepTime] = measure(m, calm != styles.end() ? *calm : styles.front(), options, kThinnedSeconds);
+      std::printf("%-16d %18.2f %16.3f\n", m->elements.size(), rtf, stepTime * 1e3);
+      j["elements"].push_back({{"elements", m->elements.size()}, {"real_time_factor", rtf}, {"step_time_ms", stepTime * 1e3}});
+    } catch (const sim::Error& e) {
+      std::printf("%-16d %s\n", m->elements.size(), e.what());
+      j["elements"].push_back({{"elements", m->elements.size()}, {"error", e.what()}});
+    }
   }
   if (!args.out.empty()) {
     viz::writeFileAtomically(args.out + "/bench.json", j.dump(2) + "\n");
