@@ -130,7 +130,8 @@ bool BlockLdlt::factorize() {
                                       end - begin, yi.data());
       else
         for (int p = begin; p < end; ++p) m_y[at(m_li[at(p)])].topRows<3>().noalias() -= m_l[at(p)].topRows<3>() * yi;
-      const Matrix3d lki = yi.transpose() * m_dInverse[at(i)];
+      // L(k, i) = Y_i^T D_i^-1 = (D_i^-1 Y_i)^T (D_i^-1 is symmetric): column products, no horizontal sums
+      const Matrix3d lki = (m_dInverse[at(i)] * yi).transpose();
       d.noalias() -= lki * yi;
       m_li[at(end)] = k;
       m_l[at(end)].topRows<3>() = lki;
