@@ -190,21 +190,28 @@ void gatherJointForces(const Joints& joints, const StepWork& w, const std::vecto
   }
 }
 
-// J_i^T K_e J_j (6 x 6) for the point Jacobians J = [I, -[r]x] of levers ri, rj and the element stiffness
-// K_e = ka d d^T + kg (I - d d^T): (ka - kg) g_i g_j^T + kg J_i^T J_j with g = J^T d = [d; r x d] and
-// J_i^T J_j = [I, -[rj]x; [ri]x, -[ri]x [rj]x]
-Eigen::Matrix<double, 6, 6> pointStiffness(const Vector3d& d, double ka, double kg, const Vector3d& ri,
-                                           const Vector3d& rj) {
-  Eigen::Matrix<double, 6, 1> gi, gj;
-  gi << d, ri.cross(d);
-  gj << d, rj.cross(d);
-  Eigen::Matrix<double, 6, 6> m = (ka - kg) * gi * gj.transpose();
+// what the body stiffness blocks need of an element end with lever r and direction d: g = J^T d = [d; r x d]
+// and [r]x, for the point Jacobian J = [I, -[r]x]
+struct EndJacobian {
+  Eigen::Matrix<double, 6, 1> g;
+  Matrix3d s;
+};
+EndJacobian endJacobian(const Vector3d& d, const Vector3d& r) {
+  EndJacobian e;
+  e.g << d, r.cross(d);
+  e.s = skew(r);
+  return e;
+}
+
+// J_i^T K_e J_j (6 x 6) for the ends i, j and the element stiffness K_e = ka d d^T + kg (I - d d^T):
+// (ka - kg) g_i g_j^T + kg J_i^T J_j with J_i^T J_j = [I, -[rj]x; [ri]x, -[ri]x [rj]x]
+Eigen::Matrix<double, 6, 6> pointStiffness(double ka, double kg, const EndJacobian& i, const EndJacobian& j) {
+  Eigen::Matrix<double, 6, 6> m = (ka - kg) * i.g * j.g.transpose();
   if (kg == 0.0) return m;
-  const Matrix3d si = skew(ri), sj = skew(rj);
   m.block<3, 3>(0, 0).diagonal().array() += kg;
-  m.block<3, 3>(0, 3) -= kg * sj;
-  m.block<3, 3>(3, 0) += kg * si;
-  m.block<3, 3>(3, 3) -= kg * si * sj;
+  m.block<3, 3>(0, 3) -= kg * j.s;
+  m.block<3, 3>(3, 0) += kg * i.s;
+  m.block<3, 3>(3, 3) -= kg * i.s * j.s;
   return m;
 }
 
@@ -472,10 +479,11 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     if (ka == 0.0 && kg == 0.0) continue;
     const Vector3d d = w.elementDirection.col(e), ra = w.leverA.col(e), rb = w.leverB.col(e);
     const bool movingA = ba >= 0 && !model.bodies.isFixed[at(ba)], movingB = bb >= 0 && !model.bodies.isFixed[at(bb)];
-    if (movingA) a.block<6, 6>(6 * ba, 6 * ba) += pointStiffness(d, ka, kg, ra, ra);
-    if (movingB) a.block<6, 6>(6 * bb, 6 * bb) += pointStiffness(d, ka, kg, rb, rb);
+    const EndJacobian ea = endJacobian(d, ra), eb = endJacobian(d, rb);
+    if (movingA) a.block<6, 6>(6 * ba, 6 * ba) += pointStiffness(ka, kg, ea, ea);
+    if (movingB) a.block<6, 6>(6 * bb, 6 * bb) += pointStiffness(ka, kg, eb, eb);
     if (movingA && movingB) {
-      const Eigen::Matrix<double, 6, 6> cab = pointStiffness(d, ka, kg, ra, rb);
+      const Eigen::Matrix<double, 6, 6> cab = pointStiffness(ka, kg, ea, eb);
       a.block<6, 6>(6 * ba, 6 * bb) -= cab;
       a.block<6, 6>(6 * bb, 6 * ba) -= cab.transpose();
     }
