@@ -37,16 +37,17 @@
 /// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
 /// mass-weighted projection removes the position drift.
 ///
-/// Linear solve (ImplicitEulerJoints): CG on A dv' = b, A = J^T (M + dt D + dt^2 K) J, to a relative residual
-/// `cgTolerance` in the preconditioner norm (r^T P^-1 r <= tol^2 b^T P^-1 b), started from dv' = P^-1 b. A is
-/// matrix-free; the preconditioner P is A itself, assembled sparse over the free coordinates (3x3 blocks: gut
-/// nodes, body spins and the free bodies' linear velocities) without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g), factored by BlockLdlt,
-/// with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 / (1 + u^T A0^-1 u). The
-/// factorization is kept while it stays a good preconditioner and refreshed when the last solve needed more
-/// than `refactorIterations`, when more than `refactorElementChanges` elements changed their 3x3 stiffness by
-/// a quarter (muscles going slack or taut, activation steps, fast rotation), after `preconditionerRefresh`
-/// steps, or when dt changes. A fresh factorization solves the step exactly (0 iterations);
-/// a stale one about 3 (0 - 8; more in the step where many muscles switch before the refresh).
+/// Linear solve (ImplicitEulerJoints): A dv' = b, A = J^T (M + dt D + dt^2 K) J. The preconditioner P is A
+/// itself, assembled sparse over the free coordinates (3x3 blocks: gut nodes, body spins and the free bodies'
+/// linear velocities) without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g),
+/// factored by BlockLdlt, with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 /
+/// (1 + u^T A0^-1 u). The factorization is kept while it stays a good preconditioner and refreshed when the last
+/// solve needed more than `refactorIterations`, when more than `refactorElementChanges` elements changed their
+/// 3x3 stiffness by a quarter (muscles going slack or taut, activation steps, fast rotation), after
+/// `preconditionerRefresh` steps, or when dt changes. A fresh factorization solves the step directly, dv' = P^-1 b
+/// (about every second step on the default model); with a kept one, CG on the matrix-free A starts from
+/// dv' = P^-1 b and stops at a relative residual `cgTolerance` in the preconditioner norm
+/// (r^T P^-1 r <= tol^2 b^T P^-1 b), after about 3 iterations (more in a step where many muscles switch).
 /// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
 /// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch
 /// no strand) only the node masses resist, 70 eigenvalues of P^-1 A below 1e-2, which neither Jacobi nor a
