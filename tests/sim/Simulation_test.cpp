@@ -50,6 +50,27 @@ TEST(SimulationInput, RejectsBadOptionsBeforeRunning) {
   expectError([&] { Simulation(toy(), calm(), o); }, "settleTime");
 }
 
+// a controller may cap the default time step (the pattern drive's 10 ms); an explicit dt still wins, and a
+// controller installed mid-run brings its cap with it
+TEST(Simulation, TimeStepFollowsTheControllersCapUnlessDtIsGiven) {
+  struct Capped : BreathStyleController {
+    Capped() : BreathStyleController(loadBreathStyle("calm")) {}
+    double maxTimeStep() const override { return 0.004; }
+  };
+  SimulationOptions o;
+  Simulation byDefault(toy(), calm(), o);
+  EXPECT_DOUBLE_EQ(byDefault.dt(), defaultTimeStep(o.step.integrator));
+  Simulation capped(toy(), std::make_unique<Capped>(), o);
+  EXPECT_DOUBLE_EQ(capped.dt(), 0.004);
+  capped.advance(0.02);
+  EXPECT_EQ(capped.state().steps, 5);
+  byDefault.setController(std::make_unique<Capped>());
+  EXPECT_DOUBLE_EQ(byDefault.dt(), 0.004);
+  o.dt = 0.002;
+  Simulation given(toy(), std::make_unique<Capped>(), o);
+  EXPECT_DOUBLE_EQ(given.dt(), 0.002);
+}
+
 TEST(SimulationInput, RejectsNegativeGainsAndMasses) {
   Model bad = *toy();
   bad.elements.kac(3) = -5.0;
