@@ -16,22 +16,8 @@ State makeInitialState(const Model& model) {
 }
 
 void anchorPositions(const AnchorSet& anchors, const State& state, Eigen::Matrix3Xd& out) {
-  const int n = anchors.size();
-  out.resize(3, n);
-  for (int i = 0; i < n; ++i) {
-    const int b = anchors.body[static_cast<std::size_t>(i)];
-    if (b >= 0) {
-      out.col(i) = state.bodyPosition.col(b) +
-                   state.bodyOrientation[static_cast<std::size_t>(b)] * anchors.local.col(i);
-    } else {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) {
-        const int nd = anchors.nodes(k, i);
-        if (nd >= 0) p += anchors.weights(k, i) * state.nodePosition.col(nd);
-      }
-      out.col(i) = p;
-    }
-  }
+  out.resize(3, anchors.size());
+  for (int i = 0; i < anchors.size(); ++i) out.col(i) = anchorPosition(anchors, i, state);
 }
 
 }  // namespace pneuma::sim

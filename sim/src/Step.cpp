@@ -88,18 +88,6 @@ void applyAnchorForce(const AnchorSet& a, int side, int i, const Vector3d& lever
     if (a.nodes(k, i) >= 0) w.nodeForce.col(a.nodes(k, i)) += a.weights(k, i) * f;
 }
 
-// world position [m] of endpoint `side` of element i in `s` (w: the endpoint classification)
-Vector3d anchorPosition(const AnchorSet& a, int side, int i, const State& s, const StepWork& w) {
-  const int b = w.endpointBody(side, i);
-  if (b >= 0) return s.bodyPosition.col(b) + s.bodyOrientation[at(b)] * a.local.col(i);
-  const int n = w.endpointNode(side, i);
-  if (n >= 0) return s.nodePosition.col(n);
-  Vector3d p = Vector3d::Zero();
-  for (int k = 0; k < 3; ++k)
-    if (a.nodes(k, i) >= 0) p += a.weights(k, i) * s.nodePosition.col(a.nodes(k, i));
-  return p;
-}
-
 // ---- generalized-velocity helpers for the implicit solve: u = [v_b, w_b]_b ++ [v_n]_n ----
 
 Eigen::Index nodeOffset(const Model& m, int n) { return 6 * static_cast<Eigen::Index>(m.bodies.size()) + 3 * n; }
@@ -1157,7 +1145,7 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   }
   double elastic = 0.0;
   for (int e = 0; e < el.size(); ++e) {
-    const double l = (anchorPosition(el.endB, 1, e, state, work) - anchorPosition(el.endA, 0, e, state, work)).norm();
+    const double l = (anchorPosition(el.endB, e, state) - anchorPosition(el.endA, e, state)).norm();
     const MuscleParams p = muscleParams(model, e, act, options);
     elastic += isMuscleGroup(el.group[at(e)]) ? muscleEnergy(l, p) : springEnergy(l, p.restLength, p.kpe);
   }

@@ -29,8 +29,19 @@ struct State {
 /// all velocities zero.
 State makeInitialState(const Model& model);
 
-/// World position [m] of every point of `anchors` in `state`, written into `out` (3 x #P, resized).
+/// World position [m] of point `i` of `anchors` in `state`.
 /// Body points: x_b + R_b * local; node points: sum_k w_k * x_{n_k}.
+inline Eigen::Vector3d anchorPosition(const AnchorSet& anchors, int i, const State& state) {
+  const int b = anchors.body[static_cast<std::size_t>(i)];
+  if (b >= 0) return state.bodyPosition.col(b) + state.bodyOrientation[static_cast<std::size_t>(b)] * anchors.local.col(i);
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k)
+    if (anchors.nodes(k, i) >= 0) p += anchors.weights(k, i) * state.nodePosition.col(anchors.nodes(k, i));
+  return p;
+}
+
+/// World position [m] of every point of `anchors` in `state` (anchorPosition()), written into `out` (3 x #P,
+/// resized).
 void anchorPositions(const AnchorSet& anchors, const State& state, Eigen::Matrix3Xd& out);
 
 }  // namespace pneuma::sim
