@@ -156,11 +156,11 @@ TEST(AffectPresets, SuspensionsHoldOneSecondThenBreathingResumes) {
     EXPECT_NEAR(maxOf(tr, hold), e.holdVolume, 1e-9);
     EXPECT_NEAR(measuredRate(tr, window(tr, e.nextLayer), 0.15), e.nextRate, 0.5);
   }
-  // startle: the inspiration is quick (0.35 s from rest to the peak)
+  // startle: the inspiration is quick (0.55 s from rest to the peak)
   const Trace tr = play("startle", 3.0);
   std::size_t i = 0;
   while (tr.v[i] < 0.30 - 1e-9) ++i;
-  EXPECT_NEAR(tr.time(i), 0.35, 2 * kDt);
+  EXPECT_NEAR(tr.time(i), 0.55, 2 * kDt);
 }
 
 TEST(AffectPresets, SighYawnAndLaughAreDeepOneOffEventsThatReturnToNeutral) {

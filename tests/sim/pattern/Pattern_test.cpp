@@ -106,9 +106,9 @@ TEST(PatternFile, TimelineStartleAtTenSecondsThenNeutral) {
   EXPECT_EQ(s.currentLayerName(), "neutral");
   s.sample(10.01);
   EXPECT_EQ(s.currentLayerName(), "startle");
-  // quick inspiration 0.35 s and a 1 s suspension: the volume holds at the startle peak
-  const double held = s.sample(10.5);
-  for (double t = 10.5; t < 11.3; t += 0.05) EXPECT_NEAR(s.sample(t), held, 1e-12);
+  // quick inspiration 0.55 s and a 1 s suspension: the volume holds at the startle peak
+  const double held = s.sample(10.6);
+  for (double t = 10.6; t < 11.5; t += 0.05) EXPECT_NEAR(s.sample(t), held, 1e-12);
   // then 8 breaths at 35 b/m and back to neutral
   s.sample(13.0);
   EXPECT_EQ(s.currentLayerName(), "startled");
