@@ -90,7 +90,7 @@ void runBench(const BenchArgs& args) {
   if (!args.out.empty()) prepareOutputDir(args.out);
   sim::SimulationOptions options;
   options.settleTime = 0.0;
-  options.recordSeconds = 1.0;
+  options.recordSeconds = sim::kTraceOnlyRecordSeconds;
   applyIntegrator(args.integrator, options.step.integrator);
   std::shared_ptr<const sim::Model> model;
   std::vector<sim::BreathStyle> styles;

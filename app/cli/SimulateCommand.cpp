@@ -112,9 +112,9 @@ void runSimulate(const SimulateArgs& args) {
     if (scenario.controller != sim::ControllerKind::Style)
       std::fprintf(stderr, "calibrating the pattern controller's muscle drive on the model...\n");
     controller = sim::makeController(scenario, model, resourceDir());
-    // the CLI writes the trace; the recorder's timeline is for the app's scrubbing, so keep only 1 s of it
+    // the CLI writes the trace; the recorder's timeline is for the app's scrubbing
     sim::SimulationOptions options = scenario.options;
-    options.recordSeconds = 1.0;
+    options.recordSeconds = sim::kTraceOnlyRecordSeconds;
     simulation = std::make_unique<sim::Simulation>(model, std::move(controller), options);
   } catch (const sim::Error& e) {
     // a controller given on the command line is named by its flag, not by its scenario-file path

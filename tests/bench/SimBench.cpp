@@ -34,7 +34,7 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
   o.step.integrator = integrator;
   o.dt = dt;
   o.settleTime = 100.0 * (dt > 0.0 ? dt : defaultTimeStep(integrator));
-  o.recordSeconds = 1.0;
+  o.recordSeconds = kTraceOnlyRecordSeconds;
   Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle(style)), o);
   const double chunk = 25.0 * sim.dt();     // [s] simulated per iteration
   double cgIterations = 0.0, frames = 0.0;  // CG iterations of the step before each output frame

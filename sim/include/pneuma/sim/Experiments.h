@@ -51,7 +51,7 @@ struct ExperimentSettings {
   double impactRadius = 0.06;         ///< [m] wall nodes within this distance of the umbilicus are struck
   ExperimentSettings() {
     simulation.outputRate = 30.0;
-    simulation.recordSeconds = 1.0;
+    simulation.recordSeconds = kTraceOnlyRecordSeconds;
   }
 };
 

@@ -32,6 +32,11 @@ struct SimulationOptions {
   double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
 };
 
+/// [s] recorder window of runs that read the trace rather than scrub the timeline (the CLI, the validation
+/// experiments, the benchmarks): filling a long fresh window costs page faults every frame (docs/cli.md,
+/// "Performance").
+inline constexpr double kTraceOnlyRecordSeconds = 1.0;
+
 /// @throws Error naming the field: dt < 0 or not finite, settleTime < 0, outputRate <= 0, bad step options.
 void validateSimulationOptions(const SimulationOptions& o);
 
