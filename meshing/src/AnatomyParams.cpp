@@ -219,6 +219,7 @@ Gains readGains(const json& j, const std::string& source) {
     Reader::fail(groups.field("cartilage.kpe"), "must be > 0 (cartilage holds the ribs to the sternum)");
   }
   g.gutKappa = r.positive("gut_kappa_pa", 1e9);
+  g.gutDrag = r.number("gut_drag_per_s", 0.0, 1e3);
   g.wallMass = r.positive("gut_wall_mass_kg", 100.0);
   g.diaphragmMass = r.positive("diaphragm_mass_kg", 10.0);
   const Reader joints = r.child("joints");

@@ -109,6 +109,11 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
                         calm->summary.tidalVolume * kMl, 450.0, 550.0));
     out.push_back(check("calm.rate", "breathing rate, calm", "15 +/- 0.5 b/m", kZordan + ", Table 2", "b/m",
                         calm->summary.breathsPerMinute, 14.5, 15.5));
+    // quiet expiration is the passive recoil of lungs and chest wall, damped by the airways: the volume falls
+    // without bouncing back (West, Respiratory Physiology, ch. 7). Our bound: 2 % of the calm breath
+    out.push_back(check("calm.expiration_rebound", "largest rise of the lung volume during an exhale, after its peak, calm",
+                        "< 10 mL (the volume falls without bouncing)", "West, Respiratory Physiology, ch. 7", "mL",
+                        expirationRebound(*calm) * kMl, 0.0, 10.0));
   }
 
   // Table 2 slow/deep: 12 b/m; between 600 mL (clearly above the 500 mL calm breath; the paper's own deep
@@ -168,28 +173,60 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
   return out;
 }
 
-double spineSway(const StyleRun& r) {
+namespace {
+
+// the trace's frame ranges [first, last) of the controller's inhale (or exhale) windows of the full cycles
+// after settling: [settle + k T, settle + (k + f) T) (or [settle + (k + f) T, settle + (k + 1) T)),
+// T = 60 / rate, f the inhale fraction (BreathStyleController)
+std::vector<std::pair<std::size_t, std::size_t>> phaseFrames(const StyleRun& r, bool inhale) {
   const Trace& t = r.trace;
-  if (r.spineTop.size() != t.size() || t.size() == 0) return 0.0;
-  // the controller's inhale windows [settle + k T, settle + (k + f) T), T = 60 / rate (BreathStyleController)
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  if (t.size() == 0) return out;
   const double period = 60.0 / r.style.breathsPerMinute;   // [s]
-  const double inhale = r.style.inhaleFraction * period;   // [s]
+  const double split = r.style.inhaleFraction * period;    // [s]
   const int cycles = r.style.cycles > 0 ? r.style.cycles : std::numeric_limits<int>::max();
-  double sum = 0.0;
-  int count = 0;
   for (int k = 0; k < cycles; ++k) {
-    const double begin = r.settleTime + k * period, end = begin + inhale;
+    const double cycle = r.settleTime + k * period;
+    const double begin = inhale ? cycle : cycle + split, end = inhale ? cycle + split : cycle + period;
     if (end > t.time.back()) break;
-    // the most posterior spine-top position during this inhale, from its start
     std::size_t i = 0;
     while (i < t.size() && t.time[i] < begin) ++i;
-    const double start = r.spineTop[i].y();
+    std::size_t j = i;
+    while (j < t.size() && t.time[j] < end) ++j;
+    if (j > i) out.emplace_back(i, j);
+  }
+  return out;
+}
+
+}  // namespace
+
+double spineSway(const StyleRun& r) {
+  if (r.spineTop.size() != r.trace.size()) return 0.0;
+  double sum = 0.0;
+  int count = 0;
+  for (const auto& [first, last] : phaseFrames(r, true)) {
+    // the most posterior spine-top position during this inhale, from its start
     double back = 0.0;
-    for (; i < t.size() && t.time[i] < end; ++i) back = std::min(back, r.spineTop[i].y() - start);
+    for (std::size_t i = first; i < last; ++i) back = std::min(back, r.spineTop[i].y() - r.spineTop[first].y());
     sum += back;
     ++count;
   }
   return count > 0 ? sum / count : 0.0;
+}
+
+double expirationRebound(const StyleRun& r) {
+  const std::vector<double>& v = r.trace.lungVolume;
+  double rebound = 0.0;
+  for (const auto& [first, last] : phaseFrames(r, false)) {
+    // from the exhale's highest volume on, the largest rise above the running minimum
+    const auto peak = std::max_element(v.begin() + static_cast<std::ptrdiff_t>(first), v.begin() + static_cast<std::ptrdiff_t>(last));
+    double low = *peak;
+    for (auto it = peak; it != v.begin() + static_cast<std::ptrdiff_t>(last); ++it) {
+      low = std::min(low, *it);
+      rebound = std::max(rebound, *it - low);
+    }
+  }
+  return rebound;
 }
 
 std::vector<Check> swayChecks(const StyleRun& withFriction, const StyleRun& frictionless) {

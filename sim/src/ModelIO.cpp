@@ -203,6 +203,7 @@ void validateModel(const Model& m) {
     else requirePositive(m.nodes.mass[i], f + ".mass");
   }
   validateTriangles(m.gut.triangles, "gut.triangles", nN);
+  requireNonNegative(m.gut.drag, "gut.drag");
   if (m.gut.triangles.cols() > 0) {
     requirePositive(m.gut.kappa, "gut.kappa");
     const double v0 = enclosedVolume(m.nodes.rest, m.gut.triangles);
@@ -320,6 +321,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   // gut
   const Reader gut = root.at("gut");
   m.gut.kappa = gut.at("kappa").number();
+  if (gut.has("drag")) m.gut.drag = gut.at("drag").number();  // optional: models written before it have none
   const Reader gutTris = gut.at("triangles");
   m.gut.triangles.resize(3, static_cast<Eigen::Index>(gutTris.size()));
   for (std::size_t i = 0; i < gutTris.size(); ++i) m.gut.triangles.col(static_cast<Eigen::Index>(i)) = gutTris[i].index3();
@@ -430,7 +432,7 @@ std::string serializeModel(const Model& m) {
     for (int i = 0; i < t.cols(); ++i) a.push_back({t(0, i), t(1, i), t(2, i)});
     return a;
   };
-  doc["gut"] = {{"kappa", m.gut.kappa}, {"triangles", triangles(m.gut.triangles)}};
+  doc["gut"] = {{"kappa", m.gut.kappa}, {"drag", m.gut.drag}, {"triangles", triangles(m.gut.triangles)}};
 
   json elements = json::array();
   for (int i = 0; i < m.elements.size(); ++i) {

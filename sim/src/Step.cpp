@@ -286,6 +286,14 @@ void accumulateJointTorques(const Model& model, const State& s, const StepOption
   }
 }
 
+// visceral drag on the free nodes: f = -beta m v (Gut::drag)
+void accumulateVisceralDrag(const Model& model, const State& s, StepWork& w) {
+  const double beta = model.gut.drag;
+  if (beta == 0.0) return;
+  for (int n = 0; n < model.nodes.size(); ++n)
+    if (!model.nodes.isFixed(n)) w.nodeForce.col(n) -= beta * model.nodes.mass(n) * s.nodeVelocity.col(n);
+}
+
 // gravity on moving bodies and nodes; gyroscopic torque -w x (I w)
 void accumulateGravityAndGyroscopic(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
   for (int b = 0; b < model.bodies.size(); ++b) {
@@ -431,15 +439,17 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
   maskFixed(w, out);
 }
 
-// out = M u (block diagonal: m I for translations, world inertia for rotations)
+// out = (M + dt D_drag) u (block diagonal: m I for translations, world inertia for rotations; the visceral
+// drag is mass-proportional, so it scales the node masses by 1 + dt beta, dt as packed by linearizeElements)
 void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, Eigen::VectorXd& out) {
+  const double nodeScale = 1.0 + w.linearDScale * model.gut.drag;
   for (int b = 0; b < model.bodies.size(); ++b) {
     const Matrix3d& r = w.rotation[at(b)];
     out.segment<3>(6 * b) = model.bodies.mass(b) * u.segment<3>(6 * b);
     out.segment<3>(6 * b + 3) = r * (model.bodies.inertia[at(b)] * (r.transpose() * u.segment<3>(6 * b + 3)));
   }
   for (int n = 0; n < model.nodes.size(); ++n)
-    out.segment<3>(nodeOffset(model, n)) = model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
+    out.segment<3>(nodeOffset(model, n)) = nodeScale * model.nodes.mass(n) * u.segment<3>(nodeOffset(model, n));
 }
 
 // the dense body block of M + dt D + dt^2 K (6 #B square) and the coupling of the body entries to the
@@ -523,9 +533,9 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
   for (Eigen::Index i = 0; i < w.couplingEntries.cols(); ++i)
     add(w.couplingEntries(0, i), w.couplingEntries(1, i),
         w.bodyNodeBlock.block<3, 3>(w.couplingEntries(1, i), w.couplingEntries(2, i)).transpose());
-  // node masses
+  // node masses and the visceral drag, (1 + dt beta) m I
   for (int n = 0; n < model.nodes.size(); ++n)
-    add(nodeOffset(model, n), nodeOffset(model, n), model.nodes.mass(n) * Matrix3d::Identity());
+    add(nodeOffset(model, n), nodeOffset(model, n), (1.0 + dt * model.gut.drag) * model.nodes.mass(n) * Matrix3d::Identity());
   // elements between nodes: w_k w_l s_k s_l K_e for every pair of node terms of the two endpoints
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
@@ -923,6 +933,7 @@ void computeForces(const Model& model, const State& s, const Activations& act, c
   accumulateElementForces(model, s, act, o, w);
   accumulateGutPressure(model, s, o, w);
   accumulateJointTorques(model, s, o, w);
+  accumulateVisceralDrag(model, s, w);
   accumulateGravityAndGyroscopic(model, s, o, w);
 }
 

@@ -43,6 +43,7 @@ Model tinyModel() {
   m.nodes.mass = Eigen::Vector4d(0.0, 0.0, 0.0, 8.0);
   m.nodes.region = {NodeRegion::Fixed, NodeRegion::Fixed, NodeRegion::Fixed, NodeRegion::Wall};
   m.gut.kappa = 1e4;
+  m.gut.drag = 20.0;
   m.gut.triangles.resize(3, 4);
   m.gut.triangles << 0, 0, 0, 1,  //
       2, 1, 3, 2,                 //
@@ -100,6 +101,8 @@ TEST(ModelIO, RejectsCorruptedFilesNamingTheField) {
             "model.json: joints[0].anchor: missing");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["elements"][0]["group"] = "biceps"; }),
             "model.json: elements[0].group: unknown group 'biceps'");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["gut"]["drag"] = -1.0; }),
+            "model.json: gut.drag: must be >= 0, got -1");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["version"] = 7; }),
             "model.json: version: unsupported version 7 (this build reads 1)");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["landmarks"].erase(0); }),
@@ -112,6 +115,14 @@ TEST(ModelIO, RejectsCorruptedFilesNamingTheField) {
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["bodies"][0]["inertia"][0][0] = -1.0; })
                 .rfind("model.json: bodies[0].inertia: must be positive definite", 0),
             0u);
+}
+
+// gut.drag is optional: a model written before the visceral drag existed loads without it
+TEST(ModelIO, ModelWithoutGutDragLoadsWithNone) {
+  nlohmann::json j = nlohmann::json::parse(serializeModel(tinyModel()));
+  EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.drag, 20.0);
+  j["gut"].erase("drag");
+  EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.drag, 0.0);
 }
 
 TEST(ModelIO, RejectsTruncatedJson) {

@@ -1,5 +1,6 @@
 // Analytic checks of the integrators and the joint solver (docs/STYLE "Tests"; Zordan et al. 2004
-// Sections 5, 6): a spring-mass period, a pendulum on a ball joint, a pressurised closed spring sphere.
+// Sections 5, 6): a spring-mass period, a pendulum on a ball joint, a pressurised closed spring sphere, and
+// the stopping distance of a node under the visceral drag (Gut::drag).
 // Every check runs with both integrators at their default time step.
 #include "ToyTorso.h"
 
@@ -120,6 +121,27 @@ TEST_P(Integrators, PressurisedSpringSphereReachesEquilibriumRadius) {
   EXPECT_NEAR(radius, expected, 0.002 * expected);
   EXPECT_LT(expected, 0.99 * r0);  // the test is not trivial: the sphere shrinks
   EXPECT_GT(expected, 1.01 * restScale * r0);
+}
+
+// a free node launched at v0 under the visceral drag alone (m dv/dt = -beta m v) stops after v0 / beta
+TEST_P(Integrators, VisceralDragStopsAFreeNodeAfterItsAnalyticDistance) {
+  Model m;
+  m.nodes.rest = Eigen::Matrix3Xd::Zero(3, 1);
+  m.nodes.mass = Eigen::VectorXd::Constant(1, 0.05);
+  m.nodes.region = {NodeRegion::Wall};
+  m.gut.drag = 4.0;
+  StepOptions o;
+  o.integrator = GetParam();
+  o.gravity = false;
+  State s = makeInitialState(m);
+  const Eigen::Vector3d v0(0.1, -0.05, 0.02);
+  s.nodeVelocity.col(0) = v0;
+  StepWork w = makeStepWork(m);
+  const double dt = test::toyTimeStep(o.integrator);
+  while (s.time < 5.0) step(m, s, dt, relaxedActivations(), o, w);  // 20 time constants
+  const Eigen::Vector3d expected = v0 / m.gut.drag;
+  EXPECT_LT((s.nodePosition.col(0) - expected).norm(), 0.005 * expected.norm()) << s.nodePosition.col(0).transpose();
+  EXPECT_LT(s.nodeVelocity.col(0).norm(), 1e-6 * v0.norm());
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, Integrators,

@@ -55,6 +55,13 @@ TEST(Breathing, CalmTidalVolumeAndRate) {
   expectPassed(breathStyleChecks(runs({"calm"})), {"calm.tidal_volume", "calm.rate"});
 }
 
+// quiet expiration is a damped recoil: the lung volume falls without bouncing back once the diaphragm
+// relaxes (the visceral drag, Gut::drag, damps the gut's bounce: 122 mL without it)
+TEST(Breathing, CalmExpirationFallsWithoutRebound) {
+  REQUIRE_DEFAULT_MODEL();
+  expectPassed(breathStyleChecks(runs({"calm"})), {"calm.expiration_rebound"});
+}
+
 // Table 2 slow/deep: 12 b/m; tidal volume above calm and within 1-3 L
 TEST(Breathing, DeepLargerThanCalmWithinHumanRange) {
   REQUIRE_DEFAULT_MODEL();

@@ -100,6 +100,7 @@ struct Gains {
   double referenceLength = 0.0;  ///< [m] element length at which the group gains apply unscaled
   std::array<GroupGains, sim::kElementGroupCount> group{};  ///< indexed by sim::ElementGroup
   double gutKappa = 0.0;              ///< [Pa] bulk modulus of Eq. 4
+  double gutDrag = 0.0;               ///< [1/s] visceral drag rate beta (sim::Gut::drag)
   double costovertebralFriction = 0.0;  ///< [N m s/rad] mu of Eq. 3
   double costovertebralStiffness = 0.0; ///< [N m/rad]
   double spineFriction = 0.0;           ///< [N m s/rad]

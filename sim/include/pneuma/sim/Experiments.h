@@ -76,8 +76,8 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
 
 /// Checks of Section 8.1, Table 2 and Figures 4-6 on runs named "calm", "deep", "panting" and
 /// "forced-exhale" (checks whose runs are missing are left out): gut volume error < 2 % in every style;
-/// calm tidal volume 500 +/- 50 mL at 15 +/- 0.5 b/m; deep above calm, 0.6-3 L, 12 +/- 0.5 b/m; panting
-/// 60 +/- 1 b/m, below calm, chest-dominant (the ratio of the xiphoid's to the umbilicus's anterior-posterior
+/// calm tidal volume 500 +/- 50 mL at 15 +/- 0.5 b/m, its exhales without a rebound above 10 mL
+/// (expirationRebound()); deep above calm, 0.6-3 L, 12 +/- 0.5 b/m; panting 60 +/- 1 b/m, below calm, chest-dominant (the ratio of the xiphoid's to the umbilicus's anterior-posterior
 /// excursion, the motion seen from the side as in Fig. 5, above calm's); forced exhale
 /// below calm end-expiration, umbilicus >= 1 cm posterior, xiphoid down.
 std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
@@ -89,6 +89,11 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 /// (< 0: the spine moves backward). Measured during the inhale rather than at peak volume because the
 /// friction torque of Eq. 3 follows the ribs' angular velocity and vanishes when they stop.
 double spineSway(const StyleRun& run);
+
+/// [m^3] the largest bounce of the lung volume during an exhale: over the controller's exhale windows
+/// [settle + (k + inhaleFraction) T, settle + (k + 1) T) of the full cycles after settling, from the window's
+/// highest volume on, the largest rise of the volume above its running minimum (0 for a monotone fall).
+double expirationRebound(const StyleRun& run);
 
 /// Section 5: with friction the spine moves backward on a deep inhale (sway < -0.1 mm), and without
 /// friction by less than half as much.

@@ -105,6 +105,10 @@ struct Nodes {
 struct Gut {
   Eigen::Matrix3Xi triangles;   ///< node indices, counter-clockwise seen from outside (outward normals) (3 x #F)
   double kappa = 0.0;           ///< [Pa] bulk "volumetric" modulus of Eq. 4
+  /// [1/s] beta of the visceral drag f_n = -beta m_n v_n on every free node: the viscosity of the viscera and
+  /// abdominal tissue, which the paper's model lacks (our addition, docs/model-format.md). Without it the
+  /// gut and the relaxing diaphragm bounce at the end of each inhale (calm: a 120 mL rebound). >= 0.
+  double drag = 0.0;
 };
 
 /// Spring elements: muscles (Eq. 2) and structural springs (cartilage).

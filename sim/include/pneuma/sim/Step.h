@@ -2,7 +2,7 @@
 /// @file Step.h
 /// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step):
 ///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3),
-///                  passive spine stiffness, gravity
+///                  passive spine stiffness, visceral drag (Gut::drag), gravity
 ///   2. integrate   velocities and positions with the chosen integrator
 ///   3. joints      ball-joint constraints: velocity impulses, then position projection (error < 0.1 mm)
 /// Metrics are computed separately, at the output rate (computeMetrics()).
@@ -21,7 +21,7 @@
 ///   and across each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx; kept
 ///   while the gut is over-full and Eq. 5's force is 0, so a step that compresses the gut meets the pressure
 ///   it raises: without it a suddenly contracting rectus squeezed the gut by 10 % in one step at dt 20 ms)
-///   and the spine joint springs; D holds element damping and joint friction.
+///   and the spine joint springs; D holds element damping, joint friction and the visceral drag beta M.
 ///   Why this one: the stiff parts of the model (cartilage, the gut's near-incompressibility kappa, joint
 ///   friction on 10-25 g ribs) are linear or nearly so, so backward Euler removes their step limit at the
 ///   cost of a few CG passes that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so
@@ -31,8 +31,8 @@
 ///   com: friction only dissipates (tested at 150 N m s/rad, 10x the calibrated mu) and the result does
 ///   not depend on dt (deep breathing: 921 / 919 / 924 mL at dt 10 / 5 / 2 ms). An earlier variant that
 ///   solved in the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
-///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 10 ms
-///   (docs/cli.md "Performance" has the accuracy by dt).
+///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 1/60 s,
+///   one step per 60 Hz frame (docs/cli.md "Performance" has the accuracy by dt).
 /// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
 /// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
 /// mass-weighted projection removes the position drift.
