@@ -24,6 +24,14 @@ double niceStep(double range, int n) {
   return 10.0 * p;
 }
 
+// tick step for the range [lo, hi]: about n ticks, but at least two labelled ones (a range of 1.7 L over
+// three ticks rounds up to 1 L steps, which label one value only)
+double tickStep(double lo, double hi, int n) {
+  double step = niceStep(hi - lo, n);
+  for (int k = n + 1; std::floor(hi / step) - std::ceil(lo / step) < 1.0 && k <= 8 * n; ++k) step = niceStep(hi - lo, k);
+  return step;
+}
+
 QString tickText(double v, double step) {
   const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
   return QString::number(std::abs(v) < step * 1e-6 ? 0.0 : v, 'f', decimals);
@@ -194,7 +202,7 @@ void PlotView::paintEvent(QPaintEvent*) {
   // grid and tick labels
   p.setPen(QColor(200, 200, 208));
   p.drawRect(area);
-  const double yStep = niceStep(yMax - yMin, std::max(2, area.height() / (2 * lineH)));
+  const double yStep = tickStep(yMin, yMax, std::max(2, area.height() / (2 * lineH)));
   for (double y = std::ceil(yMin / yStep) * yStep; y <= yMax; y += yStep) {
     p.setPen(QColor(228, 228, 234));
     p.drawLine(QPointF(area.left(), py(y)), QPointF(area.right(), py(y)));
