@@ -262,6 +262,7 @@ void MainWindow::buildActions() {
   m_affectCombo->setToolTip("Respiration pattern of an affective state (de Melo et al. 2010)");
   const std::string resources = QFileInfo(QString::fromStdString(sim::defaultPresetDir())).path().toStdString();
   for (const std::string& a : sim::pattern::listAffects(resources)) m_affectCombo->addItem(QString::fromStdString(a));
+  m_affectCombo->setCurrentText("neutral");  // nothing is pushed yet: offer neutral, not the first in the list (anger)
   tools->addWidget(m_affectCombo);
   m_affectMode = new QComboBox(this);
   m_affectMode->addItems({"at end of cycle", "immediately"});

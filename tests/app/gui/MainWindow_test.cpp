@@ -9,6 +9,7 @@
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
 
+#include <QComboBox>
 #include <QFile>
 #include <QLineEdit>
 #include <QSvgRenderer>
@@ -318,6 +319,14 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
 // the pattern drive calibrates on a model whose muscles raise the lung volume: the default model (the toy
 // torso's volume only sinks during the calibration staircase, which the drive refuses)
 TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
+  // before anything is pushed the affect selector offers neutral, not the first name in the list
+  int selectors = 0;
+  for (const QComboBox* c : window.findChildren<QComboBox*>())
+    if (c->toolTip().contains("affective state")) {
+      ++selectors;
+      EXPECT_EQ(c->currentText(), "neutral");
+    }
+  EXPECT_EQ(selectors, 1);
   // an unknown name is refused with the valid ones; the known one is pushed
   const QString error = window.pushAffect("pnic", true);
   EXPECT_TRUE(error.contains("unknown affect 'pnic'")) << error.toStdString();
