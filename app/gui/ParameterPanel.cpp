@@ -53,6 +53,10 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
   addField("Joint friction \u03bc \u00d7", "-", "Scale of every joint's friction (Eq. 3)",
            [](const RunSettings& s) { return s.options.step.jointFrictionScale; },
            [](RunSettings& s, double v) { s.options.step.jointFrictionScale = v; });
+  addField("Visceral drag \u03b2 \u00d7", "-",
+           "Scale of the gut's visceral drag (model gut.drag); 0 lets the gut bounce after each inhale",
+           [](const RunSettings& s) { return s.options.step.gutDragScale; },
+           [](RunSettings& s, double v) { s.options.step.gutDragScale = v; });
   for (const Field& f : m_fields) {
     auto* label = new QLabel(f.edit->property("label").toString());
     label->setToolTip(f.edit->toolTip());

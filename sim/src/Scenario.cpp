@@ -67,7 +67,7 @@ void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
 }
 
 void parseOverrides(const Field& o, SimulationOptions& opt) {
-  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "joint_friction_scale", "kappa_pa",
+  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "joint_friction_scale", "gut_drag_scale", "kappa_pa",
                "active_gain_scale", "passive_gain_scale"});
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
@@ -78,6 +78,7 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").nonNegative();
   if (o.has("gravity")) opt.step.gravity = o.at("gravity").boolean();
   if (o.has("joint_friction_scale")) opt.step.jointFrictionScale = o.at("joint_friction_scale").nonNegative();
+  if (o.has("gut_drag_scale")) opt.step.gutDragScale = o.at("gut_drag_scale").nonNegative();
   if (o.has("kappa_pa")) opt.step.kappa = o.at("kappa_pa").positive();
   if (o.has("active_gain_scale")) parseGroupScales(o.at("active_gain_scale"), opt.step.activeGainScale);
   if (o.has("passive_gain_scale")) parseGroupScales(o.at("passive_gain_scale"), opt.step.passiveGainScale);
@@ -182,6 +183,7 @@ std::string serializeScenario(const Scenario& s) {
   o["settle_time_s"] = s.options.settleTime;
   o["gravity"] = st.gravity;
   o["joint_friction_scale"] = st.jointFrictionScale;
+  o["gut_drag_scale"] = st.gutDragScale;
   if (st.kappa > 0.0) o["kappa_pa"] = st.kappa;
   o["active_gain_scale"] = groupScalesJson(st.activeGainScale);
   o["passive_gain_scale"] = groupScalesJson(st.passiveGainScale);

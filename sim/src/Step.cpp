@@ -27,6 +27,8 @@ Matrix3d skew(const Vector3d& v) {
 }
 
 double effectiveKappa(const Model& model, const StepOptions& o) { return o.kappa >= 0.0 ? o.kappa : model.gut.kappa; }
+// [1/s] beta of the visceral drag
+double effectiveDrag(const Model& model, const StepOptions& o) { return model.gut.drag * o.gutDragScale; }
 
 // muscle parameters of element e under the group's activation and gain scales
 MuscleParams muscleParams(const Model& model, int e, const Activations& act, const StepOptions& o) {
@@ -287,8 +289,8 @@ void accumulateJointTorques(const Model& model, const State& s, const StepOption
 }
 
 // visceral drag on the free nodes: f = -beta m v (Gut::drag)
-void accumulateVisceralDrag(const Model& model, const State& s, StepWork& w) {
-  const double beta = model.gut.drag;
+void accumulateVisceralDrag(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
+  const double beta = effectiveDrag(model, o);
   if (beta == 0.0) return;
   for (int n = 0; n < model.nodes.size(); ++n)
     if (!model.nodes.isFixed(n)) w.nodeForce.col(n) -= beta * model.nodes.mass(n) * s.nodeVelocity.col(n);
@@ -441,8 +443,9 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
 
 // out = (M + dt D_drag) u (block diagonal: m I for translations, world inertia for rotations; the visceral
 // drag is mass-proportional, so it scales the node masses by 1 + dt beta, dt as packed by linearizeElements)
-void applyMass(const Model& model, const StepWork& w, const Eigen::VectorXd& u, Eigen::VectorXd& out) {
-  const double nodeScale = 1.0 + w.linearDScale * model.gut.drag;
+void applyMass(const Model& model, const StepOptions& o, const StepWork& w, const Eigen::VectorXd& u,
+               Eigen::VectorXd& out) {
+  const double nodeScale = 1.0 + w.linearDScale * effectiveDrag(model, o);
   for (int b = 0; b < model.bodies.size(); ++b) {
     const Matrix3d& r = w.rotation[at(b)];
     out.segment<3>(6 * b) = model.bodies.mass(b) * u.segment<3>(6 * b);
@@ -525,7 +528,7 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
 // coordinates (a diagonal block is passed whole); the sequence of (row, col) depends on the model's topology
 // only
 template <typename Sink>
-void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) {
+void streamSystem(const Model& model, const StepOptions& o, const StepWork& w, double dt, Sink&& add) {
   // bodies, where they can couple
   for (Eigen::Index i = 0; i < w.bodyEntries.cols(); ++i)
     add(w.bodyEntries(0, i), w.bodyEntries(1, i), w.bodyBlock.block<3, 3>(w.bodyEntries(0, i), w.bodyEntries(1, i)));
@@ -534,8 +537,9 @@ void streamSystem(const Model& model, const StepWork& w, double dt, Sink&& add) 
     add(w.couplingEntries(0, i), w.couplingEntries(1, i),
         w.bodyNodeBlock.block<3, 3>(w.couplingEntries(1, i), w.couplingEntries(2, i)).transpose());
   // node masses and the visceral drag, (1 + dt beta) m I
+  const double dragScale = 1.0 + dt * effectiveDrag(model, o);
   for (int n = 0; n < model.nodes.size(); ++n)
-    add(nodeOffset(model, n), nodeOffset(model, n), (1.0 + dt * model.gut.drag) * model.nodes.mass(n) * Matrix3d::Identity());
+    add(nodeOffset(model, n), nodeOffset(model, n), dragScale * model.nodes.mass(n) * Matrix3d::Identity());
   // elements between nodes: w_k w_l s_k s_l K_e for every pair of node terms of the two endpoints
   const Elements& el = model.elements;
   for (int e = 0; e < el.size(); ++e) {
@@ -636,7 +640,7 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     // every streamed block in free blocks, (-1, -1) when fixed or dependent (free coordinates come in whole
     // blocks: a node's three, a jointed body's rotation, a free body's translation and rotation)
     std::vector<std::array<int, 2>> blocks;
-    streamSystem(model, w, dt, [&](Eigen::Index r, Eigen::Index c, const auto&) {
+    streamSystem(model, o, w, dt, [&](Eigen::Index r, Eigen::Index c, const auto&) {
       const int fr = w.freeIndex(r), fc = w.freeIndex(c);
       blocks.push_back(fr >= 0 && fc >= 0 ? std::array<int, 2>{fr / 3, fc / 3} : std::array<int, 2>{-1, -1});
     });
@@ -654,7 +658,7 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
   assembleBodyBlocks(model, o, tree, w, dt);
   w.system.clearValues();
   std::size_t slot = 0;
-  streamSystem(model, w, dt, [&](Eigen::Index, Eigen::Index, const auto& block) {
+  streamSystem(model, o, w, dt, [&](Eigen::Index, Eigen::Index, const auto& block) {
     const int k = w.systemPattern[slot++];
     if (k >= 0) w.system.value(k) += block;
   });
@@ -701,7 +705,7 @@ void applySystem(const Model& model, const StepOptions& o, const StepWork& w, co
   t = u;
   expandJointVelocities(model.joints, w, tree, t);
   applyStiffnessDamping(model, o, w, t, out);
-  applyMass(model, w, t, z);
+  applyMass(model, o, w, t, z);
   out += z;
   gatherJointForces(model.joints, w, tree, out);
   maskReduced(model.joints, w, tree, out);
@@ -933,7 +937,7 @@ void computeForces(const Model& model, const State& s, const Activations& act, c
   accumulateElementForces(model, s, act, o, w);
   accumulateGutPressure(model, s, o, w);
   accumulateJointTorques(model, s, o, w);
-  accumulateVisceralDrag(model, s, w);
+  accumulateVisceralDrag(model, s, o, w);
   accumulateGravityAndGyroscopic(model, s, o, w);
 }
 
@@ -974,6 +978,8 @@ void validateStepOptions(const StepOptions& o) {
   };
   if (!std::isfinite(o.jointFrictionScale) || o.jointFrictionScale < 0.0)
     fail("jointFrictionScale", o.jointFrictionScale, "must be finite and >= 0");
+  if (!std::isfinite(o.gutDragScale) || o.gutDragScale < 0.0)
+    fail("gutDragScale", o.gutDragScale, "must be finite and >= 0");
   if (!std::isfinite(o.kappa)) fail("kappa", o.kappa, "must be finite (< 0 selects the model's value)");
   for (int g = 0; g < kElementGroupCount; ++g) {
     const std::string name = groupName(static_cast<ElementGroup>(g));

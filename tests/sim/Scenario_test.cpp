@@ -61,7 +61,7 @@ TEST(Scenario, RelativePathsResolveAgainstTheScenarioDirectory) {
 TEST(Scenario, OverridesReachTheSimulationOptions) {
   const Scenario s = parseScenario(
       with(R"("overrides": {"integrator": "symplectic-euler", "dt_s": 0.0002, "settle_time_s": 0.5, "gravity": false,
-              "joint_friction_scale": 0, "kappa_pa": 40000, "active_gain_scale": {"rectus": 1.5},
+              "joint_friction_scale": 0, "gut_drag_scale": 0.5, "kappa_pa": 40000, "active_gain_scale": {"rectus": 1.5},
               "passive_gain_scale": {"cartilage": 2}}, "outputs": {"output_rate_hz": 25, "vtk": true})"),
       "o.json", "");
   EXPECT_EQ(s.options.step.integrator, IntegratorKind::SymplecticEuler);
@@ -69,6 +69,7 @@ TEST(Scenario, OverridesReachTheSimulationOptions) {
   EXPECT_EQ(s.options.settleTime, 0.5);
   EXPECT_FALSE(s.options.step.gravity);
   EXPECT_EQ(s.options.step.jointFrictionScale, 0.0);
+  EXPECT_EQ(s.options.step.gutDragScale, 0.5);
   EXPECT_EQ(s.options.step.kappa, 40000.0);
   EXPECT_EQ(s.options.step.activeGainScale[static_cast<int>(ElementGroup::Rectus)], 1.5);
   EXPECT_EQ(s.options.step.activeGainScale[static_cast<int>(ElementGroup::Diaphragm)], 1.0);

@@ -48,6 +48,9 @@ TEST(SimulationInput, RejectsBadOptionsBeforeRunning) {
   o = {};
   o.settleTime = std::nan("");
   expectError([&] { Simulation(toy(), calm(), o); }, "settleTime");
+  o = {};
+  o.step.gutDragScale = -0.5;
+  expectError([&] { Simulation(toy(), calm(), o); }, "gutDragScale");
 }
 
 // a controller may cap the default time step (the pattern drive's 10 ms); an explicit dt still wins, and a

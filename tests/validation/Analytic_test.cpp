@@ -123,25 +123,30 @@ TEST_P(Integrators, PressurisedSpringSphereReachesEquilibriumRadius) {
   EXPECT_GT(expected, 1.01 * restScale * r0);
 }
 
-// a free node launched at v0 under the visceral drag alone (m dv/dt = -beta m v) stops after v0 / beta
+// a free node launched at v0 under the visceral drag alone (m dv/dt = -beta m v) stops after v0 / beta, with
+// beta = gut.drag times StepOptions::gutDragScale
 TEST_P(Integrators, VisceralDragStopsAFreeNodeAfterItsAnalyticDistance) {
   Model m;
   m.nodes.rest = Eigen::Matrix3Xd::Zero(3, 1);
   m.nodes.mass = Eigen::VectorXd::Constant(1, 0.05);
   m.nodes.region = {NodeRegion::Wall};
   m.gut.drag = 4.0;
-  StepOptions o;
-  o.integrator = GetParam();
-  o.gravity = false;
-  State s = makeInitialState(m);
-  const Eigen::Vector3d v0(0.1, -0.05, 0.02);
-  s.nodeVelocity.col(0) = v0;
-  StepWork w = makeStepWork(m);
-  const double dt = test::toyTimeStep(o.integrator);
-  while (s.time < 5.0) step(m, s, dt, relaxedActivations(), o, w);  // 20 time constants
-  const Eigen::Vector3d expected = v0 / m.gut.drag;
-  EXPECT_LT((s.nodePosition.col(0) - expected).norm(), 0.005 * expected.norm()) << s.nodePosition.col(0).transpose();
-  EXPECT_LT(s.nodeVelocity.col(0).norm(), 1e-6 * v0.norm());
+  for (const double scale : {1.0, 2.0}) {
+    StepOptions o;
+    o.integrator = GetParam();
+    o.gravity = false;
+    o.gutDragScale = scale;
+    State s = makeInitialState(m);
+    const Eigen::Vector3d v0(0.1, -0.05, 0.02);
+    s.nodeVelocity.col(0) = v0;
+    StepWork w = makeStepWork(m);
+    const double dt = test::toyTimeStep(o.integrator);
+    while (s.time < 5.0) step(m, s, dt, relaxedActivations(), o, w);  // at least 20 time constants
+    const Eigen::Vector3d expected = v0 / (m.gut.drag * scale);
+    EXPECT_LT((s.nodePosition.col(0) - expected).norm(), 0.005 * expected.norm())
+        << "scale " << scale << ": " << s.nodePosition.col(0).transpose();
+    EXPECT_LT(s.nodeVelocity.col(0).norm(), 1e-6 * v0.norm());
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, Integrators,

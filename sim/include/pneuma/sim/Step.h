@@ -90,6 +90,7 @@ struct StepOptions {
   IntegratorKind integrator = IntegratorKind::ImplicitEulerJoints;
   bool gravity = true;                ///< apply Model::gravity to bodies and nodes
   double jointFrictionScale = 1.0;    ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
+  double gutDragScale = 1.0;          ///< [-] multiplies the visceral drag Model::gut.drag; 0 = none
   double kappa = -1.0;                ///< [Pa] gut bulk modulus of Eq. 4; < 0 uses Model::gut.kappa
   std::array<double, kElementGroupCount> activeGainScale{1, 1, 1, 1, 1, 1};   ///< [-] multiplies kac per group
   std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kpe and b per group
