@@ -6,6 +6,7 @@
 #include <vtkAxesActor.h>
 #include <vtkCamera.h>
 #include <vtkCaptionActor2D.h>
+#include <vtkCoordinate.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkCellPicker.h>
@@ -373,9 +374,19 @@ struct ModelScene::Impl {
       Label label{makeLabel(name), static_cast<int>(l), -1, -1};
       labels.push_back(label);
     }
-    for (int gi = 0; gi < kGroups; ++gi)
-      if (!groups[static_cast<std::size_t>(gi)].element.empty())
-        labels.push_back(Label{makeLabel(groupLabel(static_cast<sim::ElementGroup>(gi))), -1, gi, -1});
+    // group captions: a fixed column at the lower left of the view (above the orientation axes, below the
+    // landmarks' captions), one row per group, so that they never overlap;
+    // their leaders follow the groups
+    int row = 0;
+    for (int gi = 0; gi < kGroups; ++gi) {
+      if (groups[static_cast<std::size_t>(gi)].element.empty()) continue;
+      auto caption = makeLabel(groupLabel(static_cast<sim::ElementGroup>(gi)));
+      vtkCoordinate* at = caption->GetPositionCoordinate();
+      at->SetReferenceCoordinate(nullptr);
+      at->SetCoordinateSystemToNormalizedViewport();
+      at->SetValue(0.015, 0.44 - 0.055 * row++);
+      labels.push_back(Label{caption, -1, gi, -1});
+    }
     for (int b = 0; b < model.bodies.size(); ++b) {
       const std::string& name = model.bodies.name[static_cast<std::size_t>(b)];
       if (name == "sternum") labels.push_back(Label{makeLabel(name), -1, -1, b});
@@ -583,10 +594,9 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
       }
     }
     l.actor->SetAttachmentPoint(at.x(), at.y(), at.z());
-    // captions beside their point: the subject's right (x > 0) to one side, the rest to the other;
-    // group captions stacked by group so that neighbours do not overlap
-    if (l.group >= 0) l.actor->SetPosition(-165.0, 60.0 - 30.0 * l.group);
-    else l.actor->SetPosition(at.x() > 0.01 ? -150.0 : 40.0, 14.0);
+    // landmark and bone captions beside their point: the subject's right (x > 0) to one side, the rest to the
+    // other (group captions sit in their fixed column)
+    if (l.group < 0) l.actor->SetPosition(at.x() > 0.01 ? -150.0 : 40.0, 14.0);
   }
 
   // selection highlight

@@ -15,8 +15,13 @@
 #include <QSvgRenderer>
 #include <QTextStream>
 #include <gtest/gtest.h>
+#include <vtkCaptionActor2D.h>
+#include <vtkCoordinate.h>
+#include <vtkPropCollection.h>
+#include <vtkRenderer.h>
 
 #include <cmath>
+#include <set>
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -318,6 +323,47 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
 
 // the pattern drive calibrates on a model whose muscles raise the lung volume: the default model (the toy
 // torso's volume only sinks during the calibration staircase, which the drive refuses)
+// the teaching view: no muscle group's caption covers another caption, from any camera preset
+TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
+  const std::set<std::string> groupNames = {"External intercostals", "Internal intercostals", "Diaphragm",
+                                            "Rectus abdominis", "Transversus / obliques", "Costal cartilage"};
+  viz::DisplayOptions o = window.scene().options();
+  o.showLabels = true;
+  o.showLandmarks = true;
+  window.setDisplayOptions(o);
+  vtkRenderer* renderer = window.scene().renderer();
+  for (const viz::CameraPreset preset : {viz::CameraPreset::Anterior, viz::CameraPreset::Lateral,
+                                         viz::CameraPreset::Superior, viz::CameraPreset::Oblique}) {
+    window.scene().setCamera(preset);
+    window.grabView();  // renders
+    struct Box {
+      std::string text;
+      QRectF rect;  // [px] display coordinates
+    };
+    std::vector<Box> boxes;
+    vtkPropCollection* props = renderer->GetViewProps();
+    props->InitTraversal();
+    while (vtkProp* prop = props->GetNextProp()) {
+      auto* caption = vtkCaptionActor2D::SafeDownCast(prop);
+      if (caption == nullptr || !caption->GetVisibility()) continue;
+      const int* a = caption->GetPositionCoordinate()->GetComputedDisplayValue(renderer);
+      const int* b = caption->GetPosition2Coordinate()->GetComputedDisplayValue(renderer);
+      boxes.push_back({caption->GetCaption(), QRectF(QPointF(a[0], a[1]), QPointF(b[0], b[1])).normalized()});
+    }
+    int groups = 0;
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      if (groupNames.count(boxes[i].text) == 0) continue;
+      ++groups;
+      for (std::size_t j = 0; j < boxes.size(); ++j) {
+        if (j == i) continue;
+        EXPECT_FALSE(boxes[i].rect.intersects(boxes[j].rect))
+            << "camera " << static_cast<int>(preset) << ": '" << boxes[i].text << "' covers '" << boxes[j].text << "'";
+      }
+    }
+    EXPECT_EQ(groups, 6);
+  }
+}
+
 TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   // before anything is pushed the affect selector offers neutral, not the first name in the list
   int selectors = 0;
