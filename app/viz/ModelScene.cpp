@@ -6,11 +6,11 @@
 #include <vtkAxesActor.h>
 #include <vtkCamera.h>
 #include <vtkCaptionActor2D.h>
-#include <vtkCoordinate.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkCellPicker.h>
 #include <vtkColorTransferFunction.h>
+#include <vtkCoordinate.h>
 #include <vtkFloatArray.h>
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
@@ -375,8 +375,7 @@ struct ModelScene::Impl {
       labels.push_back(label);
     }
     // group captions: a fixed column at the lower left of the view (above the orientation axes, below the
-    // landmarks' captions), one row per group, so that they never overlap;
-    // their leaders follow the groups
+    // landmarks' captions), one row per group, so that they never overlap; their leaders follow the groups
     int row = 0;
     for (int gi = 0; gi < kGroups; ++gi) {
       if (groups[static_cast<std::size_t>(gi)].element.empty()) continue;

@@ -321,8 +321,6 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
   EXPECT_NE(w.window.exportRun("/proc/pneuma-no-such-dir/run.pvd"), QString());
 }
 
-// the pattern drive calibrates on a model whose muscles raise the lung volume: the default model (the toy
-// torso's volume only sinks during the calibration staircase, which the drive refuses)
 // the teaching view: no muscle group's caption covers another caption, from any camera preset
 TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
   const std::set<std::string> groupNames = {"External intercostals", "Internal intercostals", "Diaphragm",
@@ -364,6 +362,8 @@ TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
   }
 }
 
+// the pattern drive calibrates on a model whose muscles raise the lung volume: the default model (the toy
+// torso's volume only sinks during the calibration staircase, which the drive refuses)
 TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   // before anything is pushed the affect selector offers neutral, not the first name in the list
   int selectors = 0;
