@@ -3,7 +3,10 @@
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
 /// resources, preparing output directories, number formatting for JSON/CSV.
 
+#include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Step.h"
+
+#include <nlohmann/json.hpp>
 
 #include <string>
 
@@ -46,5 +49,12 @@ void prepareOutputDir(const std::string& dir);
 
 /// Shortest round-trip text of a double for CSV/JSON ("%.9g"); "nan" never appears: non-finite gives "".
 std::string formatNumber(double v);
+
+/// A JSON number, or null when `v` is not finite.
+nlohmann::json jsonNumber(double v);
+
+/// Writes the motion figures into `j` at the edges' units: mm, mL, degrees, % (the keys of docs/cli.md, e.g.
+/// "dome_descent_mm", "rib_cage_fraction", "rc_ab_phase_deg"); a missing figure is null.
+void writeMotion(const sim::Motion& m, nlohmann::json& j);
 
 }  // namespace pneuma::app

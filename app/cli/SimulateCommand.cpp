@@ -93,9 +93,6 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   return s;
 }
 
-/// A JSON number, or null when not finite.
-nlohmann::json jsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 void runSimulate(const SimulateArgs& args) {
   const sim::Scenario scenario = scenarioFromArgs(args);
   const std::string modelDir =
@@ -190,9 +187,7 @@ void runSimulate(const SimulateArgs& args) {
   j["end_inspiratory_volume_ml"] = jsonNumber(sum.endInspiratoryVolume * 1e6);
   j["max_gut_volume_error_pct"] = jsonNumber(sum.maxGutVolumeError * 100.0);
   j["mean_gut_volume_error_pct"] = jsonNumber(sum.meanGutVolumeError * 100.0);
-  j["diaphragm_apex_excursion_mm"] = jsonNumber(sum.diaphragmApexExcursion * 1e3);
-  j["xiphoid_excursion_mm"] = jsonNumber(sum.xiphoidExcursion * 1e3);
-  j["umbilicus_excursion_mm"] = jsonNumber(sum.umbilicusExcursion * 1e3);
+  writeMotion(sum.motion, j);
   const auto* pattern = dynamic_cast<const sim::pattern::PatternController*>(&simulation->controller());
   j["tracking_rms_pct"] = pattern != nullptr ? jsonNumber(pattern->tracking().rmsPercentOfPeakToPeak()) : nlohmann::json(nullptr);
   j["measured_from_s"] = sum.measuredFrom;

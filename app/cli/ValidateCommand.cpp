@@ -202,11 +202,14 @@ void runValidate(const ValidateArgs& args) {
                            {"unit", c.unit}, {"lower", std::isfinite(c.lower) ? nlohmann::json(c.lower) : nlohmann::json(nullptr)},
                            {"upper", std::isfinite(c.upper) ? nlohmann::json(c.upper) : nlohmann::json(nullptr)},
                            {"passed", c.isPassed()}, {"source", c.source}});
-  for (const sim::StyleRun& r : runs)
-    j["styles"][r.style.name] = {{"tidal_volume_ml", r.summary.tidalVolume * 1e6}, {"breaths_per_minute", r.summary.breathsPerMinute},
-                                 {"end_expiratory_volume_ml", r.summary.endExpiratoryVolume * 1e6},
-                                 {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
-                                 {"real_time_factor", r.summary.realTimeFactor}};
+  for (const sim::StyleRun& r : runs) {
+    nlohmann::json& style = j["styles"][r.style.name];
+    style = {{"tidal_volume_ml", r.summary.tidalVolume * 1e6}, {"breaths_per_minute", r.summary.breathsPerMinute},
+             {"end_expiratory_volume_ml", r.summary.endExpiratoryVolume * 1e6},
+             {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
+             {"real_time_factor", r.summary.realTimeFactor}};
+    writeMotion(r.summary.motion, style);
+  }
   for (const Figure& f : figures) j["figures"].push_back(f.stem + ".png");
   viz::writeFileAtomically(args.out + "/report.json", j.dump(2) + "\n");
 

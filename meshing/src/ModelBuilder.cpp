@@ -118,6 +118,7 @@ void buildLandmarks(const AnatomyParams& a, const Skeleton& sk, const GutSurface
     addEndpoint(m.landmarks.points, e, m.bodies);
   };
   add("xiphoid", Endpoint::onBody(sk.sternum, sk.xiphoidTip));
+  add("jugular_notch", Endpoint::onBody(sk.sternum, sk.jugularNotch));
   // umbilicus: the anterior midline wall node nearest the preset's umbilicus height
   int navel = g.wallRing.front().front();
   for (const auto& ring : g.wallRing) {

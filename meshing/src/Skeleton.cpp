@@ -258,6 +258,7 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     }
     sk.sternum = addBone("sternum", false, sweepTube(st, kAround, false));
     sk.xiphoidTip = notch + total * sk.sternumAxis;
+    sk.jugularNotch = notch;
     // costal notches: rib 1 on the manubrium, rib 2 at the sternal angle, 3-6 along the body, 7 at the xiphisternal joint
     for (int r = 1; r <= 7; ++r) {
       const double d = r == 1 ? 0.35 * s.manubriumLength

@@ -10,12 +10,15 @@ namespace pneuma::sim {
 double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles) {
   // tetrahedra from the vertex centroid to each face (exact for a closed surface; the centroid only
   // reduces round-off)
-  const Eigen::Vector3d c = x.rowwise().mean();
+  return coneVolume(x, triangles, x.rowwise().mean());
+}
+
+double coneVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, const Eigen::Vector3d& origin) {
   double sixV = 0.0;
   for (Eigen::Index f = 0; f < triangles.cols(); ++f) {
-    const Eigen::Vector3d a = x.col(triangles(0, f)) - c;
-    const Eigen::Vector3d b = x.col(triangles(1, f)) - c;
-    const Eigen::Vector3d e = x.col(triangles(2, f)) - c;
+    const Eigen::Vector3d a = x.col(triangles(0, f)) - origin;
+    const Eigen::Vector3d b = x.col(triangles(1, f)) - origin;
+    const Eigen::Vector3d e = x.col(triangles(2, f)) - origin;
     sixV += a.dot(b.cross(e));
   }
   return sixV / 6.0;

@@ -1002,6 +1002,15 @@ StepWork makeStepWork(const Model& model) {
   const int nb = model.bodies.size(), nn = model.nodes.size(), ne = model.elements.size(), nj = model.joints.size();
   w.restGutVolume = model.gut.triangles.cols() > 0 ? enclosedVolume(model.nodes.rest, model.gut.triangles) : 0.0;
   w.gutVolume = w.restGutVolume;
+  if (model.nodes.size() > 0) w.restGutCentroid = model.nodes.rest.rowwise().mean();
+  std::vector<int> wall;
+  for (Eigen::Index f = 0; f < model.gut.triangles.cols(); ++f) {
+    int count = 0;
+    for (int k = 0; k < 3; ++k) count += model.nodes.region[at(model.gut.triangles(k, f))] == NodeRegion::Wall ? 1 : 0;
+    if (count >= 2) wall.push_back(static_cast<int>(f));
+  }
+  w.wallTriangles.resize(3, static_cast<Eigen::Index>(wall.size()));
+  for (std::size_t i = 0; i < wall.size(); ++i) w.wallTriangles.col(static_cast<Eigen::Index>(i)) = model.gut.triangles.col(wall[i]);
   w.elementForce = Eigen::VectorXd::Zero(ne);
   w.elementLength = Eigen::VectorXd::Zero(ne);
   w.elementDirection = Eigen::Matrix3Xd::Zero(3, ne);
@@ -1131,6 +1140,7 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   out.gutVolumeError = work.restGutVolume > 0.0 ? (out.gutVolume - work.restGutVolume) / work.restGutVolume : 0.0;
   const double kappa = effectiveKappa(model, options);
   out.gutPressure = work.restGutVolume > 0.0 ? gutPressure(kappa, work.restGutVolume, out.gutVolume) : 0.0;
+  out.abdomenVolume = coneVolume(state.nodePosition, work.wallTriangles, work.restGutCentroid);
 
   // element forces of the last step, slack state and group tensions
   const Elements& el = model.elements;

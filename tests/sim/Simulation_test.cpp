@@ -196,7 +196,8 @@ TEST(Summary, CycleAnalysisOfASine) {
     m.time = i * 0.01;
     m.lungVolume = 3e-3 + 2.5e-4 * std::sin(2 * kPi * 0.25 * m.time);
     m.gutVolumeError = 0.001 * std::cos(m.time);
-    m.landmarks(2, 0) = 0.004 * std::sin(2 * kPi * 0.25 * m.time);
+    m.landmarks(2, 0) = -0.004 * std::sin(2 * kPi * 0.25 * m.time);  // the dome descends as the volume rises
+    m.abdomenVolume = 1e-4 * std::sin(2 * kPi * 0.25 * m.time + kPi / 9.0);  // leads by 20 degrees
     t.append(m);
   }
   const Summary s = summarize(t, {"diaphragm_apex"}, 2.0);
@@ -204,8 +205,17 @@ TEST(Summary, CycleAnalysisOfASine) {
   EXPECT_NEAR(s.breathsPerMinute, 15.0, 1e-3);
   EXPECT_NEAR(s.endExpiratoryVolume, 2.75e-3, 1e-7);
   EXPECT_NEAR(s.maxGutVolumeError, 0.001, 1e-6);
-  EXPECT_NEAR(s.diaphragmApexExcursion, 0.008, 1e-6);
   EXPECT_GE(s.cycles, 6);
+  // motion: end-inspiration (phase pi/2) minus end-expiration (3 pi/2)
+  EXPECT_NEAR(s.motion.domeDescent, 0.008, 1e-6);
+  EXPECT_NEAR(s.motion.abdomenTidal, 2e-4 * std::cos(kPi / 9.0), 1e-7);
+  EXPECT_NEAR(s.motion.ribCageTidal, 5e-4 - s.motion.abdomenTidal, 1e-9);
+  EXPECT_TRUE(std::isnan(s.motion.xiphoidAnterior));  // no such landmark
+  // the rib-cage signal 2.5 sin(wt) - 1.0 sin(wt + 20 deg) has phase atan2(-sin 20, 2.5 - cos 20) = -13.3 degrees
+  const double rcPhase = std::atan2(-std::sin(kPi / 9.0), 2.5 - std::cos(kPi / 9.0));
+  EXPECT_NEAR(s.motion.phaseAngle, kPi / 9.0 - rcPhase, 2e-3);
+  EXPECT_NEAR(s.motion.flowSignChanges, 2.0, 1e-9);
+  EXPECT_LT(s.motion.maxFlowJump, 0.05);  // 100 frames per cycle: a smooth flow
 }
 
 // same inputs -> bit-identical recordings (STYLE: deterministic)

@@ -62,6 +62,13 @@ inline double springEnergy(double l, double restLength, double k) {
 /// @param x  3 x #V vertex positions [m];  @param triangles 3 x #F vertex indices.
 double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles);
 
+/// Volume [m^3] of the cone from `origin` over the faces `triangles` (an open patch allowed):
+///   V = sum_f (a - o) . ((b - o) x (e - o)) / 6.
+/// For a closed surface it is enclosedVolume() for any origin; for a patch whose rim hardly moves, its change is
+/// the volume the patch sweeps (the abdominal wall's displacement of Konno & Mead 1967).
+/// @param x  3 x #V vertex positions [m];  @param triangles 3 x #F vertex indices;  @param origin [m].
+double coneVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, const Eigen::Vector3d& origin);
+
 /// Gut pressure, Eq. 4: P = kappa (V0 / V - 1) [Pa], with kappa [Pa], V0 and V [m^3].
 double gutPressure(double kappa, double restVolume, double volume);
 

@@ -9,10 +9,13 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace pneuma::sim {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Measurements at one output frame.
 struct Metrics {
@@ -21,6 +24,9 @@ struct Metrics {
   double gutVolume = 0.0;         ///< [m^3] gut volume V (sum of centroid -> face tetrahedra, Section 6.2)
   double gutVolumeError = 0.0;    ///< [-] signed relative error (V - V0) / V0
   double gutPressure = 0.0;       ///< [Pa] P = kappa (V0/V - 1), Eq. 4 (before clamping at 0)
+  /// [m^3] coneVolume() from the gut's rest centroid over its abdominal-wall faces (at least two Wall nodes): its
+  /// change is the volume the abdominal wall displaces, the abdomen compartment of Konno & Mead (1967)
+  double abdomenVolume = 0.0;
   Eigen::VectorXd elementForce;   ///< [N] signed scalar force per element, <= 0 is tension (#E)
   std::vector<std::uint8_t> isSlack;  ///< 1 when a muscle element carries no force (#E)
   std::array<double, kElementGroupCount> groupTension{};  ///< [N] sum of max(0, -F) over each group
@@ -37,12 +43,35 @@ struct Trace {
   std::vector<double> time;            ///< [s]
   std::vector<double> lungVolume;      ///< [m^3]
   std::vector<double> gutVolumeError;  ///< [-] signed
+  std::vector<double> abdomenVolume;   ///< [m^3] Metrics::abdomenVolume
   std::vector<Eigen::Matrix3Xd> landmarks;  ///< [m] (3 x #L) per frame
 
   /// Appends the scalar parts of one frame.
   void append(const Metrics& m);
   std::size_t size() const { return time.size(); }
   void clear();
+};
+
+/// How the body moves in a breath, in anatomical axes (world RAS: x lateral, y anteroposterior, z craniocaudal).
+/// Displacements are end-inspiration (the frame of a cycle's largest lung volume) minus end-expiration (its
+/// smallest), averaged over the full cycles; NaN when a landmark is missing or no cycle was found.
+struct Motion {
+  double domeDescent = kNaN;         ///< [m] caudal motion of "diaphragm_apex" (the central tendon), > 0 = down
+  double domeAnterior = kNaN;        ///< [m] its anterior motion (> 0 = forward)
+  double sternumAnterior = kNaN;     ///< [m] anterior motion of "jugular_notch" (top of the manubrium)
+  double sternumCranial = kNaN;      ///< [m] its cranial motion (> 0 = up)
+  double xiphoidAnterior = kNaN;     ///< [m] anterior motion of "xiphoid"
+  double xiphoidCranial = kNaN;      ///< [m] its cranial motion
+  double lowerRibExpansion = kNaN;   ///< [m] change of the distance between "rib8_lateral_left" and "_right"
+  double umbilicusAnterior = kNaN;   ///< [m] anterior motion of "umbilicus"
+  /// [m^3] abdomen's share of the tidal volume: the change of Metrics::abdomenVolume (Konno & Mead 1967)
+  double abdomenTidal = kNaN;
+  double ribCageTidal = kNaN;        ///< [m^3] the rest of the lung-volume change, tidal minus abdomenTidal
+  /// [rad] in [0, pi]: phase difference of the breath-frequency Fourier components of the rib-cage volume
+  /// (lung minus abdomen) and the abdomen volume over the full cycles; 0 = in phase, pi = paradoxical
+  double phaseAngle = kNaN;
+  double flowSignChanges = kNaN;     ///< [-] sign changes of the flow dV/dt (central differences) per cycle
+  double maxFlowJump = kNaN;         ///< [-] largest frame-to-frame change of dV/dt over the largest |dV/dt|
 };
 
 /// Figures over a run, measured after the settling phase.
@@ -54,9 +83,7 @@ struct Summary {
   int cycles = 0;                      ///< [-] number of full cycles found
   double maxGutVolumeError = 0.0;      ///< [-] max |(V - V0)/V0|
   double meanGutVolumeError = 0.0;     ///< [-] mean |(V - V0)/V0|
-  double diaphragmApexExcursion = 0.0; ///< [m] largest displacement range of the landmark (see landmarkExcursion)
-  double xiphoidExcursion = 0.0;       ///< [m]
-  double umbilicusExcursion = 0.0;     ///< [m]
+  Motion motion;                       ///< the breath's motion in anatomical axes (see Motion)
   double realTimeFactor = 0.0;         ///< [-] simulated seconds per wall-clock second (stepping only)
   long long steps = 0;                 ///< [-] steps taken in the whole run, settling included
   double dt = 0.0;                     ///< [s] time step
@@ -65,17 +92,15 @@ struct Summary {
 
 /// Analyses `trace` from time `from` [s] on: cycles are delimited by successive upward crossings of
 /// the mean lung volume (with a hysteresis of 25 % of the range); tidal volume is the mean
-/// per-cycle peak-to-peak, the rate is 60 / mean period. Excursions are
-/// landmarkExcursion() of "diaphragm_apex", "xiphoid" and "umbilicus" (0 when a name is missing).
-/// Fills the volume, rate, gut-error and excursion fields; the caller sets rtf, steps and dt.
+/// per-cycle peak-to-peak, the rate is 60 / mean period.
+/// Motion (see Motion) uses the landmarks "diaphragm_apex", "jugular_notch", "xiphoid", "rib8_lateral_left",
+/// "rib8_lateral_right" and "umbilicus".
+/// Fills the volume, rate, gut-error and motion fields; the caller sets rtf, steps and dt.
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from);
 
 /// Range [m] of landmark `index`'s x, y and z over frames with time >= `from`: max - min per coordinate
 /// (zero when the index or the frames are missing).
 Eigen::Vector3d landmarkRange(const Trace& trace, int index, double from);
 
-/// Excursion [m] of landmark `index` over frames with time >= `from`: the length of the range
-/// (max - min) along the axis of largest range, i.e. landmarkRange().maxCoeff().
-double landmarkExcursion(const Trace& trace, int index, double from);
 
 }  // namespace pneuma::sim

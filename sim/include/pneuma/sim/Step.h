@@ -114,6 +114,8 @@ void validateStepOptions(const StepOptions& o);
 /// step that metrics need. Make one per (Model, State) pair with makeStepWork().
 struct StepWork {
   double restGutVolume = 0.0;          ///< [m^3] V0, gut volume at the rest pose
+  Eigen::Vector3d restGutCentroid = Eigen::Vector3d::Zero();  ///< [m] centroid of the gut nodes at rest
+  Eigen::Matrix3Xi wallTriangles;      ///< gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
   double gutVolume = 0.0;              ///< [m^3] V at the start of the last step
   double gutPressure = 0.0;            ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
   Eigen::VectorXd elementForce;        ///< [N] scalar force per element of the last step (#E)
