@@ -1,26 +1,22 @@
 #include "pneuma/sim/pattern/Pattern.h"
 
-#include "../JsonField.h"
-
 #include "pneuma/sim/Error.h"
-
-#include <nlohmann/json.hpp>
+#include "pneuma/sim/JsonReader.h"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace pneuma::sim::pattern {
-
-using nlohmann::json;
 
 namespace {
 
 constexpr const char* kFormatName = "pneuma-pattern";
 
-using Node = sim::detail::JsonField;
+using Node = sim::JsonReader;
 
 CycleKind parseKind(const Node& n) {
   const std::string k = n.string();
@@ -85,7 +81,7 @@ Layer parseLayer(const Node& n) {
   Layer l;
   l.name = n.at("name").string();
   const Node repeat = n.at("repeat");
-  if (repeat.raw().is_string()) {
+  if (repeat.isString()) {
     if (repeat.string() != "infinite") repeat.fail("must be a count >= 1 or \"infinite\"");
     l.repetitions = kInfinite;
   } else {
@@ -139,21 +135,16 @@ std::vector<Layer> parseLayerSource(const Node& n, const std::string& resourceDi
 
 Pattern parseAt(const std::string& jsonText, const std::string& sourceName, const std::string& resourceDir,
                 int nesting) {
-  json j;
-  try {
-    j = json::parse(jsonText);
-  } catch (const json::parse_error& e) {
-    throw Error(sourceName + ": invalid JSON: " + e.what());
-  }
-  const Node root(j, "", sourceName);
+  const sim::JsonDocument doc = sim::JsonDocument::parse(jsonText, sourceName);
+  const Node root = doc.root();
   root.allowKeys({"format", "version", "name", "description", "layers", "affect", "timeline"});
 
   // header
   const Node format = root.at("format");
   if (format.string() != kFormatName) format.fail(std::string("must be \"") + kFormatName + "\"");
   const Node version = root.at("version");
-  if (version.number() != kPatternFormatVersion)
-    version.fail("unsupported version " + version.raw().dump() + " (this build reads " +
+  if (version.integerIn(0, std::numeric_limits<int>::max()) != kPatternFormatVersion)
+    version.fail("unsupported version " + version.excerpt() + " (this build reads " +
                  std::to_string(kPatternFormatVersion) + ")");
   Pattern p;
   p.name = root.at("name").string();
