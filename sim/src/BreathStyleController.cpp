@@ -40,7 +40,7 @@ double smoothRise(double t, double rise) {
 }  // namespace
 
 void validateBreathStyle(const BreathStyle& s) {
-  const std::string p = "breath style '" + s.name + "': ";
+  const std::string p = "breath style '" + excerptOf(s.name) + "': ";
   if (!std::isfinite(s.breathsPerMinute) || s.breathsPerMinute <= 0.0 || s.breathsPerMinute > 600.0)
     requireRange(p + "breaths_per_minute", s.breathsPerMinute, 0.0, 600.0, true);
   requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
@@ -129,7 +129,7 @@ BreathStyle loadBreathStyle(const std::string& nameOrPath, const std::string& pr
     if (isPath) throw Error("breath style file '" + path + "': cannot be read");
     std::string valid;
     for (const std::string& n : breathStyleNames(presetDir)) valid += (valid.empty() ? "" : ", ") + n;
-    throw Error("unknown breath style '" + nameOrPath + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
+    throw Error("unknown breath style '" + excerptOf(nameOrPath) + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
   }
   std::stringstream text;
   text << in.rdbuf();

@@ -14,18 +14,17 @@ namespace pneuma::sim {
 
 using nlohmann::json;
 
+std::string excerptOf(const std::string& s, std::size_t maxChars) {
+  if (s.size() <= maxChars) return s;
+  // back up to the first byte of a UTF-8 character
+  std::size_t n = maxChars > 3 ? maxChars - 3 : 0;
+  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+  return s.substr(0, n) + "...";
+}
+
 namespace {
 
 const json& node(const void* p) { return *static_cast<const json*>(p); }
-
-// cuts `s` to at most `maxChars` bytes at a UTF-8 character boundary, marking the cut with "..."
-std::string shorten(std::string s, std::size_t maxChars) {
-  if (s.size() <= maxChars) return s;
-  std::size_t n = maxChars > 3 ? maxChars - 3 : 0;
-  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
-  s.resize(n);
-  return s + "...";
-}
 
 std::string quoted(const std::string& s, std::size_t maxChars) {
   // dump a prefix only, so that a huge string costs no more than its excerpt
@@ -112,7 +111,7 @@ class ParsePosition {
     std::string p;
     for (const Frame& f : m_frames) {
       if (f.isArray) p += "[" + std::to_string(f.index) + "]";
-      else if (!f.key.empty() || !f.seen.empty()) p += (p.empty() ? "" : ".") + shorten(f.key, 60);
+      else if (!f.key.empty() || !f.seen.empty()) p += (p.empty() ? "" : ".") + excerptOf(f.key, 60);
     }
     return p.empty() ? "(root)" : p;
   }
@@ -147,7 +146,7 @@ std::string parseErrorText(const json::parse_error& e) {
     const std::size_t start = from + lastRead.size();
     const std::size_t end = what.find("'; ", start);
     const std::size_t len = (end == std::string::npos ? what.size() : end) - start;
-    what.replace(start, len, shorten(what.substr(start, len), 60));
+    what.replace(start, len, excerptOf(what.substr(start, len), 60));
   }
   return "invalid JSON" + what;
 }
@@ -180,11 +179,11 @@ JsonDocument JsonDocument::parse(const std::string& text, const std::string& sou
       const std::string what = e.what();
       const std::size_t q = what.find('\'');
       const std::string literal = q == std::string::npos ? "" : what.substr(q + 1, what.rfind('\'') - q - 1);
-      pos.fail("number " + shorten(literal, 60) + " is beyond the range of a double");
+      pos.fail("number " + excerptOf(literal, 60) + " is beyond the range of a double");
     }
-    pos.fail(std::string("invalid JSON: ") + shorten(e.what(), 120));
+    pos.fail(std::string("invalid JSON: ") + excerptOf(e.what(), 120));
   } catch (const json::exception& e) {
-    pos.fail(std::string("invalid JSON: ") + shorten(e.what(), 120));
+    pos.fail(std::string("invalid JSON: ") + excerptOf(e.what(), 120));
   }
   return JsonDocument(std::move(impl));
 }
@@ -218,7 +217,7 @@ void JsonReader::allowKeys(std::initializer_list<const char*> allowed) const {
       const std::size_t d = editDistance(it.key(), k);
       if (d < bestDistance) bestDistance = d, best = k;
     }
-    JsonReader(m_node, join(shorten(it.key(), 60)), m_source)
+    JsonReader(m_node, join(excerptOf(it.key(), 60)), m_source)
         .fail(best.empty() ? "unknown field" : "unknown field (did you mean " + best + "?)");
   }
 }
@@ -241,7 +240,7 @@ JsonReader JsonReader::at(const std::string& key) const {
   if (!j.is_object()) fail("must be an object, got " + excerpt());
   auto it = j.find(key);
   if (it == j.end()) JsonReader(m_node, join(key), m_source).fail("missing");
-  return JsonReader(&*it, join(key), m_source);
+  return JsonReader(&*it, join(excerptOf(key)), m_source);
 }
 
 std::size_t JsonReader::size() const {
@@ -355,7 +354,7 @@ std::string JsonReader::dump(int indent) const {
 std::string JsonReader::excerpt(std::size_t maxChars) const {
   std::string out;
   writeBounded(node(m_node), out, maxChars);
-  return shorten(std::move(out), maxChars);
+  return excerptOf(std::move(out), maxChars);
 }
 
 }  // namespace pneuma::sim

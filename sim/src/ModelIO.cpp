@@ -318,7 +318,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     if (region == "wall") m.nodes.region.push_back(NodeRegion::Wall);
     else if (region == "diaphragm") m.nodes.region.push_back(NodeRegion::Diaphragm);
     else if (region == "fixed") m.nodes.region.push_back(NodeRegion::Fixed);
-    else n.at("region").fail("unknown region '" + region + "' (expected wall, diaphragm or fixed)");
+    else n.at("region").fail("unknown region '" + excerptOf(region) + "' (expected wall, diaphragm or fixed)");
   }
 
   // gut
@@ -341,7 +341,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     const auto k = static_cast<Eigen::Index>(i);
     ElementGroup g;
     const std::string group = e.at("group").string();
-    if (!groupFromName(group, g)) e.at("group").fail("unknown group '" + group + "'");
+    if (!groupFromName(group, g)) e.at("group").fail("unknown group '" + excerptOf(group) + "'");
     m.elements.group.push_back(g);
     readAnchor(e.at("a"), m.elements.endA);
     readAnchor(e.at("b"), m.elements.endB);

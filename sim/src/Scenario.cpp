@@ -72,7 +72,7 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
     if (!integratorFromName(name, opt.step.integrator))
-      o.at("integrator").fail("unknown integrator '" + name + "' (valid: " + integratorNames() + ")");
+      o.at("integrator").fail("unknown integrator '" + excerptOf(name) + "' (valid: " + integratorNames() + ")");
   }
   if (o.has("dt_s")) opt.dt = o.at("dt_s").positive();
   if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").nonNegative();

@@ -105,6 +105,18 @@ TEST(JsonLoaders, MessagesQuoteAShortExcerpt) {
   EXPECT_LT(e.size(), 120u);
   const std::string s = errorOf(kLoaders[2].second, edited(kStyle, "\"s\"", "\"" + std::string(1 << 20, 'x') + "\"}"));
   EXPECT_LT(s.size(), 300u) << s.substr(0, 300);
+  // strings from the file quoted in semantic messages are cut too
+  const std::string huge(1 << 20, 'y');
+  const std::vector<std::string> messages = {
+      errorOf(kLoaders[2].second, edited(edited(kStyle, "\"s\"", "\"" + huge + "\""), "12", "-3")),
+      errorOf(kLoaders[1].second, edited(kPattern, "\"linear\"", "\"" + huge + "\"")),
+      errorOf(kLoaders[0].second, edited(kScenario, "}}", "}, \"overrides\": {\"integrator\": \"" + huge + "\"}}")),
+      errorOf(kLoaders[0].second, edited(kScenario, "}}", "}, \"overrides\": {\"active_gain_scale\": {\"" + huge + "\": 1}}}")),
+  };
+  for (const std::string& m : messages) {
+    EXPECT_NE(m.find("yyy..."), std::string::npos) << m.substr(0, 200);
+    EXPECT_LT(m.size(), 300u) << m.substr(0, 300);
+  }
 }
 
 TEST(JsonLoaders, ModelRejectsUnknownDuplicateAndWrappedKeys) {

@@ -22,7 +22,7 @@ CycleKind parseKind(const Node& n) {
   const std::string k = n.string();
   for (CycleKind kind : {CycleKind::Linear, CycleKind::Keyframe, CycleKind::Spline})
     if (k == cycleKindName(kind)) return kind;
-  n.fail("unknown cycle kind '" + k + "' (valid: linear, keyframe, spline)");
+  n.fail("unknown cycle kind '" + sim::excerptOf(k) + "' (valid: linear, keyframe, spline)");
 }
 
 CycleSpec parseCycle(const Node& n) {
@@ -33,7 +33,7 @@ CycleSpec parseCycle(const Node& n) {
 
   // time base: relative cycles need a rate, absolute ones take it from the keyframes
   const std::string time = n.stringOr("time", "relative");
-  if (time != "relative" && time != "absolute") n.at("time").fail("must be 'relative' or 'absolute', got '" + time + "'");
+  if (time != "relative" && time != "absolute") n.at("time").fail("must be 'relative' or 'absolute', got '" + sim::excerptOf(time) + "'");
   c.isRelative = time == "relative";
   if (c.isRelative) c.rate = n.at("rate_bpm").number();
   else if (n.has("rate_bpm")) n.at("rate_bpm").fail("not allowed with absolute time (the keyframes set the rate)");
@@ -165,7 +165,7 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
         time.fail("events must be in time order (previous at " + std::to_string(p.timeline.back().time) + " s)");
       const std::string mode = e.stringOr("switch", "immediate");
       if (!switchModeFromName(mode, ev.mode))
-        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + mode + "\"");
+        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + sim::excerptOf(mode) + "\"");
       ev.layers = parseLayerSource(e, resourceDir, nesting, &ev.label);
       ev.label = e.stringOr("label", ev.label);
       p.timeline.push_back(std::move(ev));
@@ -179,7 +179,7 @@ Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, in
   if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
     std::string list;
     for (const std::string& v : valid) list += (list.empty() ? "" : ", ") + v;
-    throw Error("unknown affect '" + name + "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) +
+    throw Error("unknown affect '" + sim::excerptOf(name) + "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) +
                 ")");
   }
   const std::string path = affectPath(resourceDir, name);

@@ -19,6 +19,10 @@ namespace pneuma::sim {
 
 class JsonReader;
 
+/// `s` cut to at most `maxChars` bytes at a character boundary, "..." marking the cut: how messages quote
+/// strings that came from a file.
+std::string excerptOf(const std::string& s, std::size_t maxChars = 60);
+
 /// Limits applied while parsing.
 struct JsonLimits {
   int maxDepth = 64;  ///< deepest allowed nesting of arrays and objects (the root object is depth 1)
