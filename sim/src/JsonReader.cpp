@@ -113,7 +113,7 @@ class ParsePosition {
       if (f.isArray) p += "[" + std::to_string(f.index) + "]";
       else if (!f.key.empty() || !f.seen.empty()) p += (p.empty() ? "" : ".") + excerptOf(f.key, 60);
     }
-    return p.empty() ? "(root)" : p;
+    return p.empty() ? "(root)" : excerptOf(p, 120);  // deep nesting makes long paths
   }
 
   [[noreturn]] void fail(const std::string& why) const { throw Error(m_source + ": " + path() + ": " + why); }
