@@ -88,7 +88,7 @@ void addModelCommand(CLI::App& app) {
   auto build = std::make_shared<BuildOptions>();
   CLI::App* b = model->add_subcommand("build", "Build the torso model of an anatomy preset into a directory");
   b->add_option("--anatomy", build->anatomy, "Anatomy preset (JSON)")->check(CLI::ExistingFile);
-  b->add_option("--out", build->out, "Output model directory (replaced as a whole)")->required();
+  b->add_option("--out", build->out, "Output model directory: new, empty or an earlier model (replaced as a whole)")->required();
   b->add_flag("--no-preview", build->isPreviewSkipped, "Do not render preview_front.png / preview_side.png");
   b->callback([build] { guarded([&] { runBuild(*build); }); });
 

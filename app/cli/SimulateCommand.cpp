@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -39,6 +40,7 @@ struct SimulateArgs {
   std::string out;
   double outputRate = 0.0;  // [Hz]
   bool vtk = false;
+  bool force = false;       // replace an earlier run's results in `out`
   std::uint64_t seed = 0;
   std::string integrator;
   double dt = 0.0;          // [s]
@@ -98,6 +100,11 @@ void runSimulate(const SimulateArgs& args) {
   const std::string modelDir =
       resolveModelDir(!args.model.empty() ? args.model : scenario.model == "default" ? "" : scenario.model);
   prepareOutputDir(args.out);
+  // an earlier run's results are replaced only on request
+  for (const char* earlier : {"summary.json", "timeseries.csv"}) {
+    if (!args.force && fs::exists(fs::path(args.out) / earlier))
+      fail(kExitBadInput, "--out: '" + args.out + "' holds an earlier run (" + earlier + "); add --force to replace it");
+  }
 
   // model, controller and simulation: any bad input is reported by name before anything runs
   std::shared_ptr<const sim::Model> model;
@@ -219,9 +226,19 @@ void addSimulateCommand(CLI::App& app) {
   affect->excludes(pattern);
   cmd->add_option("--duration", args->duration, "Simulated seconds after the settling phase (> 0)");
   cmd->add_option("--out", args->out, "Output directory (created if missing)")->required();
+  cmd->add_flag("--force", args->force, "Replace the results of an earlier run in --out");
   cmd->add_option("--output-rate", args->outputRate, "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
   cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
-  cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams (default 0)");
+  // digits only and in range: CLI11 would read -1 as 2^64 - 1 and saturate 2^64
+  cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams, 0 to 2^64 - 1 (default 0)")
+      ->check(CLI::Validator(
+          [](const std::string& v) {
+            std::uint64_t x = 0;
+            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+            const bool ok = !v.empty() && v[0] != '-' && ec == std::errc() && end == v.data() + v.size();
+            return ok ? std::string() : "must be an integer in [0, 18446744073709551615], got " + v.substr(0, 60);
+          },
+          "UINT64"));
   addIntegratorOption(*cmd, args->integrator);
   cmd->add_option("--dt", args->dt,
                   "Time step [s] (default: the integrator's, 1/60 s for implicit-euler-joints; 10 ms for affect and "

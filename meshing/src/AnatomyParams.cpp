@@ -1,8 +1,7 @@
 #include "pneuma/meshing/AnatomyParams.h"
 
 #include "pneuma/sim/Error.h"
-
-#include <nlohmann/json.hpp>
+#include "pneuma/sim/JsonReader.h"
 
 #include <cmath>
 #include <fstream>
@@ -12,96 +11,24 @@ namespace pneuma::meshing {
 
 namespace {
 
-using nlohmann::json;
 constexpr double kMm = 1e-3;                 // [m/mm]
 constexpr double kDeg = 3.14159265358979323846 / 180.0;  // [rad/deg]
 
-/// Reads numbers and sub-objects of one JSON object, naming "<file>: <path>.<key>" in every error.
-class Reader {
- public:
-  Reader(const json& j, std::string path) : m_j(j), m_path(std::move(path)) {
-    if (!m_j.is_object()) fail(m_path, "must be an object");
-  }
+using Reader = sim::JsonReader;
 
-  [[noreturn]] static void fail(const std::string& field, const std::string& why) {
-    throw sim::Error(field + ": " + why);
-  }
-  std::string field(const std::string& key) const { return m_path + "." + key; }
-
-  const json& get(const std::string& key) const {
-    auto it = m_j.find(key);
-    if (it == m_j.end()) fail(field(key), "missing");
-    return *it;
-  }
-  Reader child(const std::string& key) const { return Reader(get(key), field(key)); }
-
-  /// a finite number in [lo, hi]
-  double number(const std::string& key, double lo, double hi) const {
-    const json& v = get(key);
-    if (!v.is_number()) fail(field(key), "must be a number");
-    const double x = v.get<double>();
-    if (!std::isfinite(x) || x < lo || x > hi) {
-      std::ostringstream s;
-      s << "must be in [" << lo << ", " << hi << "], got " << x;
-      fail(field(key), s.str());
-    }
-    return x;
-  }
-  /// a finite number > 0 (and <= hi)
-  double positive(const std::string& key, double hi) const {
-    const double x = number(key, -1e300, hi);
-    if (!(x > 0.0)) {
-      std::ostringstream s;
-      s << "must be > 0, got " << x;
-      fail(field(key), s.str());
-    }
-    return x;
-  }
-  int integer(const std::string& key, int lo, int hi) const {
-    const json& v = get(key);
-    if (!v.is_number_integer()) fail(field(key), "must be an integer");
-    const long long x = v.get<long long>();
-    if (x < lo || x > hi) {
-      fail(field(key), "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                           std::to_string(x));
-    }
-    return static_cast<int>(x);
-  }
-  bool boolean(const std::string& key) const {
-    const json& v = get(key);
-    if (!v.is_boolean()) fail(field(key), "must be true or false");
-    return v.get<bool>();
-  }
-  /// an array of `count` positive lengths in mm, returned in m
-  std::vector<double> lengthsMm(const std::string& key, std::size_t count, double hiMm) const {
-    const json& v = get(key);
-    if (!v.is_array() || v.size() != count) {
-      fail(field(key), "must be an array of " + std::to_string(count) + " numbers");
-    }
-    std::vector<double> out;
-    for (std::size_t i = 0; i < count; ++i) {
-      const json wrapper = {{"v", v[i]}};
-      out.push_back(Reader(wrapper, field(key) + "[" + std::to_string(i) + "]").positive("v", hiMm) * kMm);
-    }
-    return out;
-  }
-  std::array<double, 2> pairMm(const std::string& key, double hiMm) const {
-    const std::vector<double> v = lengthsMm(key, 2, hiMm);
-    return {v[0], v[1]};
-  }
-
- private:
-  const json& m_j;
-  std::string m_path;
-};
-
-json parseJson(const std::string& text, const std::string& source) {
-  try {
-    return json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw sim::Error(source + ": not valid JSON: " + e.what());
-  }
+/// an array of `count` lengths in (0, hiMm] mm, returned in m
+std::vector<double> lengthsMm(const Reader& v, std::size_t count, double hiMm) {
+  if (!v.isArray() || v.size() != count) v.fail("must be an array of " + std::to_string(count) + " numbers");
+  std::vector<double> out;
+  for (std::size_t i = 0; i < count; ++i) out.push_back(v[i].positiveAtMost(hiMm) * kMm);
+  return out;
 }
+std::array<double, 2> pairMm(const Reader& v, double hiMm) {
+  const std::vector<double> l = lengthsMm(v, 2, hiMm);
+  return {l[0], l[1]};
+}
+double mm(const Reader& v, double hiMm) { return v.positiveAtMost(hiMm) * kMm; }
+int count(const Reader& v, int lo, int hi) { return static_cast<int>(v.integerIn(lo, hi)); }
 
 std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -111,122 +38,135 @@ std::string readText(const std::string& path) {
   return s.str();
 }
 
-RibLevel readRib(const Reader& r) {
+RibLevel readRib(const Reader& r, std::size_t i) {
+  r.allowKeys({"level", "arc_length_mm", "posterior_ratio", "anterior_ratio", "end_angle_deg", "inclination_deg",
+               "lateral_tilt_deg", "height_mm", "thickness_mm"});
+  if (r.has("level") && r.at("level").integerIn(1, 12) != static_cast<std::int64_t>(i + 1))
+    r.at("level").fail("must be " + std::to_string(i + 1) + " (the ribs are listed in order)");
   RibLevel rib;
-  rib.arcLength = r.positive("arc_length_mm", 600.0) * kMm;
-  rib.posteriorRatio = r.positive("posterior_ratio", 5.0);
-  rib.anteriorRatio = r.positive("anterior_ratio", 5.0);
-  rib.endAngle = r.number("end_angle_deg", 180.0, 330.0) * kDeg;
-  rib.inclination = r.number("inclination_deg", -10.0, 80.0) * kDeg;
-  rib.lateralTilt = r.number("lateral_tilt_deg", -30.0, 60.0) * kDeg;
-  rib.height = r.positive("height_mm", 40.0) * kMm;
-  rib.thickness = r.positive("thickness_mm", 20.0) * kMm;
-  if (rib.thickness > rib.height) Reader::fail(r.field("thickness_mm"), "must not exceed height_mm");
+  rib.arcLength = mm(r.at("arc_length_mm"), 600.0);
+  rib.posteriorRatio = r.at("posterior_ratio").positiveAtMost(5.0);
+  rib.anteriorRatio = r.at("anterior_ratio").positiveAtMost(5.0);
+  rib.endAngle = r.at("end_angle_deg").numberIn(180.0, 330.0) * kDeg;
+  rib.inclination = r.at("inclination_deg").numberIn(-10.0, 80.0) * kDeg;
+  rib.lateralTilt = r.at("lateral_tilt_deg").numberIn(-30.0, 60.0) * kDeg;
+  rib.height = mm(r.at("height_mm"), 40.0);
+  rib.thickness = mm(r.at("thickness_mm"), 20.0);
+  if (rib.thickness > rib.height) r.at("thickness_mm").fail("must not exceed height_mm");
   return rib;
 }
 
 SpineParams readSpine(const Reader& r) {
+  r.allowKeys({"lumbar_body_heights_mm", "thoracic_body_heights_mm", "lumbar_disc_mm", "thoracic_disc_mm",
+               "lumbar_body_width_depth_mm", "t1_body_width_depth_mm", "t12_body_width_depth_mm", "kyphosis_mm",
+               "spinous_process_mm", "thoracic_segments"});
   SpineParams s;
-  s.lumbarHeights = r.lengthsMm("lumbar_body_heights_mm", 5, 60.0);
-  s.thoracicHeights = r.lengthsMm("thoracic_body_heights_mm", 12, 40.0);
-  s.lumbarDisc = r.positive("lumbar_disc_mm", 20.0) * kMm;
-  s.thoracicDisc = r.positive("thoracic_disc_mm", 15.0) * kMm;
-  s.lumbarBody = r.pairMm("lumbar_body_width_depth_mm", 80.0);
-  s.thoracicBodyTop = r.pairMm("t1_body_width_depth_mm", 80.0);
-  s.thoracicBodyBottom = r.pairMm("t12_body_width_depth_mm", 80.0);
-  s.kyphosis = r.number("kyphosis_mm", 0.0, 80.0) * kMm;
-  s.spinousLength = r.positive("spinous_process_mm", 100.0) * kMm;
-  const json& segs = r.get("thoracic_segments");
-  const std::string segField = r.field("thoracic_segments");
-  if (!segs.is_array() || segs.size() < 3) Reader::fail(segField, "needs at least 3 articulated segments");
+  s.lumbarHeights = lengthsMm(r.at("lumbar_body_heights_mm"), 5, 60.0);
+  s.thoracicHeights = lengthsMm(r.at("thoracic_body_heights_mm"), 12, 40.0);
+  s.lumbarDisc = mm(r.at("lumbar_disc_mm"), 20.0);
+  s.thoracicDisc = mm(r.at("thoracic_disc_mm"), 15.0);
+  s.lumbarBody = pairMm(r.at("lumbar_body_width_depth_mm"), 80.0);
+  s.thoracicBodyTop = pairMm(r.at("t1_body_width_depth_mm"), 80.0);
+  s.thoracicBodyBottom = pairMm(r.at("t12_body_width_depth_mm"), 80.0);
+  s.kyphosis = r.at("kyphosis_mm").numberIn(0.0, 80.0) * kMm;
+  s.spinousLength = mm(r.at("spinous_process_mm"), 100.0);
+  const Reader segs = r.at("thoracic_segments");
+  if (!segs.isArray() || segs.size() < 3) segs.fail("needs at least 3 articulated segments");
   int expected = 1;
   for (std::size_t i = 0; i < segs.size(); ++i) {
-    const std::string f = segField + "[" + std::to_string(i) + "]";
-    if (!segs[i].is_array() || segs[i].size() != 2 || !segs[i][0].is_number_integer() ||
-        !segs[i][1].is_number_integer()) {
-      Reader::fail(f, "must be [first, last] vertebra numbers");
-    }
-    const int first = segs[i][0].get<int>();
-    const int last = segs[i][1].get<int>();
-    if (first != expected || last < first || last > 12) {
-      Reader::fail(f, "must continue at T" + std::to_string(expected) + " and end at or before T12");
-    }
+    const Reader seg = segs[i];
+    if (!seg.isArray() || seg.size() != 2) seg.fail("must be [first, last] vertebra numbers");
+    const int first = count(seg[0], 1, 12);
+    const int last = count(seg[1], 1, 12);
+    if (first != expected || last < first) seg.fail("must continue at T" + std::to_string(expected) + " and end at or before T12");
     s.thoracicSegments.push_back({first, last});
     expected = last + 1;
   }
-  if (expected != 13) Reader::fail(segField, "must cover T1..T12");
+  if (expected != 13) segs.fail("must cover T1..T12");
   return s;
 }
 
 SternumParams readSternum(const Reader& r) {
+  r.allowKeys({"manubrium_length_mm", "body_length_mm", "xiphoid_length_mm", "manubrium_width_mm", "body_width_mm",
+               "thickness_mm", "jugular_notch_vertebra", "jugular_notch_depth_mm", "inclination_deg"});
   SternumParams s;
-  s.manubriumLength = r.positive("manubrium_length_mm", 120.0) * kMm;
-  s.bodyLength = r.positive("body_length_mm", 200.0) * kMm;
-  s.xiphoidLength = r.positive("xiphoid_length_mm", 100.0) * kMm;
-  s.manubriumWidth = r.positive("manubrium_width_mm", 120.0) * kMm;
-  s.bodyWidth = r.positive("body_width_mm", 80.0) * kMm;
-  s.thickness = r.positive("thickness_mm", 30.0) * kMm;
-  s.notchLevel = r.number("jugular_notch_vertebra", 1.0, 5.0);
-  s.notchDepth = r.positive("jugular_notch_depth_mm", 300.0) * kMm;
-  s.inclination = r.number("inclination_deg", 0.0, 60.0) * kDeg;
+  s.manubriumLength = mm(r.at("manubrium_length_mm"), 120.0);
+  s.bodyLength = mm(r.at("body_length_mm"), 200.0);
+  s.xiphoidLength = mm(r.at("xiphoid_length_mm"), 100.0);
+  s.manubriumWidth = mm(r.at("manubrium_width_mm"), 120.0);
+  s.bodyWidth = mm(r.at("body_width_mm"), 80.0);
+  s.thickness = mm(r.at("thickness_mm"), 30.0);
+  s.notchLevel = r.at("jugular_notch_vertebra").numberIn(1.0, 5.0);
+  s.notchDepth = mm(r.at("jugular_notch_depth_mm"), 300.0);
+  s.inclination = r.at("inclination_deg").numberIn(0.0, 60.0) * kDeg;
   return s;
 }
 
 PelvisParams readPelvis(const Reader& r) {
+  r.allowKeys({"bi_iliac_breadth_mm", "asis_depth_mm", "iliac_height_mm"});
   PelvisParams p;
-  p.width = r.positive("bi_iliac_breadth_mm", 500.0) * kMm;
-  p.depth = r.positive("asis_depth_mm", 300.0) * kMm;
-  p.height = r.positive("iliac_height_mm", 250.0) * kMm;
+  p.width = mm(r.at("bi_iliac_breadth_mm"), 500.0);
+  p.depth = mm(r.at("asis_depth_mm"), 300.0);
+  p.height = mm(r.at("iliac_height_mm"), 250.0);
   return p;
 }
 
 AbdomenParams readAbdomen(const Reader& r) {
+  r.allowKeys({"pelvic_floor_z_mm", "inner_width_mm", "anterior_depth_mm", "posterior_depth_mm", "dome_height_mm",
+               "central_tendon_fraction", "umbilicus_z_mm"});
   AbdomenParams a;
-  a.floorLevel = r.number("pelvic_floor_z_mm", -300.0, 0.0) * kMm;
-  a.width = r.positive("inner_width_mm", 600.0) * kMm;
-  a.anteriorDepth = r.positive("anterior_depth_mm", 400.0) * kMm;
-  a.posteriorDepth = r.positive("posterior_depth_mm", 200.0) * kMm;
-  a.domeHeight = r.positive("dome_height_mm", 200.0) * kMm;
-  a.tendonFraction = r.number("central_tendon_fraction", 0.05, 0.8);
-  a.umbilicusLevel = r.number("umbilicus_z_mm", 0.0, 400.0) * kMm;
+  a.floorLevel = r.at("pelvic_floor_z_mm").numberIn(-300.0, 0.0) * kMm;
+  a.width = mm(r.at("inner_width_mm"), 600.0);
+  a.anteriorDepth = mm(r.at("anterior_depth_mm"), 400.0);
+  a.posteriorDepth = mm(r.at("posterior_depth_mm"), 200.0);
+  a.domeHeight = mm(r.at("dome_height_mm"), 200.0);
+  a.tendonFraction = r.at("central_tendon_fraction").numberIn(0.05, 0.8);
+  a.umbilicusLevel = r.at("umbilicus_z_mm").numberIn(0.0, 400.0) * kMm;
   return a;
 }
 
 Resolution readResolution(const Reader& r) {
+  r.allowKeys({"bone_edge_mm", "wall_rings", "ring_nodes", "dome_rings", "dome_rim_nodes", "intercostal_samples"});
   Resolution res;
-  res.boneEdge = r.number("bone_edge_mm", 1.0, 30.0) * kMm;
-  res.wallRings = r.integer("wall_rings", 3, 40);
-  res.ringNodes = r.integer("ring_nodes", 8, 96);
-  res.domeRings = r.integer("dome_rings", 2, 30);
-  res.domeRimNodes = r.integer("dome_rim_nodes", 8, 128);
-  res.intercostalSamples = r.integer("intercostal_samples", 1, 60);
+  res.boneEdge = r.at("bone_edge_mm").numberIn(1.0, 30.0) * kMm;
+  res.wallRings = count(r.at("wall_rings"), 3, 40);
+  res.ringNodes = count(r.at("ring_nodes"), 8, 96);
+  res.domeRings = count(r.at("dome_rings"), 2, 30);
+  res.domeRimNodes = count(r.at("dome_rim_nodes"), 8, 128);
+  res.intercostalSamples = count(r.at("intercostal_samples"), 1, 60);
   return res;
 }
 
-Gains readGains(const json& j, const std::string& source) {
-  const Reader r(j, source);
+Gains readGains(const Reader& r) {
+  r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s", "gut_wall_mass_kg",
+               "diaphragm_mass_kg", "joints"});
   Gains g;
-  g.referenceLength = r.positive("reference_length_m", 1.0);
-  const Reader groups = r.child("groups");
+  g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
+  const Reader groups = r.at("groups");
+  for (const std::string& key : groups.keys()) {
+    sim::ElementGroup unused;
+    if (!sim::groupFromName(key, unused)) groups.at(key).fail("unknown muscle group");
+  }
   for (int i = 0; i < sim::kElementGroupCount; ++i) {
-    const Reader gr = groups.child(sim::groupName(static_cast<sim::ElementGroup>(i)));
+    const Reader gr = groups.at(sim::groupName(static_cast<sim::ElementGroup>(i)));
+    gr.allowKeys({"kac", "kpe", "b"});
     GroupGains& gg = g.group[static_cast<std::size_t>(i)];
-    gg.kac = gr.number("kac", 0.0, 1e9);
-    gg.kpe = gr.number("kpe", 0.0, 1e9);
-    gg.damping = gr.number("b", 0.0, 1e9);
+    gg.kac = gr.at("kac").numberIn(0.0, 1e9);
+    gg.kpe = gr.at("kpe").numberIn(0.0, 1e9);
+    gg.damping = gr.at("b").numberIn(0.0, 1e9);
   }
-  if (g.group[static_cast<std::size_t>(sim::ElementGroup::Cartilage)].kpe <= 0.0) {
-    Reader::fail(groups.field("cartilage.kpe"), "must be > 0 (cartilage holds the ribs to the sternum)");
-  }
-  g.gutKappa = r.positive("gut_kappa_pa", 1e9);
-  g.gutDrag = r.number("gut_drag_per_s", 0.0, 1e3);
-  g.wallMass = r.positive("gut_wall_mass_kg", 100.0);
-  g.diaphragmMass = r.positive("diaphragm_mass_kg", 10.0);
-  const Reader joints = r.child("joints");
-  g.costovertebralFriction = joints.number("costovertebral_friction", 0.0, 1e6);
-  g.costovertebralStiffness = joints.number("costovertebral_stiffness", 0.0, 1e6);
-  g.spineFriction = joints.number("spine_friction", 0.0, 1e6);
-  g.spineStiffness = joints.number("spine_stiffness", 0.0, 1e6);
+  if (g.group[static_cast<std::size_t>(sim::ElementGroup::Cartilage)].kpe <= 0.0)
+    groups.at("cartilage").at("kpe").fail("must be > 0 (cartilage holds the ribs to the sternum)");
+  g.gutKappa = r.at("gut_kappa_pa").positiveAtMost(1e9);
+  g.gutDrag = r.at("gut_drag_per_s").numberIn(0.0, 1e3);
+  g.wallMass = r.at("gut_wall_mass_kg").positiveAtMost(100.0);
+  g.diaphragmMass = r.at("diaphragm_mass_kg").positiveAtMost(10.0);
+  const Reader joints = r.at("joints");
+  joints.allowKeys({"costovertebral_friction", "costovertebral_stiffness", "spine_friction", "spine_stiffness"});
+  g.costovertebralFriction = joints.at("costovertebral_friction").numberIn(0.0, 1e6);
+  g.costovertebralStiffness = joints.at("costovertebral_stiffness").numberIn(0.0, 1e6);
+  g.spineFriction = joints.at("spine_friction").numberIn(0.0, 1e6);
+  g.spineStiffness = joints.at("spine_stiffness").numberIn(0.0, 1e6);
   return g;
 }
 
@@ -239,40 +179,37 @@ std::string directoryOf(const std::string& path) {
 
 AnatomyParams parseAnatomy(const std::string& anatomyText, const std::string& gainsText,
                            const std::string& sourceName, const std::string& gainsName) {
-  const json j = parseJson(anatomyText, sourceName);
-  const Reader r(j, sourceName);
+  const sim::JsonDocument doc = sim::JsonDocument::parse(anatomyText, sourceName);
+  const Reader r = doc.root();
+  r.allowKeys({"name", "description", "gains", "bone_density_kg_m3", "floating_ribs_moving", "ribs", "spine",
+               "sternum", "pelvis", "abdomen", "resolution"});
   AnatomyParams a;
   a.source = sourceName;
-  const json& name = r.get("name");
-  if (!name.is_string() || name.get<std::string>().empty()) Reader::fail(r.field("name"), "must be a non-empty string");
-  a.name = name.get<std::string>();
-  a.boneDensity = r.number("bone_density_kg_m3", 100.0, 5000.0);
-  a.areFloatingRibsMoving = r.boolean("floating_ribs_moving");
+  a.name = r.at("name").string();
+  if (a.name.empty()) r.at("name").fail("must be a non-empty string");
+  a.boneDensity = r.at("bone_density_kg_m3").numberIn(100.0, 5000.0);
+  a.areFloatingRibsMoving = r.at("floating_ribs_moving").boolean();
 
   // rib levels 1..12, in order
-  const json& ribs = r.get("ribs");
-  if (!ribs.is_array() || ribs.size() != 12) {
-    Reader::fail(r.field("ribs"), "must list 12 rib levels, got " +
-                                      std::to_string(ribs.is_array() ? ribs.size() : 0));
-  }
-  for (std::size_t i = 0; i < ribs.size(); ++i) {
-    a.ribs.push_back(readRib(Reader(ribs[i], r.field("ribs") + "[" + std::to_string(i) + "]")));
-  }
-  a.spine = readSpine(r.child("spine"));
-  a.sternum = readSternum(r.child("sternum"));
-  a.pelvis = readPelvis(r.child("pelvis"));
-  a.abdomen = readAbdomen(r.child("abdomen"));
-  a.resolution = readResolution(r.child("resolution"));
-  a.gains = readGains(parseJson(gainsText, gainsName), gainsName);
+  const Reader ribs = r.at("ribs");
+  if (!ribs.isArray() || ribs.size() != 12)
+    ribs.fail("must list 12 rib levels, got " + std::to_string(ribs.isArray() ? ribs.size() : 0));
+  for (std::size_t i = 0; i < ribs.size(); ++i) a.ribs.push_back(readRib(ribs[i], i));
+  a.spine = readSpine(r.at("spine"));
+  a.sternum = readSternum(r.at("sternum"));
+  a.pelvis = readPelvis(r.at("pelvis"));
+  a.abdomen = readAbdomen(r.at("abdomen"));
+  a.resolution = readResolution(r.at("resolution"));
+  a.gains = readGains(sim::JsonDocument::parse(gainsText, gainsName).root());
   return a;
 }
 
 AnatomyParams loadAnatomy(const std::string& path) {
   const std::string text = readText(path);
-  const json j = parseJson(text, path);
-  auto it = j.find("gains");
-  if (it == j.end() || !it->is_string()) throw sim::Error(path + ".gains: must name the gains file");
-  const std::string gainsPath = directoryOf(path) + "/" + it->get<std::string>();
+  const sim::JsonDocument doc = sim::JsonDocument::parse(text, path);
+  const Reader gains = doc.root().at("gains");
+  if (!gains.isString()) gains.fail("must name the gains file");
+  const std::string gainsPath = directoryOf(path) + "/" + gains.string();
   return parseAnatomy(text, readText(gainsPath), path, gainsPath);
 }
 

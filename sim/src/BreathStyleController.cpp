@@ -1,6 +1,7 @@
 #include "pneuma/sim/BreathStyleController.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
 
 #include <nlohmann/json.hpp>
 
@@ -9,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace pneuma::sim {
@@ -38,7 +40,7 @@ double smoothRise(double t, double rise) {
 }  // namespace
 
 void validateBreathStyle(const BreathStyle& s) {
-  const std::string p = "breath style '" + s.name + "': ";
+  const std::string p = "breath style '" + excerptOf(s.name) + "': ";
   if (!std::isfinite(s.breathsPerMinute) || s.breathsPerMinute <= 0.0 || s.breathsPerMinute > 600.0)
     requireRange(p + "breaths_per_minute", s.breathsPerMinute, 0.0, 600.0, true);
   requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
@@ -58,46 +60,26 @@ void validateBreathStyle(const BreathStyle& s) {
 }
 
 BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& source) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(jsonText);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(source + ": not valid JSON: " + e.what());
-  }
-  if (!j.is_object()) throw Error(source + ": expected a JSON object");
+  const JsonDocument doc = JsonDocument::parse(jsonText, source);
+  const JsonReader j = doc.root();
+  j.allowKeys({"name", "note", "breaths_per_minute", "inhale_fraction", "diaphragm_r", "diaphragm_alpha",
+               "diaphragm_rise_time_s", "intercostal_mean", "intercostal_amplitude", "intercostal_alpha", "rectus_r",
+               "rectus_active", "cycles"});
   BreathStyle s;
-  auto number = [&](const char* key, double& out, bool required) {
-    if (!j.contains(key)) {
-      if (required) throw Error(source + ": " + key + ": missing");
-      return;
-    }
-    if (!j[key].is_number()) throw Error(source + ": " + key + ": must be a number");
-    out = j[key].get<double>();
-  };
-  try {
-    if (!j.contains("name") || !j["name"].is_string()) throw Error(source + ": name: missing or not a string");
-    s.name = j["name"].get<std::string>();
-    if (j.contains("note")) s.note = j["note"].get<std::string>();
-    number("breaths_per_minute", s.breathsPerMinute, true);
-    number("inhale_fraction", s.inhaleFraction, false);
-    number("diaphragm_r", s.diaphragmR, true);
-    number("diaphragm_alpha", s.diaphragmAlpha, false);
-    number("diaphragm_rise_time_s", s.diaphragmRiseTime, false);
-    number("intercostal_mean", s.intercostalMean, true);
-    number("intercostal_amplitude", s.intercostalAmplitude, true);
-    number("intercostal_alpha", s.intercostalAlpha, false);
-    number("rectus_r", s.rectusR, false);
-    if (j.contains("rectus_active")) {
-      if (!j["rectus_active"].is_boolean()) throw Error(source + ": rectus_active: must be true or false");
-      s.rectusActive = j["rectus_active"].get<bool>();
-    }
-    if (j.contains("cycles")) {
-      if (!j["cycles"].is_number_integer()) throw Error(source + ": cycles: must be an integer");
-      s.cycles = j["cycles"].get<int>();
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(source + ": " + e.what());
-  }
+  // required fields, then optional ones that keep their defaults when absent
+  s.name = j.at("name").string();
+  s.note = j.stringOr("note", s.note);
+  s.breathsPerMinute = j.at("breaths_per_minute").number();
+  s.diaphragmR = j.at("diaphragm_r").number();
+  s.intercostalMean = j.at("intercostal_mean").number();
+  s.intercostalAmplitude = j.at("intercostal_amplitude").number();
+  s.inhaleFraction = j.numberOr("inhale_fraction", s.inhaleFraction);
+  s.diaphragmAlpha = j.numberOr("diaphragm_alpha", s.diaphragmAlpha);
+  s.diaphragmRiseTime = j.numberOr("diaphragm_rise_time_s", s.diaphragmRiseTime);
+  s.intercostalAlpha = j.numberOr("intercostal_alpha", s.intercostalAlpha);
+  s.rectusR = j.numberOr("rectus_r", s.rectusR);
+  if (j.has("rectus_active")) s.rectusActive = j.at("rectus_active").boolean();
+  if (j.has("cycles")) s.cycles = static_cast<int>(j.at("cycles").integerIn(0, std::numeric_limits<int>::max()));
   try {
     validateBreathStyle(s);
   } catch (const Error& e) {
@@ -147,7 +129,7 @@ BreathStyle loadBreathStyle(const std::string& nameOrPath, const std::string& pr
     if (isPath) throw Error("breath style file '" + path + "': cannot be read");
     std::string valid;
     for (const std::string& n : breathStyleNames(presetDir)) valid += (valid.empty() ? "" : ", ") + n;
-    throw Error("unknown breath style '" + nameOrPath + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
+    throw Error("unknown breath style '" + excerptOf(nameOrPath) + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
   }
   std::stringstream text;
   text << in.rdbuf();

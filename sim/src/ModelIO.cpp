@@ -1,8 +1,7 @@
 #include "pneuma/sim/ModelIO.h"
 
-#include "JsonField.h"
-
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
 
 #include <nlohmann/json.hpp>
 
@@ -36,14 +35,18 @@ const char* regionName(NodeRegion r) {
 // ---------------------------------------------------------------------------------------------
 // reading: every accessor carries the JSON path so that errors name the field
 
-using Reader = detail::JsonField;
+using Reader = JsonReader;
 
-// anchor: {"body": i, "local": [x,y,z]} or {"nodes": [a(,b,c)], "weights": [wa(,wb,wc)]}
-void readAnchor(const Reader& r, AnchorSet& out) {
+// anchor: {"body": i, "local": [x,y,z]} or {"nodes": [a(,b,c)], "weights": [wa(,wb,wc)]}; landmarks add "name"
+void readAnchor(const Reader& r, AnchorSet& out, bool named = false) {
   if (r.has("body")) {
+    if (named) r.allowKeys({"body", "local", "name"});
+    else r.allowKeys({"body", "local"});
     out.addBodyPoint(r.at("body").integer(), r.at("local").vec3());
     return;
   }
+  if (named) r.allowKeys({"nodes", "weights", "name"});
+  else r.allowKeys({"nodes", "weights"});
   const Reader nodes = r.at("nodes");
   const Reader weights = r.at("weights");
   const std::size_t n = nodes.size();
@@ -245,13 +248,10 @@ void validateModel(const Model& m) {
 // =============================================================================================
 
 Model parseModel(const std::string& jsonText, const std::string& sourceName) {
-  json doc;
-  try {
-    doc = json::parse(jsonText);
-  } catch (const json::parse_error& e) {
-    throw Error(sourceName + ": not valid JSON (byte " + std::to_string(e.byte) + ")");
-  }
-  const Reader root(doc, "", sourceName);
+  const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
+  const Reader root = doc.root();
+  root.allowKeys({"format", "version", "name", "anatomy", "units", "frame", "gravity", "bodies", "joints", "nodes",
+                  "gut", "elements", "cavity", "landmarks"});
 
   // header
   if (root.at("format").string() != kFormatName)
@@ -273,6 +273,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.bodies.com.resize(3, static_cast<Eigen::Index>(nB));
   for (std::size_t i = 0; i < nB; ++i) {
     const Reader b = bodies[i];
+    b.allowKeys({"name", "fixed", "mass", "com", "inertia", "mesh"});
     m.bodies.name.push_back(b.at("name").string());
     m.bodies.isFixed.push_back(b.at("fixed").boolean() ? 1 : 0);
     m.bodies.mass[static_cast<Eigen::Index>(i)] = b.at("mass").number();
@@ -293,6 +294,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.joints.stiffness.resize(static_cast<Eigen::Index>(nJ));
   for (std::size_t i = 0; i < nJ; ++i) {
     const Reader j = joints[i];
+    j.allowKeys({"name", "parent", "child", "anchor", "friction", "stiffness"});
     const auto k = static_cast<Eigen::Index>(i);
     m.joints.name.push_back(j.at("name").string());
     m.joints.parent.push_back(j.at("parent").integer());
@@ -309,17 +311,19 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.nodes.mass.resize(static_cast<Eigen::Index>(nN));
   for (std::size_t i = 0; i < nN; ++i) {
     const Reader n = nodes[i];
+    n.allowKeys({"x", "mass", "region"});
     m.nodes.rest.col(static_cast<Eigen::Index>(i)) = n.at("x").vec3();
     m.nodes.mass[static_cast<Eigen::Index>(i)] = n.at("mass").number();
     const std::string region = n.at("region").string();
     if (region == "wall") m.nodes.region.push_back(NodeRegion::Wall);
     else if (region == "diaphragm") m.nodes.region.push_back(NodeRegion::Diaphragm);
     else if (region == "fixed") m.nodes.region.push_back(NodeRegion::Fixed);
-    else n.at("region").fail("unknown region '" + region + "' (expected wall, diaphragm or fixed)");
+    else n.at("region").fail("unknown region '" + excerptOf(region) + "' (expected wall, diaphragm or fixed)");
   }
 
   // gut
   const Reader gut = root.at("gut");
+  gut.allowKeys({"kappa", "drag", "triangles"});
   m.gut.kappa = gut.at("kappa").number();
   if (gut.has("drag")) m.gut.drag = gut.at("drag").number();  // optional: models written before it have none
   const Reader gutTris = gut.at("triangles");
@@ -333,10 +337,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     v->resize(static_cast<Eigen::Index>(nE));
   for (std::size_t i = 0; i < nE; ++i) {
     const Reader e = elements[i];
+    e.allowKeys({"group", "a", "b", "rest_length", "kac", "kpe", "damping"});
     const auto k = static_cast<Eigen::Index>(i);
     ElementGroup g;
     const std::string group = e.at("group").string();
-    if (!groupFromName(group, g)) e.at("group").fail("unknown group '" + group + "'");
+    if (!groupFromName(group, g)) e.at("group").fail("unknown group '" + excerptOf(group) + "'");
     m.elements.group.push_back(g);
     readAnchor(e.at("a"), m.elements.endA);
     readAnchor(e.at("b"), m.elements.endB);
@@ -348,6 +353,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
 
   // cavity
   const Reader cavity = root.at("cavity");
+  cavity.allowKeys({"vertices", "triangles"});
   const Reader cavVerts = cavity.at("vertices");
   for (std::size_t i = 0; i < cavVerts.size(); ++i) readAnchor(cavVerts[i], m.cavity.vertices);
   const Reader cavTris = cavity.at("triangles");
@@ -358,7 +364,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   const Reader landmarks = root.at("landmarks");
   for (std::size_t i = 0; i < landmarks.size(); ++i) {
     m.landmarks.name.push_back(landmarks[i].at("name").string());
-    readAnchor(landmarks[i], m.landmarks.points);
+    readAnchor(landmarks[i], m.landmarks.points, true);
   }
 
   // semantic checks; their messages name the model field

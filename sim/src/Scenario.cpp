@@ -1,9 +1,8 @@
 #include "pneuma/sim/Scenario.h"
 
-#include "JsonField.h"
-
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
 #include "pneuma/sim/pattern/PatternController.h"
 
 #include <nlohmann/json.hpp>
@@ -13,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <sstream>
 
 namespace pneuma::sim {
@@ -24,7 +24,7 @@ namespace {
 
 constexpr const char* kFormatName = "pneuma-scenario";
 
-using Field = detail::JsonField;
+using Field = JsonReader;
 
 std::string resolve(const std::string& path, const std::string& baseDir) {
   if (path.empty() || fs::path(path).is_absolute() || baseDir.empty()) return path;
@@ -33,15 +33,15 @@ std::string resolve(const std::string& path, const std::string& baseDir) {
 
 // {"diaphragm": 1.2, ...} -> per-group scale factors (>= 0)
 void parseGroupScales(const Field& f, std::array<double, kElementGroupCount>& out) {
-  if (!f.raw().is_object()) f.fail("must be an object of group names to scale factors");
-  for (auto it = f.raw().begin(); it != f.raw().end(); ++it) {
+  if (!f.isObject()) f.fail("must be an object of group names to scale factors");
+  for (const std::string& key : f.keys()) {
     ElementGroup g;
-    if (!groupFromName(it.key(), g)) {
+    if (!groupFromName(key, g)) {
       std::string valid;
       for (int i = 0; i < kElementGroupCount; ++i) valid += std::string(i ? ", " : "") + groupName(static_cast<ElementGroup>(i));
-      f.child(it.key()).fail("unknown muscle group (valid: " + valid + ")");
+      f.at(key).fail("unknown muscle group (valid: " + valid + ")");
     }
-    out[static_cast<std::size_t>(g)] = f.child(it.key()).nonNegative();
+    out[static_cast<std::size_t>(g)] = f.at(key).nonNegative();
   }
 }
 
@@ -58,8 +58,8 @@ void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
   } else {
     s.controller = ControllerKind::Pattern;
     const Field p = c.at("pattern");
-    if (p.raw().is_string()) s.controllerName = resolve(p.string(), baseDir);
-    else if (p.raw().is_object()) s.patternText = p.raw().dump(2);
+    if (p.isString()) s.controllerName = resolve(p.string(), baseDir);
+    else if (p.isObject()) s.patternText = p.dump(2);
     else p.fail("must be a pattern file path or an inline pattern object");
   }
   if (s.controller != ControllerKind::Pattern && s.controllerName.empty())
@@ -72,7 +72,7 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
     if (!integratorFromName(name, opt.step.integrator))
-      o.at("integrator").fail("unknown integrator '" + name + "' (valid: " + integratorNames() + ")");
+      o.at("integrator").fail("unknown integrator '" + excerptOf(name) + "' (valid: " + integratorNames() + ")");
   }
   if (o.has("dt_s")) opt.dt = o.at("dt_s").positive();
   if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").nonNegative();
@@ -110,21 +110,16 @@ const char* controllerKindName(ControllerKind k) {
 }
 
 Scenario parseScenario(const std::string& jsonText, const std::string& sourceName, const std::string& baseDir) {
-  json j;
-  try {
-    j = json::parse(jsonText);
-  } catch (const json::parse_error& e) {
-    throw Error(sourceName + ": invalid JSON: " + e.what());
-  }
-  const Field root(j, "", sourceName);
+  const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
+  const Field root = doc.root();
   root.allowKeys({"format", "version", "name", "description", "model", "duration_s", "seed", "controller", "overrides",
                   "outputs"});
 
   // header
   if (root.at("format").string() != kFormatName) root.at("format").fail(std::string("must be \"") + kFormatName + "\"");
   const Field version = root.at("version");
-  if (!version.raw().is_number_integer() || version.raw().get<int>() != kScenarioFormatVersion)
-    version.fail("unsupported version " + version.raw().dump() + " (this build reads " +
+  if (version.integerIn(0, std::numeric_limits<int>::max()) != kScenarioFormatVersion)
+    version.fail("unsupported version " + version.excerpt() + " (this build reads " +
                  std::to_string(kScenarioFormatVersion) + ")");
 
   Scenario s;
@@ -136,11 +131,7 @@ Scenario parseScenario(const std::string& jsonText, const std::string& sourceNam
     if (s.model != "default") s.model = resolve(s.model, baseDir);
   }
   s.duration = root.at("duration_s").positive();
-  if (root.has("seed")) {
-    const Field seed = root.at("seed");
-    if (!seed.raw().is_number_unsigned()) seed.fail("must be a non-negative integer, got " + seed.raw().dump());
-    s.seed = seed.raw().get<std::uint64_t>();
-  }
+  if (root.has("seed")) s.seed = root.at("seed").unsignedInteger();
   parseController(root.at("controller"), baseDir, s);
   if (root.has("overrides")) parseOverrides(root.at("overrides"), s.options);
   if (root.has("outputs")) parseOutputs(root.at("outputs"), s.outputs);

@@ -52,17 +52,17 @@ TEST(AnatomyParams, PresetsLoadInSiUnits) {
 
 TEST(AnatomyParams, NegativeLengthIsRejectedNamingTheField) {
   const std::string e = errorOf([](nlohmann::json& j) { j["ribs"][3]["arc_length_mm"] = -5; });
-  EXPECT_NE(e.find("male.json.ribs[3].arc_length_mm: must be > 0, got -5"), std::string::npos) << e;
+  EXPECT_NE(e.find("male.json: ribs[3].arc_length_mm: must be > 0, got -5"), std::string::npos) << e;
 }
 
 TEST(AnatomyParams, ZeroRibCountIsRejected) {
   const std::string e = errorOf([](nlohmann::json& j) { j["ribs"] = nlohmann::json::array(); });
-  EXPECT_NE(e.find("male.json.ribs: must list 12 rib levels, got 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("male.json: ribs: must list 12 rib levels, got 0"), std::string::npos) << e;
 }
 
 TEST(AnatomyParams, MissingFieldIsNamed) {
   const std::string e = errorOf([](nlohmann::json& j) { j["sternum"].erase("body_length_mm"); });
-  EXPECT_NE(e.find("male.json.sternum.body_length_mm: missing"), std::string::npos) << e;
+  EXPECT_NE(e.find("male.json: sternum.body_length_mm: missing"), std::string::npos) << e;
 }
 
 TEST(AnatomyParams, TooFewSpineSegmentsAreRejected) {
@@ -83,8 +83,39 @@ TEST(AnatomyParams, BadGainsAreRejectedNamingTheFile) {
     parseAnatomy(read(kDir + "male.json"), g.dump(), "male.json", "muscle_gains.json");
     FAIL() << "negative gain accepted";
   } catch (const sim::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("muscle_gains.json.groups.diaphragm.kpe"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("muscle_gains.json: groups.diaphragm.kpe"), std::string::npos) << e.what();
   }
+}
+
+// typos, duplicates, huge numbers and deep nesting in the anatomy and the gains give clear errors
+TEST(AnatomyParams, StrictJsonNamesTheKeyAndPath) {
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["sternum"]["body_lenght_mm"] = 1; }),
+            "male.json: sternum.body_lenght_mm: unknown field (did you mean body_length_mm?)");
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["ribs"][2]["posterior_ratio"] = 7; }),
+            "male.json: ribs[2].posterior_ratio: must be in (0, 5], got 7");
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["resolution"]["ring_nodes"] = 4294967312LL; }),
+            "male.json: resolution.ring_nodes: must be an integer in [8, 96], got 4294967312");
+  auto parseError = [](const std::string& anatomy, const std::string& gains) {
+    try {
+      parseAnatomy(anatomy, gains, "male.json", "muscle_gains.json");
+    } catch (const sim::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string male = read(kDir + "male.json");
+  const std::string gains = read(kDir + "muscle_gains.json");
+  EXPECT_EQ(parseError("{\"name\": \"a\", \"name\": \"b\"}", gains), "male.json: name: duplicate key");
+  EXPECT_EQ(parseError("{\"bone_density_kg_m3\": 1e400}", gains),
+            "male.json: bone_density_kg_m3: number 1e400 is beyond the range of a double");
+  EXPECT_NE(parseError(std::string(5000, '[') + std::string(5000, ']'), gains).find("nesting deeper than 64"),
+            std::string::npos);
+  nlohmann::json g = nlohmann::json::parse(gains);
+  g["groups"]["rectus"]["kpee"] = 1.0;
+  EXPECT_EQ(parseError(male, g.dump()), "muscle_gains.json: groups.rectus.kpee: unknown field (did you mean kpe?)");
+  g = nlohmann::json::parse(gains);
+  g["groups"]["biceps"] = g["groups"]["rectus"];
+  EXPECT_EQ(parseError(male, g.dump()), "muscle_gains.json: groups.biceps: unknown muscle group");
 }
 
 TEST(AnatomyParams, MalformedJsonAndMissingFileAreErrors) {

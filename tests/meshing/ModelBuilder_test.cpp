@@ -243,14 +243,49 @@ TEST(ModelBuilder, BuildIsDeterministicAndDirectoryIsReplacedWhole) {
   const fs::path dir = fs::temp_directory_path() / ("pneuma_mesh_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  { std::ofstream(dir / "model.json") << "{}"; }  // an earlier model
   { std::ofstream(dir / "stale.txt") << "old"; }
   writeModelDirectory(one, dir.string());
   EXPECT_FALSE(fs::exists(dir / "stale.txt"));
-  EXPECT_FALSE(fs::exists(dir.string() + ".tmp"));
+  for (const auto& e : fs::directory_iterator(dir.parent_path()))
+    EXPECT_EQ(e.path().filename().string().rfind(dir.filename().string() + ".", 0), std::string::npos) << e.path();
   EXPECT_TRUE(fs::exists(dir / "meshes" / "sternum.vtp"));
   const sim::Model loaded = sim::loadModel(dir.string());
   EXPECT_TRUE(sim::serializeModel(loaded) == sim::serializeModel(one.model)) << "model.json does not round-trip";
   fs::remove_all(dir);
+}
+
+// data loss: a folder that is not a model is never replaced, and siblings the writer did not make survive
+TEST(ModelBuilder, WriterReplacesOnlyModelDirectoriesAndLeavesSiblingsAlone) {
+  namespace fs = std::filesystem;
+  const BuiltModel one = buildModel(loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/female.json"));
+  const fs::path base = fs::temp_directory_path() / ("pneuma_mesh_siblings_" + std::to_string(::getpid()));
+  fs::remove_all(base);
+  const fs::path dir = base / "m";
+  fs::create_directories(dir);
+  { std::ofstream(dir / "thesis.tex") << "precious"; }
+  for (const char* sib : {".old", ".tmp"}) {
+    fs::create_directories(dir.string() + sib);
+    std::ofstream(dir.string() + sib + "/keep.txt") << "mine";
+  }
+  try {
+    writeModelDirectory(one, dir.string());
+    ADD_FAILURE() << "a non-model folder was replaced";
+  } catch (const sim::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a model directory"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::exists(dir / "thesis.tex"));
+
+  // an empty folder, given with a trailing slash, takes the model; then the model is rebuilt in place
+  fs::remove(dir / "thesis.tex");
+  writeModelDirectory(one, dir.string() + "/");
+  writeModelDirectory(one, dir.string() + "/");
+  EXPECT_TRUE(fs::exists(dir / "model.json"));
+  for (const char* sib : {".old", ".tmp"}) EXPECT_TRUE(fs::exists(dir.string() + sib + "/keep.txt")) << sib;
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(base)) entries += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(entries, 3);  // m, m.old, m.tmp: nothing left behind
+  fs::remove_all(base);
 }
 
 TEST_P(BuiltPresets, CorruptedModelJsonIsRejected) {

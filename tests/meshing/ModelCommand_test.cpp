@@ -72,6 +72,19 @@ TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {
   fs::remove_all(dir);
 }
 
+// data loss: a non-empty folder that is not a model is refused with its contents intact
+TEST(ModelCommand, BuildRefusesAFolderThatIsNotAModel) {
+  const fs::path out = scratch("notamodel");
+  fs::create_directories(out);
+  { std::ofstream(out / "notes.txt") << "keep me"; }
+  const test::CliResult r = runCli({"model", "build", "--anatomy", kAnatomy + "male.json", "--out", out.string() + "/", "--no-preview"});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("not a model directory (no model.json) and not empty; refusing to replace it"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(test::slurp((out / "notes.txt").string()), "keep me");
+  fs::remove_all(out);
+}
+
 TEST(ModelCommand, InfoOnAMissingModelIsBadInput) {
   const test::CliResult r = runCli({"model", "info", scratch("missing").string()});
   EXPECT_EQ(r.exitCode, 2);

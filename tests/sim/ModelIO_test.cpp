@@ -131,7 +131,7 @@ TEST(ModelIO, RejectsTruncatedJson) {
     parseModel(text.substr(0, text.size() / 2), "m.json");
     FAIL() << "truncated JSON was accepted";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("m.json: not valid JSON", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("m.json: invalid JSON", 0), 0u) << e.what();
   }
 }
 

@@ -1,32 +1,28 @@
 #include "pneuma/sim/pattern/Pattern.h"
 
-#include "../JsonField.h"
-
 #include "pneuma/sim/Error.h"
-
-#include <nlohmann/json.hpp>
+#include "pneuma/sim/JsonReader.h"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace pneuma::sim::pattern {
-
-using nlohmann::json;
 
 namespace {
 
 constexpr const char* kFormatName = "pneuma-pattern";
 
-using Node = sim::detail::JsonField;
+using Node = sim::JsonReader;
 
 CycleKind parseKind(const Node& n) {
   const std::string k = n.string();
   for (CycleKind kind : {CycleKind::Linear, CycleKind::Keyframe, CycleKind::Spline})
     if (k == cycleKindName(kind)) return kind;
-  n.fail("unknown cycle kind '" + k + "' (valid: linear, keyframe, spline)");
+  n.fail("unknown cycle kind '" + sim::excerptOf(k) + "' (valid: linear, keyframe, spline)");
 }
 
 CycleSpec parseCycle(const Node& n) {
@@ -37,7 +33,7 @@ CycleSpec parseCycle(const Node& n) {
 
   // time base: relative cycles need a rate, absolute ones take it from the keyframes
   const std::string time = n.stringOr("time", "relative");
-  if (time != "relative" && time != "absolute") n.at("time").fail("must be 'relative' or 'absolute', got '" + time + "'");
+  if (time != "relative" && time != "absolute") n.at("time").fail("must be 'relative' or 'absolute', got '" + sim::excerptOf(time) + "'");
   c.isRelative = time == "relative";
   if (c.isRelative) c.rate = n.at("rate_bpm").number();
   else if (n.has("rate_bpm")) n.at("rate_bpm").fail("not allowed with absolute time (the keyframes set the rate)");
@@ -85,7 +81,7 @@ Layer parseLayer(const Node& n) {
   Layer l;
   l.name = n.at("name").string();
   const Node repeat = n.at("repeat");
-  if (repeat.raw().is_string()) {
+  if (repeat.isString()) {
     if (repeat.string() != "infinite") repeat.fail("must be a count >= 1 or \"infinite\"");
     l.repetitions = kInfinite;
   } else {
@@ -139,21 +135,16 @@ std::vector<Layer> parseLayerSource(const Node& n, const std::string& resourceDi
 
 Pattern parseAt(const std::string& jsonText, const std::string& sourceName, const std::string& resourceDir,
                 int nesting) {
-  json j;
-  try {
-    j = json::parse(jsonText);
-  } catch (const json::parse_error& e) {
-    throw Error(sourceName + ": invalid JSON: " + e.what());
-  }
-  const Node root(j, "", sourceName);
+  const sim::JsonDocument doc = sim::JsonDocument::parse(jsonText, sourceName);
+  const Node root = doc.root();
   root.allowKeys({"format", "version", "name", "description", "layers", "affect", "timeline"});
 
   // header
   const Node format = root.at("format");
   if (format.string() != kFormatName) format.fail(std::string("must be \"") + kFormatName + "\"");
   const Node version = root.at("version");
-  if (version.number() != kPatternFormatVersion)
-    version.fail("unsupported version " + version.raw().dump() + " (this build reads " +
+  if (version.integerIn(0, std::numeric_limits<int>::max()) != kPatternFormatVersion)
+    version.fail("unsupported version " + version.excerpt() + " (this build reads " +
                  std::to_string(kPatternFormatVersion) + ")");
   Pattern p;
   p.name = root.at("name").string();
@@ -174,7 +165,7 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
         time.fail("events must be in time order (previous at " + std::to_string(p.timeline.back().time) + " s)");
       const std::string mode = e.stringOr("switch", "immediate");
       if (!switchModeFromName(mode, ev.mode))
-        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + mode + "\"");
+        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + sim::excerptOf(mode) + "\"");
       ev.layers = parseLayerSource(e, resourceDir, nesting, &ev.label);
       ev.label = e.stringOr("label", ev.label);
       p.timeline.push_back(std::move(ev));
@@ -188,7 +179,7 @@ Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, in
   if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
     std::string list;
     for (const std::string& v : valid) list += (list.empty() ? "" : ", ") + v;
-    throw Error("unknown affect '" + name + "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) +
+    throw Error("unknown affect '" + sim::excerptOf(name) + "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) +
                 ")");
   }
   const std::string path = affectPath(resourceDir, name);

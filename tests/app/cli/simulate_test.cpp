@@ -238,6 +238,39 @@ TEST(CliSimulate, SigintWritesValidPartialSummary) {
   EXPECT_TRUE(fs::exists(out + "/lung_volume.png"));
 }
 
+// data loss: a second run into the same --out keeps the first run's results unless --force is given
+TEST(CliSimulate, EarlierRunIsReplacedOnlyWithForce) {
+  const std::string out = freshOutDir("again");
+  const std::vector<std::string> run = {"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5",
+                                        "--settle", "0", "--output-rate", "10", "--out", out};
+  ASSERT_EQ(runCli(run).exitCode, 0);
+  const std::string first = slurp(out + "/summary.json");
+  std::vector<std::string> again = run;
+  again[6] = "1";  // a different run
+  auto r = runCli(again);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("holds an earlier run (summary.json); add --force"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out + "/summary.json"), first);
+  again.push_back("--force");
+  r = runCli(again);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/summary.json"))["duration_s"].get<double>(), 1.0);
+}
+
+// integers do not wrap: --seed -1 is not 2^64 - 1
+TEST(CliSimulate, NegativeOrOverflowingSeedIsRejected) {
+  for (const char* seed : {"-1", "18446744073709551616", "1.5"}) {
+    const std::string out = freshOutDir("seed");
+    auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--seed", seed,
+                     "--out", out});
+    EXPECT_EQ(r.exitCode, 2) << seed;
+    EXPECT_NE(r.err.find(std::string("--seed: must be an integer in [0, 18446744073709551615], got ") + seed),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out + "/summary.json"));
+  }
+}
+
 TEST(CliSimulate, UnknownStyleListsValidNames) {
   auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "yodel", "--duration", "1", "--out", freshOutDir("bad")});
   EXPECT_EQ(r.exitCode, 2);

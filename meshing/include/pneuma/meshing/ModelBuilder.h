@@ -35,9 +35,11 @@ struct BuiltModel {
 /// landmarks, then validates the model. Deterministic. @throws sim::Error naming the failing part.
 BuiltModel buildModel(const AnatomyParams& anatomy);
 
-/// Writes `built` to `dir` (model.json and meshes/*.vtp) through a temporary sibling directory that is
-/// renamed into place, so `dir` is either left untouched or holds the whole model.
-/// @throws sim::Error when the directory cannot be written.
+/// Writes `built` to `dir` (model.json and meshes/*.vtp) through a temporary sibling directory of its own
+/// ("<dir>.tmp-<pid>-<n>") that is renamed into place, so `dir` is either left untouched or holds the whole
+/// model. Only a missing or empty `dir` or an earlier model (one holding model.json) is replaced; nothing
+/// else beside it is touched. A trailing slash is allowed.
+/// @throws sim::Error when `dir` is not empty and not a model directory, or cannot be written.
 void writeModelDirectory(const BuiltModel& built, const std::string& dir);
 
 }  // namespace pneuma::meshing
