@@ -31,6 +31,7 @@ RunRecord::RunRecord(const sim::Model& model, bool hasVolumeTarget) : m_model(mo
 void RunRecord::append(const sim::Metrics& m, double targetFraction, double measuredFraction) {
   m_time.push_back(m.time);
   m_lungVolume.push_back(m.lungVolume);
+  m_abdomenVolume.push_back(m.abdomenVolume);
   m_gutVolumeError.push_back(m.gutVolumeError);
   m_activations.push_back(m.activations);
   m_tension.push_back(m.groupTension);
@@ -42,7 +43,7 @@ void RunRecord::append(const sim::Metrics& m, double targetFraction, double meas
 void RunRecord::writeCsv(const std::string& path) const {
   std::ostringstream csv;
   // header: one "name [unit]" column each
-  csv << "time [s],lung_volume [mL],gut_volume_error [%]";
+  csv << "time [s],lung_volume [mL],gut_volume_error [%],rib_cage_volume [mL],abdomen_volume [mL]";
   for (int g = 0; g < sim::kElementGroupCount; ++g)
     if (sim::isMuscleGroup(group(g))) csv << "," << sim::groupName(group(g)) << ".r [-]," << sim::groupName(group(g)) << ".alpha [-]";
   for (int g = 0; g < sim::kElementGroupCount; ++g) csv << "," << sim::groupName(group(g)) << ".tension [N]";
@@ -52,7 +53,8 @@ void RunRecord::writeCsv(const std::string& path) const {
 
   // rows
   for (std::size_t i = 0; i < m_time.size(); ++i) {
-    csv << formatNumber(m_time[i]) << "," << formatNumber(m_lungVolume[i] * kMl) << "," << formatNumber(m_gutVolumeError[i] * kPct);
+    csv << formatNumber(m_time[i]) << "," << formatNumber(m_lungVolume[i] * kMl) << "," << formatNumber(m_gutVolumeError[i] * kPct)
+        << "," << formatNumber((m_lungVolume[i] - m_abdomenVolume[i]) * kMl) << "," << formatNumber(m_abdomenVolume[i] * kMl);
     for (int g = 0; g < sim::kElementGroupCount; ++g)
       if (sim::isMuscleGroup(group(g)))
         csv << "," << formatNumber(m_activations[i][static_cast<std::size_t>(g)].r) << ","

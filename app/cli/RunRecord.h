@@ -32,6 +32,7 @@ class RunRecord {
   bool m_hasVolumeTarget;
   std::vector<double> m_time;             // [s]
   std::vector<double> m_lungVolume;       // [m^3]
+  std::vector<double> m_abdomenVolume;    // [m^3] Metrics::abdomenVolume (the rib-cage volume is the lung minus it)
   std::vector<double> m_gutVolumeError;   // [-]
   std::vector<sim::Activations> m_activations;
   std::vector<std::array<double, sim::kElementGroupCount>> m_tension;  // [N]

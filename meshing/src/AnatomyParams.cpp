@@ -13,6 +13,7 @@ namespace {
 
 constexpr double kMm = 1e-3;                 // [m/mm]
 constexpr double kDeg = 3.14159265358979323846 / 180.0;  // [rad/deg]
+constexpr double kPaPerCmH2O = 98.0665;  // [Pa/cmH2O]
 
 using Reader = sim::JsonReader;
 
@@ -40,7 +41,7 @@ std::string readText(const std::string& path) {
 
 RibLevel readRib(const Reader& r, std::size_t i) {
   r.allowKeys({"level", "arc_length_mm", "posterior_ratio", "anterior_ratio", "end_angle_deg", "inclination_deg",
-               "lateral_tilt_deg", "height_mm", "thickness_mm"});
+               "lateral_tilt_deg", "height_mm", "thickness_mm", "neck_axis_deg"});
   if (r.has("level") && r.at("level").integerIn(1, 12) != static_cast<std::int64_t>(i + 1))
     r.at("level").fail("must be " + std::to_string(i + 1) + " (the ribs are listed in order)");
   RibLevel rib;
@@ -52,6 +53,7 @@ RibLevel readRib(const Reader& r, std::size_t i) {
   rib.lateralTilt = r.at("lateral_tilt_deg").numberIn(-30.0, 60.0) * kDeg;
   rib.height = mm(r.at("height_mm"), 40.0);
   rib.thickness = mm(r.at("thickness_mm"), 20.0);
+  rib.neckAxis = r.at("neck_axis_deg").numberIn(0.0, 90.0) * kDeg;
   if (rib.thickness > rib.height) r.at("thickness_mm").fail("must not exceed height_mm");
   return rib;
 }
@@ -138,7 +140,7 @@ Resolution readResolution(const Reader& r) {
 }
 
 Gains readGains(const Reader& r) {
-  r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s", "gut_wall_mass_kg",
+  r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o", "gut_wall_mass_kg",
                "diaphragm_mass_kg", "joints"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
@@ -159,12 +161,15 @@ Gains readGains(const Reader& r) {
     groups.at("cartilage").at("kpe").fail("must be > 0 (cartilage holds the ribs to the sternum)");
   g.gutKappa = r.at("gut_kappa_pa").positiveAtMost(1e9);
   g.gutDrag = r.at("gut_drag_per_s").numberIn(0.0, 1e3);
+  g.lungRecoil = r.at("lung_recoil_cmh2o").numberIn(0.0, 30.0) * kPaPerCmH2O;
+  g.lungCompliance = r.at("lung_compliance_l_per_cmh2o").numberIn(0.0, 2.0) * 1e-3 / kPaPerCmH2O;
   g.wallMass = r.at("gut_wall_mass_kg").positiveAtMost(100.0);
   g.diaphragmMass = r.at("diaphragm_mass_kg").positiveAtMost(10.0);
   const Reader joints = r.at("joints");
-  joints.allowKeys({"costovertebral_friction", "costovertebral_stiffness", "spine_friction", "spine_stiffness"});
+  joints.allowKeys({"costovertebral_friction", "costovertebral_stiffness", "costotransverse_stiffness", "spine_friction", "spine_stiffness"});
   g.costovertebralFriction = joints.at("costovertebral_friction").numberIn(0.0, 1e6);
   g.costovertebralStiffness = joints.at("costovertebral_stiffness").numberIn(0.0, 1e6);
+  g.costotransverseStiffness = joints.at("costotransverse_stiffness").numberIn(0.0, 1e6);
   g.spineFriction = joints.at("spine_friction").numberIn(0.0, 1e6);
   g.spineStiffness = joints.at("spine_stiffness").numberIn(0.0, 1e6);
   return g;

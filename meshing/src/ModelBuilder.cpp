@@ -54,6 +54,8 @@ void buildJoints(const AnatomyParams& a, const Skeleton& sk, sim::Joints& j) {
   j.anchor.resize(3, n);
   j.friction.resize(n);
   j.stiffness.resize(n);
+  j.axis.resize(3, n);
+  j.lockStiffness.resize(n);
   for (int i = 0; i < n; ++i) {
     const JointSpec& s = sk.joints[static_cast<std::size_t>(i)];
     j.name.push_back(s.name);
@@ -62,6 +64,8 @@ void buildJoints(const AnatomyParams& a, const Skeleton& sk, sim::Joints& j) {
     j.anchor.col(i) = s.anchor;
     j.friction(i) = s.isSpine ? a.gains.spineFriction : a.gains.costovertebralFriction;
     j.stiffness(i) = s.isSpine ? a.gains.spineStiffness : a.gains.costovertebralStiffness;
+    j.axis.col(i) = s.isSpine ? Eigen::Vector3d::UnitX() : s.axis;
+    j.lockStiffness(i) = s.isSpine ? 0.0 : a.gains.costotransverseStiffness;
   }
 }
 
@@ -156,6 +160,8 @@ BuiltModel buildModel(const AnatomyParams& a) {
   buildGutNodes(a, gut, out);
   buildElements(a, sk, gut, out.model);
   buildCavity(sk, gut, out.model);
+  out.model.cavity.recoilPressure = a.gains.lungRecoil;
+  out.model.cavity.compliance = a.gains.lungCompliance;
   buildLandmarks(a, sk, gut, out.model);
 
   sim::validateModel(out.model);

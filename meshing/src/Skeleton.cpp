@@ -283,9 +283,12 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     sk.rib.push_back({br, bl});
     sk.ribCurve.push_back({right, left});
     if (!isFixed) {
+      // the rib-neck axis runs from the head laterally and backward to the tubercle
+      const double phi = a.ribs[static_cast<std::size_t>(level - 1)].neckAxis;
+      const Eigen::Vector3d axisRight(std::cos(phi), -std::sin(phi), 0.0), axisLeft(-std::cos(phi), -std::sin(phi), 0.0);
       const int parent = sk.thoracicSegment[static_cast<std::size_t>(level - 1)];
-      sk.joints.push_back({"costovertebral_" + n + "_right", parent, br, right.centre.front(), false});
-      sk.joints.push_back({"costovertebral_" + n + "_left", parent, bl, left.centre.front(), false});
+      sk.joints.push_back({"costovertebral_" + n + "_right", parent, br, right.centre.front(), false, axisRight});
+      sk.joints.push_back({"costovertebral_" + n + "_left", parent, bl, left.centre.front(), false, axisLeft});
     }
   }
 

@@ -43,6 +43,7 @@ struct JointSpec {
   int child = -1;
   Eigen::Vector3d anchor{0, 0, 0};  ///< [m] world
   bool isSpine = false;             ///< spine joint (else costovertebral)
+  Eigen::Vector3d axis{1, 0, 0};    ///< [-] unit rib-neck axis, world at rest (costovertebral joints only)
 };
 
 /// The whole rest-pose skeleton.

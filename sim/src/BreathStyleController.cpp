@@ -30,6 +30,9 @@ void requireRange(const std::string& field, double v, double lo, double hi, bool
 
 GroupActivation& slot(Activations& a, ElementGroup g) { return a[static_cast<std::size_t>(g)]; }
 
+constexpr double kExpiratoryRise = 0.3;  // [-] part of the exhale over which the expiratory drive rises
+constexpr double kExpiratoryFall = 0.15; // [-] part at the exhale's end over which it falls back to 0
+
 // [-] 0 -> 1 over `rise` seconds after t = 0: s(x) = 3x^2 - 2x^3, x = t / rise clamped to [0, 1]; a step when rise = 0
 double smoothRise(double t, double rise) {
   if (rise <= 0.0) return t >= 0.0 ? 1.0 : 0.0;
@@ -46,9 +49,8 @@ void validateBreathStyle(const BreathStyle& s) {
   requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
   requireRange(p + "diaphragm_r", s.diaphragmR, 0.0, 1.5, true);
   requireRange(p + "diaphragm_alpha", s.diaphragmAlpha, 0.0, 1.0, true);
-  const double period = 60.0 / s.breathsPerMinute;  // [s]
-  requireRange(p + "diaphragm_rise_time_s", s.diaphragmRiseTime, 0.0,
-               period * std::min(s.inhaleFraction, 1.0 - s.inhaleFraction), false);
+  requireRange(p + "drive_decay_fraction", s.driveDecayFraction, 0.0, 1.0, true);
+  requireRange(p + "internal_intercostal_alpha", s.internalIntercostalAlpha, 0.0, 1.0, false);
   requireRange(p + "intercostal_alpha", s.intercostalAlpha, 0.0, 1.0, true);
   requireRange(p + "intercostal_amplitude", s.intercostalAmplitude, 0.0, 1.5, false);
   requireRange(p + "intercostal_mean - intercostal_amplitude", s.intercostalMean - s.intercostalAmplitude, 0.0, 1.5,
@@ -63,8 +65,8 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   const JsonDocument doc = JsonDocument::parse(jsonText, source);
   const JsonReader j = doc.root();
   j.allowKeys({"name", "note", "breaths_per_minute", "inhale_fraction", "diaphragm_r", "diaphragm_alpha",
-               "diaphragm_rise_time_s", "intercostal_mean", "intercostal_amplitude", "intercostal_alpha", "rectus_r",
-               "rectus_active", "cycles"});
+               "drive_decay_fraction", "intercostal_mean", "intercostal_amplitude", "intercostal_alpha",
+               "internal_intercostal_alpha", "rectus_r", "rectus_active", "cycles"});
   BreathStyle s;
   // required fields, then optional ones that keep their defaults when absent
   s.name = j.at("name").string();
@@ -75,8 +77,9 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   s.intercostalAmplitude = j.at("intercostal_amplitude").number();
   s.inhaleFraction = j.numberOr("inhale_fraction", s.inhaleFraction);
   s.diaphragmAlpha = j.numberOr("diaphragm_alpha", s.diaphragmAlpha);
-  s.diaphragmRiseTime = j.numberOr("diaphragm_rise_time_s", s.diaphragmRiseTime);
+  s.driveDecayFraction = j.numberOr("drive_decay_fraction", s.driveDecayFraction);
   s.intercostalAlpha = j.numberOr("intercostal_alpha", s.intercostalAlpha);
+  s.internalIntercostalAlpha = j.numberOr("internal_intercostal_alpha", s.internalIntercostalAlpha);
   s.rectusR = j.numberOr("rectus_r", s.rectusR);
   if (j.has("rectus_active")) s.rectusActive = j.at("rectus_active").boolean();
   if (j.has("cycles")) s.cycles = static_cast<int>(j.at("cycles").integerIn(0, std::numeric_limits<int>::max()));
@@ -95,10 +98,11 @@ std::string serializeBreathStyle(const BreathStyle& s) {
                             {"inhale_fraction", s.inhaleFraction},
                             {"diaphragm_r", s.diaphragmR},
                             {"diaphragm_alpha", s.diaphragmAlpha},
-                            {"diaphragm_rise_time_s", s.diaphragmRiseTime},
+                            {"drive_decay_fraction", s.driveDecayFraction},
                             {"intercostal_mean", s.intercostalMean},
                             {"intercostal_amplitude", s.intercostalAmplitude},
                             {"intercostal_alpha", s.intercostalAlpha},
+                            {"internal_intercostal_alpha", s.internalIntercostalAlpha},
                             {"rectus_active", s.rectusActive},
                             {"rectus_r", s.rectusR},
                             {"cycles", s.cycles}};
@@ -140,28 +144,36 @@ BreathStyleController::BreathStyleController(BreathStyle style) : m_style(std::m
   validateBreathStyle(m_style);
 }
 
+double inspiratoryDrive(const BreathStyle& s, double phase) {
+  if (phase < s.inhaleFraction) return 0.5 * (1.0 - std::cos(kPi * phase / s.inhaleFraction));
+  const double x = (phase - s.inhaleFraction) / ((1.0 - s.inhaleFraction) * s.driveDecayFraction);
+  return 1.0 - smoothRise(x, 1.0);
+}
+
+double expiratoryDrive(const BreathStyle& s, double phase) {
+  if (phase < s.inhaleFraction) return 0.0;
+  const double x = (phase - s.inhaleFraction) / (1.0 - s.inhaleFraction);  // [-] 0 to 1 over the exhale
+  return smoothRise(x, kExpiratoryRise) * (1.0 - smoothRise(x - 1.0 + kExpiratoryFall, kExpiratoryFall));
+}
+
 Activations BreathStyleController::activations(double t, const Metrics& /*latest*/) {
   const BreathStyle& s = m_style;
   const double period = 60.0 / s.breathsPerMinute;  // [s]
   // after a finite number of cycles, hold the cycle-start posture
   const double tc = (s.cycles > 0 && t >= s.cycles * period) ? 0.0 : std::max(t, 0.0);
   const double phase = std::fmod(tc, period) / period;  // [-] 0 = start of inhale
-  // the cycle-start posture itself (settling, holds) is the relaxed end of an exhale: diaphragm and rectus off
+  // the cycle-start posture itself (settling, holds) is the relaxed end of an exhale: every muscle off
   const bool isRest = tc == 0.0;
-  const bool inhale = !isRest && phase < s.inhaleFraction;
-  const double c = std::cos(2.0 * kPi * phase);
-
+  const double in = isRest ? 0.0 : inspiratoryDrive(s, phase);
+  const double out = isRest ? 0.0 : expiratoryDrive(s, phase);
   Activations a = relaxedActivations();
-  // diaphragm: step function, on during inhale, its edges smoothed over the rise time
-  const double sinceInhale = phase * period, sinceExhale = sinceInhale - s.inhaleFraction * period;  // [s]
-  const double on = isRest ? 0.0 : inhale ? smoothRise(sinceInhale, s.diaphragmRiseTime)
-                                          : 1.0 - smoothRise(sinceExhale, s.diaphragmRiseTime);
-  slot(a, ElementGroup::Diaphragm) = on > 0.0 ? GroupActivation{s.diaphragmR, on * s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
-  // intercostals: out-of-phase sinusoids, outer contract (r drops) on inhale, inner on exhale
-  slot(a, ElementGroup::IntercostalExternal) = {s.intercostalMean + s.intercostalAmplitude * c, s.intercostalAlpha};
-  slot(a, ElementGroup::IntercostalInternal) = {s.intercostalMean - s.intercostalAmplitude * c, s.intercostalAlpha};
-  // rectus: forced exhale only, during the exhale part
-  if (s.rectusActive && !isRest && !inhale) slot(a, ElementGroup::Rectus) = {s.rectusR, 1.0};
+  // inspiratory muscles: diaphragm and external intercostals share the inspiratory drive
+  slot(a, ElementGroup::Diaphragm) = in > 0.0 ? GroupActivation{s.diaphragmR, in * s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
+  const double ric = s.intercostalMean - s.intercostalAmplitude;  // [-] Table 2's deepest intercostal contraction
+  slot(a, ElementGroup::IntercostalExternal) = {ric, in * s.intercostalAlpha};
+  // expiratory muscles: internal intercostals and rectus on the expiratory drive (quiet breathing: none)
+  slot(a, ElementGroup::IntercostalInternal) = {ric, out * s.internalIntercostalAlpha};
+  if (s.rectusActive) slot(a, ElementGroup::Rectus) = {s.rectusR, out};
   return a;
 }
 

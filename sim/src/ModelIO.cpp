@@ -181,7 +181,8 @@ void validateModel(const Model& m) {
   // joints
   const int nJ = m.joints.size();
   if (static_cast<int>(m.joints.name.size()) != nJ || static_cast<int>(m.joints.child.size()) != nJ ||
-      m.joints.anchor.cols() != nJ || m.joints.friction.size() != nJ || m.joints.stiffness.size() != nJ)
+      m.joints.anchor.cols() != nJ || m.joints.friction.size() != nJ || m.joints.stiffness.size() != nJ ||
+      m.joints.axis.cols() != nJ || m.joints.lockStiffness.size() != nJ)
     invalid("joints", "inconsistent array sizes");
   for (int i = 0; i < nJ; ++i) {
     const std::string f = "joints[" + std::to_string(i) + "]";
@@ -194,6 +195,9 @@ void validateModel(const Model& m) {
     requireFinite(m.joints.anchor.col(i), f + ".anchor");
     requireNonNegative(m.joints.friction[i], f + ".friction");
     requireNonNegative(m.joints.stiffness[i], f + ".stiffness");
+    requireNonNegative(m.joints.lockStiffness[i], f + ".lock_stiffness");
+    requireFinite(m.joints.axis.col(i), f + ".axis");
+    if (std::abs(m.joints.axis.col(i).norm() - 1.0) > 1e-6) invalid(f + ".axis", "must be a unit vector");
   }
 
   // nodes and gut
@@ -233,6 +237,8 @@ void validateModel(const Model& m) {
   // cavity
   validateAnchors(m.cavity.vertices, "cavity.vertices", nB, nN);
   validateTriangles(m.cavity.triangles, "cavity.triangles", m.cavity.vertices.size());
+  requireNonNegative(m.cavity.recoilPressure, "cavity.recoil_pressure");
+  requireNonNegative(m.cavity.compliance, "cavity.compliance");
 
   // landmarks
   if (static_cast<int>(m.landmarks.name.size()) != m.landmarks.points.size())
@@ -292,9 +298,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.joints.anchor.resize(3, static_cast<Eigen::Index>(nJ));
   m.joints.friction.resize(static_cast<Eigen::Index>(nJ));
   m.joints.stiffness.resize(static_cast<Eigen::Index>(nJ));
+  m.joints.axis.resize(3, static_cast<Eigen::Index>(nJ));
+  m.joints.lockStiffness.resize(static_cast<Eigen::Index>(nJ));
   for (std::size_t i = 0; i < nJ; ++i) {
     const Reader j = joints[i];
-    j.allowKeys({"name", "parent", "child", "anchor", "friction", "stiffness"});
+    j.allowKeys({"name", "parent", "child", "anchor", "friction", "stiffness", "axis", "lock_stiffness"});
     const auto k = static_cast<Eigen::Index>(i);
     m.joints.name.push_back(j.at("name").string());
     m.joints.parent.push_back(j.at("parent").integer());
@@ -302,6 +310,9 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     m.joints.anchor.col(k) = j.at("anchor").vec3();
     m.joints.friction[k] = j.at("friction").number();
     m.joints.stiffness[k] = j.at("stiffness").number();
+    // optional: models written before the rib-neck axes have ball joints (docs/model-format.md)
+    m.joints.axis.col(k) = j.has("axis") ? j.at("axis").vec3() : Eigen::Vector3d::UnitX();
+    m.joints.lockStiffness[k] = j.has("lock_stiffness") ? j.at("lock_stiffness").number() : 0.0;
   }
 
   // nodes
@@ -353,7 +364,10 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
 
   // cavity
   const Reader cavity = root.at("cavity");
-  cavity.allowKeys({"vertices", "triangles"});
+  cavity.allowKeys({"vertices", "triangles", "recoil_pressure", "compliance"});
+  // optional: models written before the pleural pressure have none (docs/model-format.md)
+  if (cavity.has("recoil_pressure")) m.cavity.recoilPressure = cavity.at("recoil_pressure").number();
+  if (cavity.has("compliance")) m.cavity.compliance = cavity.at("compliance").number();
   const Reader cavVerts = cavity.at("vertices");
   for (std::size_t i = 0; i < cavVerts.size(); ++i) readAnchor(cavVerts[i], m.cavity.vertices);
   const Reader cavTris = cavity.at("triangles");
@@ -421,7 +435,9 @@ std::string serializeModel(const Model& m) {
                       {"child", m.joints.child[static_cast<std::size_t>(i)]},
                       {"anchor", vec(m.joints.anchor.col(i))},
                       {"friction", m.joints.friction[i]},
-                      {"stiffness", m.joints.stiffness[i]}});
+                      {"stiffness", m.joints.stiffness[i]},
+                      {"axis", vec(m.joints.axis.col(i))},
+                      {"lock_stiffness", m.joints.lockStiffness[i]}});
   }
   doc["joints"] = std::move(joints);
 
@@ -454,7 +470,10 @@ std::string serializeModel(const Model& m) {
 
   json cavVerts = json::array();
   for (int i = 0; i < m.cavity.vertices.size(); ++i) cavVerts.push_back(writeAnchor(m.cavity.vertices, i));
-  doc["cavity"] = {{"vertices", std::move(cavVerts)}, {"triangles", triangles(m.cavity.triangles)}};
+  doc["cavity"] = {{"vertices", std::move(cavVerts)},
+                   {"triangles", triangles(m.cavity.triangles)},
+                   {"recoil_pressure", m.cavity.recoilPressure},
+                   {"compliance", m.cavity.compliance}};
 
   json landmarks = json::array();
   for (int i = 0; i < m.landmarks.points.size(); ++i) {

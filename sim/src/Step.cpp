@@ -266,6 +266,34 @@ void accumulateGutPressure(const Model& model, const State& s, const StepOptions
   if (w.gutPressure > 0.0) w.nodeForce += w.gutPressure * w.gutGradient;
 }
 
+// [Pa] pleural pressure Ppl = min(0, -(P0 + (V - Vr) / C)) of Cavity, 0 when it has no compliance
+double pleuralPressure(const Cavity& c, double volume, double restVolume) {
+  if (!(c.compliance > 0.0)) return 0.0;
+  return std::min(0.0, -(c.recoilPressure + (volume - restVolume) / c.compliance));
+}
+
+// pleural pressure on the cavity walls, f_i = Ppl dV/dx_i, carried to the bones and gut nodes the vertices are bound to
+void accumulatePleuralPressure(const Model& model, const State& s, StepWork& w) {
+  const Cavity& c = model.cavity;
+  if (!(c.compliance > 0.0) || c.triangles.cols() == 0) return;
+  anchorPositions(c.vertices, s, w.cavityPosition);
+  w.pleuralPressure = pleuralPressure(c, enclosedVolume(w.cavityPosition, c.triangles), w.restCavityVolume);
+  if (w.pleuralPressure == 0.0) return;
+  w.cavityGradient.setZero(3, w.cavityPosition.cols());
+  addVolumeGradient(w.cavityPosition, c.triangles, w.pleuralPressure, w.cavityGradient);
+  for (int i = 0; i < c.vertices.size(); ++i) {
+    const Vector3d f = w.cavityGradient.col(i);
+    const int b = c.vertices.body[at(i)];
+    if (b >= 0) {
+      w.bodyForce.col(b) += f;
+      w.bodyTorque.col(b) += (w.cavityPosition.col(i) - s.bodyPosition.col(b)).cross(f);
+      continue;
+    }
+    for (int k = 0; k < 3; ++k)
+      if (c.vertices.nodes(k, i) >= 0) w.nodeForce.col(c.vertices.nodes(k, i)) += c.vertices.weights(k, i) * f;
+  }
+}
+
 // rotation vector [rad] of the child relative to the parent, world frame (zero at rest)
 Vector3d jointRotation(const State& s, int parent, int child) {
   const Eigen::Quaterniond rel = s.bodyOrientation[at(parent)].conjugate() * s.bodyOrientation[at(child)];
@@ -273,7 +301,13 @@ Vector3d jointRotation(const State& s, int parent, int child) {
   return s.bodyOrientation[at(parent)] * (aa.angle() * aa.axis());
 }
 
-// joint friction tau = -mu (w_child - w_parent) (Eq. 3) and passive rotational stiffness tau = -k theta;
+// [N m/rad] joint i's rotational stiffness K = k I + k_lock (I - a a^T), a = R_parent axis (world; Joints)
+Matrix3d jointStiffness(const Joints& j, int i, const Matrix3d& parentRotation) {
+  const Vector3d a = parentRotation * j.axis.col(i);
+  return j.stiffness(i) * Matrix3d::Identity() + j.lockStiffness(i) * (Matrix3d::Identity() - a * a.transpose());
+}
+
+// joint friction tau = -mu (w_child - w_parent) (Eq. 3) and passive rotational stiffness tau = -K theta;
 // the friction is left out for symplectic Euler, which integrates it implicitly (integrateJointFriction)
 void accumulateJointTorques(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
@@ -282,7 +316,7 @@ void accumulateJointTorques(const Model& model, const State& s, const StepOption
     const int p = j.parent[at(i)], c = j.child[at(i)];
     const double mu = j.friction(i) * frictionScale;
     Vector3d tau = -mu * (s.bodyAngularVelocity.col(c) - s.bodyAngularVelocity.col(p));
-    if (j.stiffness(i) > 0.0) tau -= j.stiffness(i) * jointRotation(s, p, c);
+    if (j.stiffness(i) > 0.0 || j.lockStiffness(i) > 0.0) tau -= jointStiffness(j, i, w.rotation[at(p)]) * jointRotation(s, p, c);
     w.bodyTorque.col(c) += tau;
     w.bodyTorque.col(p) -= tau;
   }
@@ -431,9 +465,10 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
   // joint springs and friction act on the relative angular velocity
   const Joints& j = model.joints;
   for (int i = 0; i < j.size(); ++i) {
-    const double kj = kScale * j.stiffness(i) + dScale * j.friction(i) * o.jointFrictionScale;
-    if (kj == 0.0) continue;
+    const double mu = dScale * j.friction(i) * o.jointFrictionScale;
+    if (mu == 0.0 && (kScale == 0.0 || (j.stiffness(i) == 0.0 && j.lockStiffness(i) == 0.0))) continue;
     const int p = j.parent[at(i)], c = j.child[at(i)];
+    const Matrix3d kj = kScale * jointStiffness(j, i, w.rotation[at(p)]) + mu * Matrix3d::Identity();
     const Vector3d y = kj * (u.segment<3>(6 * c + 3) - u.segment<3>(6 * p + 3));
     out.segment<3>(6 * c + 3) += y;
     out.segment<3>(6 * p + 3) -= y;
@@ -503,12 +538,13 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
   // joint springs and friction on relative angular velocity
   const Joints& j = model.joints;
   for (int i = 0; i < j.size(); ++i) {
-    const double kj = dt * dt * j.stiffness(i) + dt * j.friction(i) * o.jointFrictionScale;
     const int p = j.parent[at(i)], ch = j.child[at(i)];
-    a.block<3, 3>(6 * ch + 3, 6 * ch + 3).diagonal().array() += kj;
-    a.block<3, 3>(6 * p + 3, 6 * p + 3).diagonal().array() += kj;
-    a.block<3, 3>(6 * ch + 3, 6 * p + 3).diagonal().array() -= kj;
-    a.block<3, 3>(6 * p + 3, 6 * ch + 3).diagonal().array() -= kj;
+    const Matrix3d kj =
+        dt * dt * jointStiffness(j, i, w.rotation[at(p)]) + dt * j.friction(i) * o.jointFrictionScale * Matrix3d::Identity();
+    a.block<3, 3>(6 * ch + 3, 6 * ch + 3) += kj;
+    a.block<3, 3>(6 * p + 3, 6 * p + 3) += kj;
+    a.block<3, 3>(6 * ch + 3, 6 * p + 3) -= kj;
+    a.block<3, 3>(6 * p + 3, 6 * ch + 3) -= kj;
   }
   // restrict to the joint tree's coordinates: J^T A by columns (fixed bodies' columns are not needed), then
   // J^T A J as the gathered columns of its transpose (the free columns only)
@@ -936,6 +972,7 @@ void computeForces(const Model& model, const State& s, const Activations& act, c
   updateBodyFrames(model, s, w);
   accumulateElementForces(model, s, act, o, w);
   accumulateGutPressure(model, s, o, w);
+  accumulatePleuralPressure(model, s, w);
   accumulateJointTorques(model, s, o, w);
   accumulateVisceralDrag(model, s, o, w);
   accumulateGravityAndGyroscopic(model, s, o, w);
@@ -1003,6 +1040,11 @@ StepWork makeStepWork(const Model& model) {
   w.restGutVolume = model.gut.triangles.cols() > 0 ? enclosedVolume(model.nodes.rest, model.gut.triangles) : 0.0;
   w.gutVolume = w.restGutVolume;
   if (model.nodes.size() > 0) w.restGutCentroid = model.nodes.rest.rowwise().mean();
+  if (model.cavity.triangles.cols() > 0) {
+    const State rest = makeInitialState(model);
+    anchorPositions(model.cavity.vertices, rest, w.cavityPosition);
+    w.restCavityVolume = enclosedVolume(w.cavityPosition, model.cavity.triangles);
+  }
   std::vector<int> wall;
   for (Eigen::Index f = 0; f < model.gut.triangles.cols(); ++f) {
     int count = 0;
@@ -1177,9 +1219,18 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
     elastic += isMuscleGroup(el.group[at(e)]) ? muscleEnergy(l, p) : springEnergy(l, p.restLength, p.kpe);
   }
   if (work.restGutVolume > 0.0) elastic += gutEnergy(kappa, work.restGutVolume, out.gutVolume);
+  // lung recoil: E = P0 dV + dV^2 / (2 C) while Ppl < 0, the potential of the pleural pressure
+  if (model.cavity.compliance > 0.0) {
+    const double dv = out.lungVolume - work.restCavityVolume;
+    const double c = model.cavity.compliance, p0 = model.cavity.recoilPressure;
+    const double dvZero = -p0 * c;  // [m^3] where Ppl reaches 0
+    const double d = std::max(dv, dvZero);
+    elastic += p0 * (d - dvZero) + (d * d - dvZero * dvZero) / (2.0 * c);
+  }
   for (int i = 0; i < model.joints.size(); ++i) {
-    const double th = jointRotation(state, model.joints.parent[at(i)], model.joints.child[at(i)]).norm();
-    elastic += 0.5 * model.joints.stiffness(i) * th * th;
+    const int p = model.joints.parent[at(i)];
+    const Vector3d th = jointRotation(state, p, model.joints.child[at(i)]);
+    elastic += 0.5 * th.dot(jointStiffness(model.joints, i, state.bodyOrientation[at(p)].toRotationMatrix()) * th);
   }
   out.kineticEnergy = kinetic;
   out.elasticEnergy = elastic;

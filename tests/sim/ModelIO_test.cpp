@@ -34,6 +34,8 @@ Model tinyModel() {
   m.joints.anchor = Eigen::Vector3d(0.05, 0.0, 0.0);
   m.joints.friction = Eigen::VectorXd::Constant(1, 0.01);
   m.joints.stiffness = Eigen::VectorXd::Zero(1);
+  m.joints.axis = Eigen::Vector3d(-0.6, -0.8, 0.0);
+  m.joints.lockStiffness = Eigen::VectorXd::Constant(1, 50.0);
 
   m.nodes.rest.resize(3, 4);
   m.nodes.rest << 0, 1, 0, 0,  //

@@ -113,29 +113,39 @@ TEST(SimulationInput, BlowUpIsReportedWithCause) {
   expectError([&] { sim.advance(2.0); }, "too large for the stiffness");
 }
 
-// Section 7 / Table 2: diaphragm step, out-of-phase intercostal sinusoids, rectus only when forced
-TEST(BreathStyleController, SignalsFollowSection7) {
-  BreathStyleController c(loadBreathStyle("calm"));
-  const double period = 4.0;
+// the muscles take turns: diaphragm and external intercostals on the inspiratory drive, internal intercostals
+// quiet in calm breathing, rectus only in the forced exhale's expiration
+TEST(BreathStyleController, InspiratoryAndExpiratoryMusclesTakeTurns) {
+  BreathStyle calm = loadBreathStyle("calm");
+  calm.driveDecayFraction = 0.6;  // the drive is off for the last 40 % of the exhale
+  BreathStyleController c(calm);
+  const double period = 4.0, inhale = 1.6, exhale = 2.4;  // [s]
   const Metrics none;
   auto at = [&](double t, ElementGroup g) { return c.activations(t, none)[static_cast<std::size_t>(g)]; };
-  EXPECT_EQ(at(0.1 * period, ElementGroup::Diaphragm).alpha, 1.0);
-  EXPECT_DOUBLE_EQ(at(0.1 * period, ElementGroup::Diaphragm).r, 0.85);
-  EXPECT_EQ(at(0.6 * period, ElementGroup::Diaphragm).alpha, 0.0);
-  // outer intercostals: r = 1.0 at the start of inhale, 0.84 at its end; inner the opposite
-  EXPECT_NEAR(at(0.0, ElementGroup::IntercostalExternal).r, 1.0, 1e-12);
-  EXPECT_NEAR(at(0.5 * period, ElementGroup::IntercostalExternal).r, 0.84, 1e-12);
-  EXPECT_NEAR(at(0.0, ElementGroup::IntercostalInternal).r, 0.84, 1e-12);
-  EXPECT_NEAR(at(0.5 * period, ElementGroup::IntercostalInternal).r, 1.0, 1e-12);
-  for (double t = 0.0; t < period; t += 0.1) {
+  // a rounded rise over the inhale: (1 - cos(pi t / Ti)) / 2, 0.5 at mid-inhale, full at its end
+  EXPECT_NEAR(at(0.5 * inhale, ElementGroup::Diaphragm).alpha, 0.5 * calm.diaphragmAlpha, 1e-12);
+  EXPECT_NEAR(at(inhale - 1e-9, ElementGroup::Diaphragm).alpha, calm.diaphragmAlpha, 1e-9);
+  EXPECT_DOUBLE_EQ(at(0.5 * inhale, ElementGroup::Diaphragm).r, calm.diaphragmR);
+  EXPECT_NEAR(at(0.5 * inhale, ElementGroup::IntercostalExternal).alpha, 0.5 * calm.intercostalAlpha, 1e-12);
+  EXPECT_NEAR(at(0.5 * inhale, ElementGroup::IntercostalExternal).r, calm.intercostalMean - calm.intercostalAmplitude, 1e-12);
+  // post-inspiratory braking: half-way down at half the decay window, off after it
+  EXPECT_NEAR(at(inhale + 0.5 * calm.driveDecayFraction * exhale, ElementGroup::Diaphragm).alpha, 0.5 * calm.diaphragmAlpha, 1e-9);
+  EXPECT_EQ(at(inhale + 1.01 * calm.driveDecayFraction * exhale, ElementGroup::Diaphragm).alpha, 0.0);
+  // the drive is continuous: no step larger than a smooth curve's over 1 ms
+  for (double t = 0.001; t < 2 * period; t += 0.001)
+    EXPECT_LT(std::abs(at(t, ElementGroup::Diaphragm).alpha - at(t - 0.001, ElementGroup::Diaphragm).alpha), 0.005) << t;
+  for (double t = 0.0; t < period; t += 0.05) {
     EXPECT_EQ(at(t, ElementGroup::Rectus).alpha, 0.0);
-    EXPECT_NEAR(at(t, ElementGroup::IntercostalExternal).r + at(t, ElementGroup::IntercostalInternal).r, 1.84, 1e-12);
+    EXPECT_EQ(at(t, ElementGroup::IntercostalInternal).alpha, 0.0);  // quiet expiration is passive recoil
   }
-  BreathStyleController forced(loadBreathStyle("forced-exhale"));
-  EXPECT_EQ(forced.activations(1.0, none)[static_cast<std::size_t>(ElementGroup::Rectus)].alpha, 0.0);   // inhale
-  EXPECT_EQ(forced.activations(4.0, none)[static_cast<std::size_t>(ElementGroup::Rectus)].alpha, 1.0);   // exhale
-  EXPECT_DOUBLE_EQ(forced.activations(4.0, none)[static_cast<std::size_t>(ElementGroup::Rectus)].r, 0.5);
-  EXPECT_EQ(forced.activations(7.0, none)[static_cast<std::size_t>(ElementGroup::Rectus)].alpha, 0.0);   // after the one cycle
+  BreathStyleController forced(loadBreathStyle("forced-exhale"));  // 6 s cycle, 2.4 s inhale
+  auto forcedAt = [&](double t, ElementGroup g) { return forced.activations(t, none)[static_cast<std::size_t>(g)]; };
+  EXPECT_EQ(forcedAt(1.0, ElementGroup::Rectus).alpha, 0.0);  // inhale
+  EXPECT_DOUBLE_EQ(forcedAt(4.0, ElementGroup::Rectus).alpha, 1.0);  // exhale, after the drive's rise
+  EXPECT_DOUBLE_EQ(forcedAt(4.0, ElementGroup::Rectus).r, 0.5);
+  EXPECT_DOUBLE_EQ(forcedAt(4.0, ElementGroup::IntercostalInternal).alpha, 1.0);
+  EXPECT_EQ(forcedAt(7.0, ElementGroup::Rectus).alpha, 0.0);  // after the one cycle
+  EXPECT_EQ(forcedAt(7.0, ElementGroup::Diaphragm).alpha, 0.0);
 }
 
 TEST(BreathStyle, PresetsLoadWithTable2Rates) {
@@ -152,9 +162,9 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   const BreathStyle panting = loadBreathStyle("panting");
   BreathStyleController c(panting);
   const Metrics none;
-  const Activations a = c.activations(0.3, none);  // inhale, after the diaphragm's 0.2 s rise
-  EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha, panting.diaphragmAlpha);
-  EXPECT_DOUBLE_EQ(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha);
+  const Activations a = c.activations(0.5 - 1e-9, none);  // the end of the 0.5 s inhale, at full inspiratory drive
+  EXPECT_NEAR(a[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha, panting.diaphragmAlpha, 1e-9);
+  EXPECT_NEAR(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha, 1e-9);
   EXPECT_LT(panting.diaphragmAlpha, 1.0);
   const std::string text = serializeBreathStyle(panting);
   EXPECT_EQ(serializeBreathStyle(parseBreathStyle(text, "panting.json")), text);
@@ -163,28 +173,16 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   EXPECT_THROW(validateBreathStyle(bad), Error);
 }
 
-// the diaphragm's step rises and falls as s(x) = 3x^2 - 2x^3 over the rise time, so its activation is continuous
-// across the inhale and exhale edges; the rise must fit into both phases
-TEST(BreathStyle, DiaphragmStepRisesAndFallsSmoothly) {
-  BreathStyle calm = loadBreathStyle("calm");  // period 4 s, inhale 1.6 s
-  calm.diaphragmRiseTime = 0.2;
-  BreathStyleController c(calm);
-  const Metrics none;
-  const auto alpha = [&](double t) { return c.activations(t, none)[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha; };
-  EXPECT_DOUBLE_EQ(alpha(0.0), 0.0);
-  EXPECT_NEAR(alpha(0.05), calm.diaphragmAlpha * (3 * 0.0625 - 2 * 0.015625), 1e-12);
-  EXPECT_NEAR(alpha(0.1), 0.5 * calm.diaphragmAlpha, 1e-12);
-  EXPECT_DOUBLE_EQ(alpha(1.0), calm.diaphragmAlpha);
-  EXPECT_NEAR(alpha(1.6 - 1e-9), calm.diaphragmAlpha, 1e-9);
-  EXPECT_NEAR(alpha(1.6 + 1e-9), calm.diaphragmAlpha, 1e-6);
-  EXPECT_NEAR(alpha(1.7), 0.5 * calm.diaphragmAlpha, 1e-12);
-  EXPECT_DOUBLE_EQ(alpha(1.9), 0.0);
-  EXPECT_DOUBLE_EQ(c.activations(1.0, none)[static_cast<std::size_t>(ElementGroup::Diaphragm)].r, calm.diaphragmR);
-  BreathStyle tooSlow = calm;
-  tooSlow.diaphragmRiseTime = 1.7;  // longer than the 1.6 s inhale
-  EXPECT_THROW(validateBreathStyle(tooSlow), Error);
-  tooSlow.diaphragmRiseTime = -0.1;
-  EXPECT_THROW(validateBreathStyle(tooSlow), Error);
+// the drive's decay window must be a fraction of the exhale, the internal layer's level in [0, 1]
+TEST(BreathStyle, DriveFieldsAreRangeChecked) {
+  BreathStyle bad = loadBreathStyle("calm");
+  bad.driveDecayFraction = 0.0;
+  EXPECT_THROW(validateBreathStyle(bad), Error);
+  bad.driveDecayFraction = 1.5;
+  EXPECT_THROW(validateBreathStyle(bad), Error);
+  bad = loadBreathStyle("calm");
+  bad.internalIntercostalAlpha = -0.1;
+  EXPECT_THROW(validateBreathStyle(bad), Error);
 }
 
 // Summary: a pure sine of amplitude A at f gives tidal volume 2 A and 60 f b/m

@@ -73,3 +73,122 @@ TEST(ImplicitSolve, StaleFactorizationGivesTheSameMotion) {
 
 }  // namespace
 }  // namespace pneuma::sim
+
+namespace pneuma::sim {
+namespace {
+
+// a rib on a rib-neck hinge (Joints): a fixed parent, one child, axis a, k about every direction plus k_lock off a
+Model hingedRib(const Eigen::Vector3d& axis, double k, double kLock) {
+  Model m;
+  m.gravity.setZero();
+  test::addBody(m, "spine", true, 1.0, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity());
+  test::addBody(m, "rib", false, 0.02, Eigen::Vector3d(0.1, 0.0, 0.0), 1e-5 * Eigen::Matrix3d::Identity());
+  test::addJoint(m, "costovertebral", 0, 1, Eigen::Vector3d::Zero(), 0.0, k, axis, kLock);
+  return m;
+}
+
+// the torque on a rib turned by theta is -K theta, K = k I + k_lock (I - a a^T): about the neck axis only k resists,
+// across it k + k_lock; the same for the potential, whose derivative along theta is the torque
+TEST(RibNeckHinge, TorqueIsKThetaAndTheGradientOfItsEnergy) {
+  const Eigen::Vector3d a = Eigen::Vector3d(std::cos(0.9), -std::sin(0.9), 0.0);  // about 52 degrees from transverse
+  const double k = 5.0, kLock = 100.0;  // [N m/rad]
+  const Model m = hingedRib(a, k, kLock);
+  const Eigen::Vector3d across = a.cross(Eigen::Vector3d::UnitZ()).normalized();
+  for (const Eigen::Vector3d& dir : {a, across, Eigen::Vector3d(a + across).normalized()}) {
+    const double angle = 0.01;  // [rad]
+    State s = makeInitialState(m);
+    s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(angle, dir));
+    StepWork w = makeStepWork(m);
+    computeForces(m, s, relaxedActivations(), StepOptions{}, w);
+    const Eigen::Matrix3d K = k * Eigen::Matrix3d::Identity() + kLock * (Eigen::Matrix3d::Identity() - a * a.transpose());
+    const Eigen::Vector3d expected = -K * (angle * dir);
+    EXPECT_LT((w.bodyTorque.col(1) - expected).norm(), 1e-9 * expected.norm()) << dir.transpose();
+    // energy: E(angle) = 1/2 theta^T K theta, so dE/dangle = -tau . dir
+    auto energy = [&](double th) {
+      State t = makeInitialState(m);
+      t.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(th, dir));
+      Metrics out;
+      computeMetrics(m, t, relaxedActivations(), StepOptions{}, w, out);
+      return out.elasticEnergy;
+    };
+    const double h = 1e-5;
+    EXPECT_NEAR((energy(angle + h) - energy(angle - h)) / (2 * h), -w.bodyTorque.col(1).dot(dir), 1e-6);
+  }
+  // off the axis the rib is (k + k_lock) / k = 21 times stiffer than about it
+  State s = makeInitialState(m);
+  StepWork w = makeStepWork(m);
+  s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(0.01, across));
+  computeForces(m, s, relaxedActivations(), StepOptions{}, w);
+  const double offAxis = w.bodyTorque.col(1).norm();
+  s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(0.01, a));
+  computeForces(m, s, relaxedActivations(), StepOptions{}, w);
+  EXPECT_NEAR(offAxis / w.bodyTorque.col(1).norm(), (k + kLock) / k, 1e-6);
+}
+
+// the hinge's axis turns with its parent: a rotation of the whole pair leaves the joint unloaded, and a rib turned
+// about the parent's turned axis meets only k
+TEST(RibNeckHinge, AxisFollowsTheParent) {
+  const Eigen::Vector3d a = Eigen::Vector3d::UnitX();
+  Model m = hingedRib(a, 5.0, 100.0);
+  m.bodies.isFixed[0] = 0;  // a moving parent
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 0.5, 0.8).normalized()));
+  State s = makeInitialState(m);
+  s.bodyOrientation[0] = turn;
+  s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(0.02, turn * a)) * turn;
+  StepWork w = makeStepWork(m);
+  computeForces(m, s, relaxedActivations(), StepOptions{}, w);
+  EXPECT_LT((w.bodyTorque.col(1) + 5.0 * 0.02 * (turn * a)).norm(), 1e-9);
+}
+
+}  // namespace
+}  // namespace pneuma::sim
+
+namespace pneuma::sim {
+namespace {
+
+// the pleural pressure (Cavity) is the gradient of its potential: on the node it pulls hardest, the force change
+// it makes equals minus the finite-difference derivative of the elastic energy, and it pulls the walls inward
+TEST(PleuralPressure, ForceIsMinusTheGradientOfTheRecoilEnergy) {
+  Model off = test::makeToyTorso();
+  off.gravity.setZero();
+  ASSERT_GT(off.cavity.triangles.cols(), 0);
+  Model on = off;
+  on.cavity.recoilPressure = 490.0;   // [Pa] 5 cmH2O
+  on.cavity.compliance = 2.0e-6;      // [m^3/Pa] 0.2 L/cmH2O
+  const State s0 = makeInitialState(on);
+  StepWork wOn = makeStepWork(on), wOff = makeStepWork(off);
+  computeForces(on, s0, relaxedActivations(), StepOptions{}, wOn);
+  computeForces(off, s0, relaxedActivations(), StepOptions{}, wOff);
+  EXPECT_NEAR(wOn.pleuralPressure, -490.0, 1e-9);  // at the rest volume Ppl = -P0
+  const Eigen::Matrix3Xd pull = wOn.nodeForce - wOff.nodeForce;
+  Eigen::Index node = 0;
+  pull.colwise().norm().maxCoeff(&node);
+  ASSERT_GT(pull.col(node).norm(), 0.0);
+  auto energy = [&](const Model& m, int k, double h) {
+    State s = s0;
+    s.nodePosition(k, node) += h;
+    StepWork w = makeStepWork(m);
+    Metrics out;
+    computeMetrics(m, s, relaxedActivations(), StepOptions{}, w, out);
+    return out.elasticEnergy;
+  };
+  const double h = 1e-6;  // [m]
+  for (int k = 0; k < 3; ++k) {
+    const double dOn = (energy(on, k, h) - energy(on, k, -h)) / (2 * h);
+    const double dOff = (energy(off, k, h) - energy(off, k, -h)) / (2 * h);
+    EXPECT_NEAR(-(dOn - dOff), pull(k, node), 1e-4 * pull.col(node).norm() + 1e-9) << k;
+  }
+  // suction: the node is pulled into the cavity, against the cavity's outward volume gradient
+  Eigen::Matrix3Xd x, grad = Eigen::Matrix3Xd::Zero(3, on.cavity.vertices.size());
+  anchorPositions(on.cavity.vertices, s0, x);
+  addVolumeGradient(x, on.cavity.triangles, 1.0, grad);
+  double outward = 0.0;
+  for (int i = 0; i < on.cavity.vertices.size(); ++i)
+    for (int j = 0; j < 3; ++j)
+      if (on.cavity.vertices.body[static_cast<std::size_t>(i)] < 0 && on.cavity.vertices.nodes(j, i) == node)
+        outward += on.cavity.vertices.weights(j, i) * grad.col(i).dot(pull.col(node));
+  EXPECT_LT(outward, 0.0);
+}
+
+}  // namespace
+}  // namespace pneuma::sim

@@ -86,7 +86,8 @@ inline int addBody(Model& m, const std::string& name, bool fixed, double mass, c
 }
 
 inline void addJoint(Model& m, const std::string& name, int parent, int child, const Eigen::Vector3d& anchor,
-                     double friction, double stiffness) {
+                     double friction, double stiffness, const Eigen::Vector3d& axis = Eigen::Vector3d::UnitX(),
+                     double lockStiffness = 0.0) {
   const int i = m.joints.size();
   m.joints.name.push_back(name);
   m.joints.parent.push_back(parent);
@@ -97,6 +98,10 @@ inline void addJoint(Model& m, const std::string& name, int parent, int child, c
   m.joints.friction(i) = friction;
   m.joints.stiffness.conservativeResize(i + 1);
   m.joints.stiffness(i) = stiffness;
+  m.joints.axis.conservativeResize(3, i + 1);
+  m.joints.axis.col(i) = axis;
+  m.joints.lockStiffness.conservativeResize(i + 1);
+  m.joints.lockStiffness(i) = lockStiffness;
 }
 
 // one endpoint: a body point (world position p) or a node

@@ -34,8 +34,9 @@ class PatternTracking : public ::testing::TestWithParam<const char*> {
 }  // namespace
 
 // the calibration staircase identifies each lever's lag: the rib friction (Eq. 3, 15 N m s/rad) makes the
-// intercostals, which turn the ribs, a slower lever than the diaphragm, which mainly pushes the gut down;
-// every lag is far below a breath (1 s at 60 b/m) and above the 10 ms step
+// external intercostals, which lift the ribs about their neck axes, a slower lever than the diaphragm, which mainly
+// pushes the gut down; the internal layer is quicker (65 ms on the default model with the
+// rib-neck hinges); every lag is far below a breath (1 s at 60 b/m) and above the 10 ms step
 TEST(PatternDriveCalibration, IdentifiesTheRibcageAsTheSlowerLeverOnTheDefaultModel) {
   REQUIRE_DEFAULT_MODEL();
   const auto tau = [](ElementGroup g) { return calibration().timeConstant[static_cast<std::size_t>(g)]; };
@@ -46,7 +47,6 @@ TEST(PatternDriveCalibration, IdentifiesTheRibcageAsTheSlowerLeverOnTheDefaultMo
     EXPECT_LT(tau(g), 0.5) << groupName(g);
   }
   EXPECT_GT(tau(ElementGroup::IntercostalExternal), 1.5 * tau(ElementGroup::Diaphragm));
-  EXPECT_GT(tau(ElementGroup::IntercostalInternal), 1.5 * tau(ElementGroup::Diaphragm));
 }
 
 TEST_P(PatternTracking, FollowsThePresetOnTheDefaultModel) {

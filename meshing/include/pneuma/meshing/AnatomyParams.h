@@ -30,6 +30,10 @@ struct RibLevel {
   double lateralTilt = 0.0;     ///< [rad] lateral descent of the rib plane below horizontal
   double height = 0.0;          ///< [m] cross-section height (superior-inferior)
   double thickness = 0.0;       ///< [m] cross-section thickness (inner-outer)
+  /// [rad] direction of the rib-neck axis (head to tubercle, the axis the rib turns about) in the horizontal
+  /// plane, measured from the left-right axis toward posterior: 0 = transverse (pure pump handle), 90 deg =
+  /// anteroposterior (pure bucket handle). resources/anatomy/README.md has the values and their sources.
+  double neckAxis = 0.0;
 };
 
 /// Vertebral column: bodies stacked upward from z = 0 (L5 bottom).
@@ -101,8 +105,13 @@ struct Gains {
   std::array<GroupGains, sim::kElementGroupCount> group{};  ///< indexed by sim::ElementGroup
   double gutKappa = 0.0;              ///< [Pa] bulk modulus of Eq. 4
   double gutDrag = 0.0;               ///< [1/s] visceral drag rate beta (sim::Gut::drag)
+  double lungRecoil = 0.0;            ///< [Pa] lung recoil at the rest volume (sim::Cavity::recoilPressure)
+  double lungCompliance = 0.0;        ///< [m^3/Pa] lung compliance (sim::Cavity::compliance)
   double costovertebralFriction = 0.0;  ///< [N m s/rad] mu of Eq. 3
-  double costovertebralStiffness = 0.0; ///< [N m/rad]
+  double costovertebralStiffness = 0.0; ///< [N m/rad] about the rib-neck axis
+  /// [N m/rad] the costotransverse joint's resistance to rotation off the rib-neck axis (a rib with both its
+  /// head and its tubercle articulated turns about the line through them)
+  double costotransverseStiffness = 0.0;
   double spineFriction = 0.0;           ///< [N m s/rad]
   double spineStiffness = 0.0;          ///< [N m/rad]
   double wallMass = 0.0;                ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)

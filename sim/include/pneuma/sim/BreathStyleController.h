@@ -3,25 +3,25 @@
 /// Breath-style presets (Zordan et al. 2004, Section 7, Section 8.1 and Table 2) and the open-loop
 /// controller that plays them.
 ///
-/// One breath cycle of period T = 60 / breathsPerMinute starts at the beginning of inhale:
-///  - diaphragm: a step function (the "pump"), alpha = diaphragmAlpha and r = diaphragmR during the
-///    inhale part [0, inhaleFraction T), alpha = 0 and r = 1 otherwise. The paper switches alpha
-///    between 0 and 1; a partial level (panting) is our calibration choice, see the preset notes.
-///    Our choice: the step's edges are smoothed over diaphragmRiseTime (alpha = s(t / rise) diaphragmAlpha,
-///    s(x) = 3x^2 - 2x^3, from the start of inhale; 1 - s(t / rise) from the start of exhale, r = diaphragmR
-///    throughout). A muscle's force rises over tens to hundreds of ms (excitation-contraction coupling;
-///    the phrenic nerve's inspiratory discharge is a ramp), and a sharp step made the stiff diaphragm
-///    (kac 28.8 kN/m) jolt in about 20 ms and ring, so the run depended on dt (calm 474 mL at dt 10 ms,
-///    a ring counted as a second breath at 5 ms). With a 0.2 s rise calm, deep and panting agree within
-///    1 % from dt 5 ms to 1/60 s. 0 gives the sharp step;
-///  - outer intercostals: r(t) = mean + amplitude cos(2 pi t / T), alpha = intercostalAlpha: r drops
-///    smoothly during the first half-cycle (inhale) and rises again during exhale;
-///  - inner intercostals: out of phase, r(t) = mean - amplitude cos(2 pi t / T), alpha = intercostalAlpha;
-///  - rectus: only when rectusActive (forced exhale): alpha = 1 and r = rectusR during exhale;
-///  - transversus/obliques and cartilage stay passive (alpha = 0, r = 1).
-/// The cycle-start posture (t <= 0, i.e. during settling, and the hold after a finite style) is the relaxed end
-/// of an exhale: diaphragm and rectus off, intercostals at their t = 0 values. When cycles > 0 the style plays that many cycles
-/// and then holds that posture.
+/// One breath cycle of period T = 60 / breathsPerMinute starts at the beginning of inhale (phase x = t / T mod 1,
+/// inhale for x < f = inhaleFraction). The muscles take turns, as in a body (De Troyer & Boriek 2011, Compr
+/// Physiol 1:1273; De Troyer, Kirkwood & Wilson 2005, Physiol Rev 85:717), on two smooth drives in [0, 1]:
+///  - inspiratory drive d(x) (inspiratoryDrive()): a rounded rise over the inhale, d = (1 - cos(pi x / f)) / 2,
+///    then the post-inspiratory decay of early expiration, d = 1 - s(x' / w) with x' the fraction of the exhale
+///    gone and w = driveDecayFraction, s(u) = 3u^2 - 2u^3 clamped. Quiet expiration is braked, not a drop: the
+///    inspiratory muscles' pressure falls to 50 % at 23 % of the exhale and to 0 at 79 % (J Appl Physiol 1985,
+///    58:1859); w = 0.6 gives 50 % at 30 % and 0 at 60 %. The diaphragm gets alpha = d diaphragmAlpha at
+///    r = diaphragmR, the external intercostals (with the parasternals they stand for) alpha = d intercostalAlpha
+///    at r = intercostalMean - intercostalAmplitude, Table 2's deepest contraction;
+///  - expiratory drive e(x) (expiratoryDrive()): 0 during the inhale; over the exhale s(x' / 0.3) (1 - s((x' - 0.85)
+///    / 0.15)). The internal intercostals get alpha = e internalIntercostalAlpha (0 in quiet breathing, where
+///    expiration is passive recoil), the rectus alpha = e at r = rectusR when rectusActive (forced exhale).
+/// This replaces the paper's control (Section 7, Table 2: a diaphragm step and out-of-phase intercostal sinusoids
+/// of r at alpha 1): with both intercostal layers always at full activation the antagonists co-contracted at
+/// kilonewtons, and the diaphragm's step moved the abdomen a fraction of a second before the rib cage.
+/// Table 2's rates, inhale fractions and r values are kept. The cycle-start posture (t <= 0, i.e. during settling,
+/// and the hold after a finite style) is the relaxed end of an exhale: every muscle off. When cycles > 0 the style
+/// plays that many cycles and then holds that posture.
 
 #include "pneuma/sim/Controller.h"
 
@@ -38,25 +38,32 @@ struct BreathStyle {
   double inhaleFraction = 0.4;        ///< [-] part of the cycle with the diaphragm on, in (0, 1)
   double diaphragmR = 0.85;           ///< [-] diaphragm contraction ratio during inhale, (0, 1.5]
   double diaphragmAlpha = 1.0;        ///< [-] diaphragm activation level during inhale, (0, 1]
-  double diaphragmRiseTime = 0.2;     ///< [s] rise and fall time of the diaphragm's step, [0, inhale and exhale time]
+  double driveDecayFraction = 1.0;    ///< [-] part of the exhale over which the inspiratory drive decays, (0, 1]
   double intercostalMean = 0.92;      ///< [-] mean r of the intercostal sinusoids
   double intercostalAmplitude = 0.08; ///< [-] amplitude of the intercostal sinusoids (Table 2 "±")
-  double intercostalAlpha = 1.0;      ///< [-] intercostal activation level, (0, 1]
+  double intercostalAlpha = 1.0;      ///< [-] external intercostal activation at full inspiratory drive, (0, 1]
+  double internalIntercostalAlpha = 0.0;  ///< [-] internal intercostal activation at full expiratory drive, [0, 1]
   bool rectusActive = false;          ///< rectus contracts during exhale (forced exhale only)
   double rectusR = 1.0;               ///< [-] rectus contraction ratio when active
   int cycles = 0;                     ///< [-] 0 = periodic; n > 0 = n cycles, then hold
 };
 
-/// Checks ranges: rate > 0, inhaleFraction in (0, 1), every resulting r in (0, 1.5], diaphragmRiseTime at most
-/// the inhale and the exhale time, cycles >= 0.
+/// Checks ranges: rate > 0, inhaleFraction in (0, 1), every resulting r in (0, 1.5], driveDecayFraction in (0, 1],
+/// internalIntercostalAlpha in [0, 1], cycles >= 0.
 /// @throws Error naming the field and value.
 void validateBreathStyle(const BreathStyle& s);
 
 /// Parses a preset from JSON text (fields: name, note, breaths_per_minute, inhale_fraction,
-/// diaphragm_r, diaphragm_alpha (optional, default 1), diaphragm_rise_time_s (optional, default 0.2), intercostal_mean,
-/// intercostal_alpha (optional, default 1), intercostal_amplitude, rectus_active, rectus_r, cycles).
+/// diaphragm_r, diaphragm_alpha (optional, default 1), drive_decay_fraction (optional, default 1), intercostal_mean,
+/// intercostal_alpha (optional, default 1), internal_intercostal_alpha (optional, default 0), intercostal_amplitude,
+/// rectus_active, rectus_r, cycles).
 /// @throws Error naming `source` and the field.
 BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& source);
+
+/// [-] the inspiratory drive d in [0, 1] at cycle phase `phase` in [0, 1) (see the file comment).
+double inspiratoryDrive(const BreathStyle& s, double phase);
+/// [-] the expiratory drive e in [0, 1] at cycle phase `phase` in [0, 1) (see the file comment).
+double expiratoryDrive(const BreathStyle& s, double phase);
 
 /// Serialises a preset to JSON text with the fields parseBreathStyle() reads (round-trips exactly).
 std::string serializeBreathStyle(const BreathStyle& s);

@@ -70,15 +70,22 @@ struct Bodies {
 };
 
 /// Ball joints (Zordan et al. 2004, Section 5): rib-spine costovertebral joints and the joints
-/// between thoracic segments. Joint friction follows Eq. 3, tau = -mu * relative angular velocity;
-/// a passive rotational spring tau = -k * (rotation vector of the relative rotation) holds the spine.
+/// between thoracic segments. Joint friction follows Eq. 3, tau = -mu * relative angular velocity.
+/// A passive rotational spring acts on the rotation vector theta of the child relative to the parent (world):
+///   tau = -K theta,  K = k I + k_lock (I - a a^T),  a = R_parent axis,
+/// so k holds every direction (the spine) and k_lock adds a resistance to turning off the axis: a rib whose
+/// head (costovertebral joint) and tubercle (costotransverse joint) both articulate turns about its neck axis,
+/// the line through the two (De Troyer & Boriek 2011, Compr Physiol 1:1273; Jordanoglou 1969, Thorax 24:407).
+/// k_lock = 0 is a plain ball joint.
 struct Joints {
   std::vector<std::string> name;   ///< e.g. "costovertebral_rib3_left"        (#J)
   std::vector<int> parent;         ///< body index of the parent (may be fixed) (#J)
   std::vector<int> child;          ///< body index of the child                 (#J)
   Eigen::Matrix3Xd anchor;         ///< [m] rest-pose joint centre, world       (3 x #J)
   Eigen::VectorXd friction;        ///< [N m s/rad] mu of Eq. 3                 (#J)
-  Eigen::VectorXd stiffness;       ///< [N m/rad] passive rotational stiffness  (#J)
+  Eigen::VectorXd stiffness;       ///< [N m/rad] passive rotational stiffness k, every direction (#J)
+  Eigen::Matrix3Xd axis;           ///< [-] unit hinge axis a in the parent frame (= world at rest)   (3 x #J)
+  Eigen::VectorXd lockStiffness;   ///< [N m/rad] k_lock against rotation off the axis, 0 = ball joint (#J)
 
   int size() const { return static_cast<int>(parent.size()); }
 };
@@ -129,9 +136,19 @@ struct Elements {
 
 /// Closed lung-cavity surface (Figure 6): its vertices are anchors, so its volume can be recomputed
 /// from the current bone poses and diaphragm nodes at every step.
+///
+/// The lungs' elastic recoil acts on the cavity's walls as a pleural pressure (our addition; the paper has none):
+///   Ppl = min(0, -(P0 + (V - Vr) / C)),  f_i = Ppl dV/dx_i  (suction: the walls are pulled inward),
+/// with V the cavity volume, Vr its rest volume, P0 = recoilPressure the recoil at rest and C = compliance the lung
+/// compliance. It holds the diaphragm's dome up against the weight it carries (upright, resting Pdi is about
+/// 3 cmH2O) and is the force of passive expiration. Relaxed FRC: lung recoil +5 cmH2O (Ppl -5 cmH2O); lung
+/// compliance about 0.2 L/cmH2O (Naimark & Cherniack 1960, J Appl Physiol 15:377; Guyton & Hall).
+/// compliance 0 turns it off (models written before it).
 struct Cavity {
   AnchorSet vertices;            ///< (#C points)
   Eigen::Matrix3Xi triangles;    ///< vertex indices, outward normals (3 x #T)
+  double recoilPressure = 0.0;   ///< [Pa] P0, the lungs' elastic recoil at the rest volume, >= 0
+  double compliance = 0.0;       ///< [m^3/Pa] C, the lung compliance; 0 = no pleural pressure
 };
 
 /// Named points for measurement, bound like cavity vertices.

@@ -116,6 +116,10 @@ struct StepWork {
   double restGutVolume = 0.0;          ///< [m^3] V0, gut volume at the rest pose
   Eigen::Vector3d restGutCentroid = Eigen::Vector3d::Zero();  ///< [m] centroid of the gut nodes at rest
   Eigen::Matrix3Xi wallTriangles;      ///< gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
+  double restCavityVolume = 0.0;       ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
+  double pleuralPressure = 0.0;        ///< [Pa] Ppl of Cavity at the start of the last step (<= 0)
+  Eigen::Matrix3Xd cavityPosition;     ///< [m] cavity vertices at the start of the last step (3 x #C)
+  Eigen::Matrix3Xd cavityGradient;     ///< [m^2] dV/dx per cavity vertex (3 x #C)
   double gutVolume = 0.0;              ///< [m^3] V at the start of the last step
   double gutPressure = 0.0;            ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
   Eigen::VectorXd elementForce;        ///< [N] scalar force per element of the last step (#E)
