@@ -68,6 +68,40 @@ std::string number(double v) {
 }
 
 /// Figure 6 of Zordan et al. 2004: lung-cavity volume of every style, relative to calm end-expiration,
+/// One row of the physiology table: a motion figure of a style next to its published range (informational: the
+/// mechanics of issue 13 do not meet them yet, so they do not count toward the verdict).
+struct PhysiologyRow {
+  const char* style;      // the run it is measured on
+  const char* what;       // e.g. "dome descent (central tendon, craniocaudal)"
+  const char* unit;       // shown unit
+  double (*measure)(const sim::Motion&, const sim::Summary&);  // in `unit`
+  double lower, upper;    // published range, in `unit`
+  const char* source;
+};
+
+const PhysiologyRow kPhysiology[] = {
+    {"calm", "dome descent (central tendon, craniocaudal)", "mm", [](const sim::Motion& m, const sim::Summary&) { return m.domeDescent * 1e3; },
+     12.0, 25.0, "M-mode ultrasound, quiet breathing 18 +/- 3 mm in men (Boussuges, Gole & Blanc 2009, Chest 135:391)"},
+    {"deep", "dome descent per litre inspired", "mm/L",
+     [](const sim::Motion& m, const sim::Summary& s) { return m.domeDescent * 1e3 / (s.tidalVolume * 1e3); }, 20.0, 35.0,
+     "derived: deep breathing 70 +/- 11 mm in men (Boussuges et al. 2009) over an inspiratory capacity of 2-3.5 L"},
+    {"calm", "umbilicus anterior motion", "mm", [](const sim::Motion& m, const sim::Summary&) { return m.umbilicusAnterior * 1e3; },
+     0.0, 1e9, "the belly moves out on every inhale (Konno & Mead 1967, J Appl Physiol 22:407)"},
+    {"calm", "rib-8 lateral distance, change", "mm", [](const sim::Motion& m, const sim::Summary&) { return m.lowerRibExpansion * 1e3; },
+     2.0, 1e9, "bucket-handle widening of the lower ribs (Wilson et al. 1987, J Appl Physiol 62:1872); >= 2 mm is issue 13's bound"},
+    {"deep", "rib-8 lateral distance, change", "mm", [](const sim::Motion& m, const sim::Summary&) { return m.lowerRibExpansion * 1e3; },
+     10.0, 1e9, "as above; >= 10 mm is issue 13's bound"},
+    {"calm", "rib-cage share of the tidal volume", "%",
+     [](const sim::Motion& m, const sim::Summary&) { return 100.0 * m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal); }, 55.0, 85.0,
+     "seated at rest the abdomen gives about a quarter (J Appl Physiol 1968, 24:159; Sharp et al. 1975, J Appl Physiol 39:608)"},
+    {"calm", "rib-cage / abdomen phase angle", "deg", [](const sim::Motion& m, const sim::Summary&) { return m.phaseAngle * 180.0 / M_PI; },
+     0.0, 30.0, "12-23 deg in healthy young adults (Chen et al. 2015)"},
+    {"calm", "flow sign changes per breath", "-", [](const sim::Motion& m, const sim::Summary&) { return m.flowSignChanges; }, 2.0,
+     2.0, "a spirogram: one inspiration, one expiration"},
+    {"calm", "largest frame-to-frame flow change", "% of peak", [](const sim::Motion& m, const sim::Summary&) { return m.maxFlowJump * 100.0; },
+     0.0, 20.0, "smooth airflow profiles (Benchetrit 2000, Respir Physiol 122:123); 20 % is issue 13's bound"},
+};
+
 /// with the 500 mL calm tidal volume as a dashed reference.
 viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
   double base = 0.0;
@@ -230,6 +264,27 @@ void runValidate(const ValidateArgs& args) {
           << "</td></tr>\n";
   }
   md << "\n";
+
+  // physiology: the motion next to published ranges (informational, not part of the verdict)
+  std::ostringstream physMd, physHtml;
+  for (const PhysiologyRow& row : kPhysiology) {
+    const auto run = std::find_if(runs.begin(), runs.end(), [&](const sim::StyleRun& r) { return r.style.name == row.style; });
+    if (run == runs.end()) continue;
+    const double v = row.measure(run->summary.motion, run->summary);
+    const bool inside = v >= row.lower && v <= row.upper;
+    const std::string range = row.upper > 1e8 ? ">= " + number(row.lower) : row.lower == row.upper ? number(row.lower)
+                                                                         : number(row.lower) + " - " + number(row.upper);
+    const std::string verdictText = !std::isfinite(v) ? "n/a" : inside ? "within" : "outside";
+    physMd << "| " << row.style << " | " << row.what << " | " << number(v) << " " << row.unit << " | " << range << " "
+           << row.unit << " | " << verdictText << " | " << row.source << " |\n";
+    physHtml << "<tr class=\"" << (inside ? "pass" : "fail") << "\"><td>" << row.style << "</td><td>" << htmlEscape(row.what)
+             << "</td><td>" << number(v) << " " << htmlEscape(row.unit) << "</td><td>" << htmlEscape(range) << " "
+             << htmlEscape(row.unit) << "</td><td>" << verdictText << "</td><td>" << htmlEscape(row.source) << "</td></tr>\n";
+  }
+  const char* physIntro = "Physiology: the breath's motion in anatomical axes next to published ranges "
+                          "(summary.json's motion fields; informational until issue 13's mechanics land, not part of the result).";
+  md << "## Physiology\n\n" << physIntro << "\n\n| style | what | measured | published | | source |\n|---|---|---|---|---|---|\n"
+     << physMd.str() << "\n";
   for (const Figure& f : figures) md << "![" << f.caption << "](" << f.stem << ".png)\n\n" << f.caption << "\n\n";
   html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Pneuma validation report</title>\n<style>"
        << "body{font-family:sans-serif;max-width:1000px;margin:2em auto}table{border-collapse:collapse;font-size:14px}"
@@ -239,7 +294,9 @@ void runValidate(const ValidateArgs& args) {
        << "), integrator " << sim::integratorName(settings.simulation.step.integrator) << (args.isQuick ? ", quick settings" : "")
        << ", pneuma " << PNEUMA_VERSION << ". Result: <b>" << verdict << "</b>.</p>\n"
        << "<table><tr><th>check</th><th>what</th><th>target</th><th>measured</th><th>result</th><th>source</th></tr>\n"
-       << table.str() << "</table>\n";
+       << table.str() << "</table>\n"
+       << "<h2>Physiology</h2>\n<p>" << physIntro << "</p>\n<table><tr><th>style</th><th>what</th><th>measured</th>"
+       << "<th>published</th><th></th><th>source</th></tr>\n" << physHtml.str() << "</table>\n";
   for (const Figure& f : figures)
     html << "<figure><img alt=\"" << htmlEscape(f.stem) << "\" src=\"data:image/png;base64," << base64(f.plot.toPng())
          << "\"><figcaption>" << htmlEscape(f.caption) << "</figcaption></figure>\n";

@@ -46,6 +46,17 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   EXPECT_NE(html.find("data:image/png;base64,iVBORw0KGgo"), std::string::npos);  // PNG signature in base64
   EXPECT_EQ(html.find("src=\"figure"), std::string::npos);  // no external image references
   EXPECT_NE(slurp(out + "/figure6_lung_volume.svg").find("500 mL"), std::string::npos);
+  // the physiology section: the calm dome descent beside its published range and source, in both reports; the
+  // figure is report.json's styles.calm.dome_descent_mm
+  const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
+  ASSERT_TRUE(report["styles"]["calm"]["dome_descent_mm"].is_number());
+  const std::string row = "| calm | dome descent (central tendon, craniocaudal) | ";
+  const std::size_t at = md.find(row);
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_NEAR(std::stod(md.substr(at + row.size())), report["styles"]["calm"]["dome_descent_mm"].get<double>(),
+              1e-3 * std::max(1.0, std::abs(report["styles"]["calm"]["dome_descent_mm"].get<double>())));
+  EXPECT_NE(md.find("12 - 25 mm"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Physiology</h2>"), std::string::npos);
   // stdout carries the table
   EXPECT_NE(r.out.find("calm.tidal_volume"), std::string::npos);
 }
