@@ -34,7 +34,7 @@ void RunRecord::append(const sim::Metrics& m, double targetFraction, double meas
   m_abdomenVolume.push_back(m.abdomenVolume);
   m_gutVolumeError.push_back(m.gutVolumeError);
   m_activations.push_back(m.activations);
-  m_tension.push_back(m.groupTension);
+  m_tension.push_back(m.groupMeanTension);
   m_landmarks.push_back(m.landmarks);
   m_target.push_back(targetFraction);
   m_measured.push_back(measuredFraction);
@@ -46,7 +46,7 @@ void RunRecord::writeCsv(const std::string& path) const {
   csv << "time [s],lung_volume [mL],gut_volume_error [%],rib_cage_volume [mL],abdomen_volume [mL]";
   for (int g = 0; g < sim::kElementGroupCount; ++g)
     if (sim::isMuscleGroup(group(g))) csv << "," << sim::groupName(group(g)) << ".r [-]," << sim::groupName(group(g)) << ".alpha [-]";
-  for (int g = 0; g < sim::kElementGroupCount; ++g) csv << "," << sim::groupName(group(g)) << ".tension [N]";
+  for (int g = 0; g < sim::kElementGroupCount; ++g) csv << "," << sim::groupName(group(g)) << ".mean_tension [N]";
   for (const std::string& name : m_model.landmarks.name) csv << "," << name << ".x [mm]," << name << ".y [mm]," << name << ".z [mm]";
   if (m_hasVolumeTarget) csv << ",target_volume_fraction [-],measured_volume_fraction [-]";
   csv << "\n";
@@ -93,7 +93,7 @@ std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std
 
   // activations: contraction ratio r solid, activation alpha dashed, one colour per group
   viz::Plot act("Muscle activations (" + runLabel + ")", "time [s]", "r, alpha [-]");
-  viz::Plot ten("Group tensions (" + runLabel + ")", "time [s]", "summed tension [N]");
+  viz::Plot ten("Mean element tension per group (" + runLabel + ")", "time [s]", "mean tension per element [N]");
   for (int g = 0; g < sim::kElementGroupCount; ++g) {
     std::vector<double> r, a, t;
     for (std::size_t i = 0; i < m_time.size(); ++i) {

@@ -44,7 +44,7 @@ LivePlots::LivePlots(QWidget* parent) : QWidget(parent), m_cursor(kNaN) {
   m_plots = {new PlotView("Lung-cavity volume", "volume [mL]"),
              new PlotView("Gut volume error", "error [%]"),
              new PlotView("Activations (r solid, \u03b1 dashed)", "activation [-]"),
-             new PlotView("Muscle tension", "tension [N]")};
+             new PlotView("Muscle tension (mean per element)", "tension [N]")};
   m_plots[1]->setReferences({{"+0.5 %", 0.5, QColor(40, 160, 60)},
                              {"-0.5 %", -0.5, QColor(40, 160, 60)},
                              {"+2 %", 2.0, QColor(220, 120, 0)},
@@ -153,7 +153,7 @@ bool LivePlots::refresh() {
                    column([g](const PlotSample& s) { return s.activations[static_cast<std::size_t>(g)].alpha; }),
                    QString()});
     tension.push_back({name, colourOf(group), false,
-                       column([g](const PlotSample& s) { return s.groupTension[static_cast<std::size_t>(g)]; }),
+                       column([g](const PlotSample& s) { return s.groupMeanTension[static_cast<std::size_t>(g)]; }),
                        shortLabel(group)});
   }
   m_plots[2]->setData(time, std::move(act));

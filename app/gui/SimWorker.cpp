@@ -168,7 +168,7 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
                              : std::numeric_limits<double>::quiet_NaN();
   s.activations = m.activations;
-  s.groupTension = m.groupTension;
+  s.groupMeanTension = m.groupMeanTension;
   s.elementForce.assign(m.elementForce.data(), m.elementForce.data() + m.elementForce.size());
   m_samples.push_back(std::move(s));
 }

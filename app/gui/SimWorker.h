@@ -38,7 +38,7 @@ struct PlotSample {
   double gutVolumeError = 0.0;            ///< [-] signed (V - V0) / V0
   double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung volume; NaN without one
   sim::Activations activations{};         ///< r and alpha per group
-  std::array<double, sim::kElementGroupCount> groupTension{};  ///< [N]
+  std::array<double, sim::kElementGroupCount> groupMeanTension{};  ///< [N] sim::Metrics::groupMeanTension
   std::vector<float> elementForce;        ///< [N] signed, per element (#E)
 };
 

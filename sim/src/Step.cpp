@@ -1188,12 +1188,16 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   const Elements& el = model.elements;
   out.elementForce = work.elementForce;
   out.isSlack.assign(at(el.size()), 0);
-  out.groupTension.fill(0.0);
+  out.groupMeanTension.fill(0.0);
+  std::array<int, kElementGroupCount> count{};
   for (int e = 0; e < el.size(); ++e) {
     const double f = work.elementForce(e);
     if (isMuscleGroup(el.group[at(e)]) && f >= 0.0) out.isSlack[at(e)] = 1;
-    out.groupTension[at(static_cast<int>(el.group[at(e)]))] += std::max(-f, 0.0);
+    out.groupMeanTension[at(static_cast<int>(el.group[at(e)]))] += std::max(-f, 0.0);
+    ++count[at(static_cast<int>(el.group[at(e)]))];
   }
+  for (int g = 0; g < kElementGroupCount; ++g)
+    if (count[at(g)] > 0) out.groupMeanTension[at(g)] /= count[at(g)];
 
   // energies: kinetic, elastic (elements at the current pose, gut, joint springs), gravity
   double kinetic = 0.0, gravity = 0.0;

@@ -82,7 +82,7 @@ TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
   EXPECT_EQ(header.at(1), "lung_volume [mL]");
   EXPECT_EQ(header.at(2), "gut_volume_error [%]");
   for (const std::string& h : header) EXPECT_NE(h.find(" ["), std::string::npos) << "no unit: " << h;
-  for (const char* col : {"diaphragm.r [-]", "diaphragm.alpha [-]", "diaphragm.tension [N]", "xiphoid.z [mm]"})
+  for (const char* col : {"diaphragm.r [-]", "diaphragm.alpha [-]", "diaphragm.mean_tension [N]", "xiphoid.z [mm]"})
     EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << col;
   // the summary's figures follow from the CSV's columns in their units (mL, %, mm), from the end of settling on
   auto column = [&](const std::string& name) {

@@ -29,7 +29,9 @@ struct Metrics {
   double abdomenVolume = 0.0;
   Eigen::VectorXd elementForce;   ///< [N] signed scalar force per element, <= 0 is tension (#E)
   std::vector<std::uint8_t> isSlack;  ///< 1 when a muscle element carries no force (#E)
-  std::array<double, kElementGroupCount> groupTension{};  ///< [N] sum of max(0, -F) over each group
+  /// [N] mean over each group's elements of their tension max(0, -F) (slack ones count 0): a per-element force, on
+  /// the scale of one element's trace; a sum would add up elements that sit in series along a muscle
+  std::array<double, kElementGroupCount> groupMeanTension{};
   Activations activations{};      ///< control input in effect at this frame
   double kineticEnergy = 0.0;     ///< [J] sum of 1/2 m v^2 + 1/2 w^T I w over bodies and nodes
   double elasticEnergy = 0.0;     ///< [J] springs (one-sided muscles, two-sided cartilage), gut pressure, spine joints
