@@ -33,10 +33,9 @@ GroupActivation& slot(Activations& a, ElementGroup g) { return a[static_cast<std
 constexpr double kExpiratoryRise = 0.3;  // [-] part of the exhale over which the expiratory drive rises
 constexpr double kExpiratoryFall = 0.15; // [-] part at the exhale's end over which it falls back to 0
 
-// [-] 0 -> 1 over `rise` seconds after t = 0: s(x) = 3x^2 - 2x^3, x = t / rise clamped to [0, 1]; a step when rise = 0
-double smoothRise(double t, double rise) {
-  if (rise <= 0.0) return t >= 0.0 ? 1.0 : 0.0;
-  const double x = std::clamp(t / rise, 0.0, 1.0);
+// [-] 0 -> 1 as u goes from 0 to `width` (> 0): s(x) = 3x^2 - 2x^3, x = u / width clamped to [0, 1]
+double smoothRise(double u, double width) {
+  const double x = std::clamp(u / width, 0.0, 1.0);
   return x * x * (3.0 - 2.0 * x);
 }
 
