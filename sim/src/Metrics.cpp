@@ -121,7 +121,6 @@ Eigen::Vector3d landmarkRange(const Trace& trace, int index, double from) {
   return hi - lo;
 }
 
-
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from) {
   Summary s;
   s.measuredFrom = from;

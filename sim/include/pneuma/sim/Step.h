@@ -1,8 +1,9 @@
 #pragma once
 /// @file Step.h
 /// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step):
-///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3),
-///                  passive spine stiffness, visceral drag (Gut::drag), gravity
+///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity, explicit),
+///                  joint friction (Eq. 3), joint stiffness (spine; rib-neck hinges, Joints), visceral drag
+///                  (Gut::drag), gravity
 ///   2. integrate   velocities and positions with the chosen integrator
 ///   3. joints      ball-joint constraints: velocity impulses, then position projection (error < 0.1 mm)
 /// Metrics are computed separately, at the output rate (computeMetrics()).
@@ -187,8 +188,9 @@ struct StepWork {
 StepWork makeStepWork(const Model& model);
 
 /// Stage 1 alone: clears and accumulates work.bodyForce [N], bodyTorque [N m] (world, about each com) and
-/// nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), joint friction (Eq. 3)
-/// and stiffness, gravity and the gyroscopic term; also fills the per-element and gut by-products.
+/// nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), the pleural pressure (Cavity),
+/// joint friction (Eq. 3) and stiffness, gravity and the gyroscopic term; also fills the per-element, gut and
+/// cavity by-products.
 /// Joint friction is included for ImplicitEulerJoints only; SymplecticEuler integrates it implicitly per joint
 /// right after the velocity update (unconditionally stable for light bones).
 void computeForces(const Model& model, const State& state, const Activations& act, const StepOptions& options,
