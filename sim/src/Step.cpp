@@ -272,26 +272,39 @@ double pleuralPressure(const Cavity& c, double volume, double restVolume) {
   return std::min(0.0, -(c.recoilPressure + (volume - restVolume) / c.compliance));
 }
 
-// pleural pressure on the cavity walls, f_i = Ppl dV/dx_i, carried to the bones and gut nodes the vertices are bound to
+// pleural pressure on the cavity walls, f_i = Ppl dV/dx_i, carried to the bones and gut nodes the vertices are
+// bound to; also dV/dq over the implicit solver's entries and the stiffness 1/C it has while Ppl < 0
 void accumulatePleuralPressure(const Model& model, const State& s, StepWork& w) {
   const Cavity& c = model.cavity;
+  w.pleuralStiffness = 0.0;
   if (!(c.compliance > 0.0) || c.triangles.cols() == 0) return;
   anchorPositions(c.vertices, s, w.cavityPosition);
   w.pleuralPressure = pleuralPressure(c, enclosedVolume(w.cavityPosition, c.triangles), w.restCavityVolume);
   if (w.pleuralPressure == 0.0) return;
+  w.pleuralStiffness = 1.0 / c.compliance;
   w.cavityGradient.setZero(3, w.cavityPosition.cols());
-  addVolumeGradient(w.cavityPosition, c.triangles, w.pleuralPressure, w.cavityGradient);
+  addVolumeGradient(w.cavityPosition, c.triangles, 1.0, w.cavityGradient);
+  // dV/dq: a vertex on a body moves with v_b + w_b x r, one on nodes with their weighted velocities
+  Eigen::VectorXd& g = w.cavityGeneralized;
+  g.setZero();
   for (int i = 0; i < c.vertices.size(); ++i) {
-    const Vector3d f = w.cavityGradient.col(i);
+    const Vector3d gi = w.cavityGradient.col(i);
     const int b = c.vertices.body[at(i)];
     if (b >= 0) {
-      w.bodyForce.col(b) += f;
-      w.bodyTorque.col(b) += (w.cavityPosition.col(i) - s.bodyPosition.col(b)).cross(f);
+      g.segment<3>(6 * b) += gi;
+      g.segment<3>(6 * b + 3) += (w.cavityPosition.col(i) - s.bodyPosition.col(b)).cross(gi);
       continue;
     }
     for (int k = 0; k < 3; ++k)
-      if (c.vertices.nodes(k, i) >= 0) w.nodeForce.col(c.vertices.nodes(k, i)) += c.vertices.weights(k, i) * f;
+      if (c.vertices.nodes(k, i) >= 0) g.segment<3>(nodeOffset(model, c.vertices.nodes(k, i))) += c.vertices.weights(k, i) * gi;
   }
+  maskFixed(w, g);
+  // the force Ppl dV/dq
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    w.bodyForce.col(b) += w.pleuralPressure * g.segment<3>(6 * b);
+    w.bodyTorque.col(b) += w.pleuralPressure * g.segment<3>(6 * b + 3);
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) w.nodeForce.col(n) += w.pleuralPressure * g.segment<3>(nodeOffset(model, n));
 }
 
 // rotation vector [rad] of the child relative to the parent, world frame (zero at rest)
@@ -462,6 +475,10 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     const double gu = g.dot(u.tail(nodes));
     out.tail(nodes) += (kp * gu) * g;
   }
+  // rank-one pleural stiffness g_c g_c^T / C while the lungs pull (Ppl < 0), g_c = dV/dq of the cavity (its
+  // geometric part -Ppl A^T H A, like the gut pressure's, is left out: it changed no energy figure measurably)
+  if (w.pleuralStiffness > 0.0 && kScale != 0.0)
+    out += (kScale * w.pleuralStiffness * w.cavityGeneralized.dot(u)) * w.cavityGeneralized;
   // joint springs and friction act on the relative angular velocity
   const Joints& j = model.joints;
   for (int i = 0; i < j.size(); ++i) {
@@ -716,6 +733,22 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
   w.rankOneSolve = w.rankOne;
   w.system.solve(w.rankOneSolve);
   w.rankOneScale = 1.0 / (1.0 + w.rankOne.dot(w.rankOneSolve));
+  // and the pleural one, v v^T with v = dt J^T g_c / sqrt(C), on top: (A1 + v v^T)^-1 = A1^-1 - A1^-1 v v^T A1^-1 /
+  // (1 + v^T A1^-1 v), A1 = A0 + u u^T
+  w.rankTwo.resize(0);
+  if (w.pleuralStiffness > 0.0) {
+    Eigen::VectorXd& v = w.cavityReduced;
+    v = w.cavityGeneralized;
+    gatherJointForces(model.joints, w, tree, v);
+    maskReduced(model.joints, w, tree, v);
+    const double sv = dt * std::sqrt(w.pleuralStiffness);
+    w.rankTwo.resize(nf);
+    for (Eigen::Index k = 0; k < nf; ++k) w.rankTwo(k) = sv * v(w.freeCoordinates(k));
+    w.rankTwoSolve = w.rankTwo;
+    w.system.solve(w.rankTwoSolve);
+    w.rankTwoSolve -= (w.rankOneScale * w.rankOne.dot(w.rankTwoSolve)) * w.rankOneSolve;
+    w.rankTwoScale = 1.0 / (1.0 + w.rankTwo.dot(w.rankTwoSolve));
+  }
   w.factorDt = dt;
   w.factorAge = 0;
   w.factorAxial = dt * dt * w.elementStiffness + dt * w.elementDamping;
@@ -730,6 +763,7 @@ void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd&
   w.compactZ = w.compactR;
   w.system.solve(w.compactZ);
   w.compactZ -= (w.rankOneScale * w.rankOne.dot(w.compactZ)) * w.rankOneSolve;
+  if (w.rankTwo.size() > 0) w.compactZ -= (w.rankTwoScale * w.rankTwo.dot(w.compactZ)) * w.rankTwoSolve;
   z.setZero();
   for (Eigen::Index k = 0; k < nf; ++k) z(w.freeCoordinates(k)) = w.compactZ(k);
 }
@@ -792,7 +826,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   }
   const bool stale = w.system.blocks() == 0 || w.factorAge >= o.preconditionerRefresh ||
                      w.cgIterations > o.refactorIterations || changed > o.refactorElementChanges ||
-                     dt != w.factorDt;
+                     dt != w.factorDt || (w.pleuralStiffness > 0.0) != (w.rankTwo.size() > 0);
   if (stale) factorSystem(model, o, tree, w, dt);
   ++w.factorAge;
   linearizeElements(model, dt * dt, dt, w);
@@ -1120,6 +1154,7 @@ StepWork makeStepWork(const Model& model) {
   w.nodeForce = Eigen::Matrix3Xd::Zero(3, nn);
   w.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
+  w.cavityGeneralized = Eigen::VectorXd::Zero(n);
   w.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
   // nodes tied by an element to a moving body: their coupling columns in bodyNodeBlock
   w.attachedColumn.setConstant(nn, -1);

@@ -1,7 +1,7 @@
 #pragma once
 /// @file Step.h
 /// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step):
-///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity, explicit),
+///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity),
 ///                  joint friction (Eq. 3), joint stiffness (spine; rib-neck hinges, Joints), visceral drag
 ///                  (Gut::drag), gravity
 ///   2. integrate   velocities and positions with the chosen integrator
@@ -22,7 +22,9 @@
 ///   and across each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx; kept
 ///   while the gut is over-full and Eq. 5's force is 0, so a step that compresses the gut meets the pressure
 ///   it raises: without it a suddenly contracting rectus squeezed the gut by 10 % in one step at dt 20 ms)
-///   and the spine joint springs; D holds element damping, joint friction and the visceral drag beta M.
+///   the rank-one pleural stiffness g_c g_c^T / C of the lung recoil while Ppl < 0 (g_c = dV/dq of the cavity over
+///   the bones and nodes its vertices are bound to, so a step meets the recoil its own motion changes) and the
+///   spine and rib-neck joint springs; D holds element damping, joint friction and the visceral drag beta M.
 ///   Why this one: the stiff parts of the model (cartilage, the gut's near-incompressibility kappa, joint
 ///   friction on 10-25 g ribs) are linear or nearly so, so backward Euler removes their step limit at the
 ///   cost of a few CG passes that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so
@@ -42,11 +44,12 @@
 /// itself, assembled sparse over the free coordinates (3x3 blocks: gut nodes, body spins and the free bodies'
 /// linear velocities) without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g),
 /// factored by BlockLdlt, with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 /
-/// (1 + u^T A0^-1 u). The factorization is kept while it stays a good preconditioner and refreshed when the last
-/// solve needed more than `refactorIterations`, when more than `refactorElementChanges` elements changed their
-/// 3x3 stiffness by a quarter (muscles going slack or taut, activation steps, fast rotation), after
-/// `preconditionerRefresh` steps, or when dt changes. A fresh factorization solves the step directly, dv' = P^-1 b
-/// (about every second step on the default model); with a kept one, CG on the matrix-free A starts from
+/// (1 + u^T A0^-1 u), and the pleural v v^T (v = dt J^T g_c / sqrt(C)) added the same way on top. The
+/// factorization is kept while it stays a good preconditioner and refreshed when the last solve needed more than
+/// `refactorIterations`, when more than `refactorElementChanges` elements changed their 3x3 stiffness by a quarter
+/// (muscles going slack or taut, activation steps, fast rotation), after `preconditionerRefresh` steps, when dt
+/// changes, or when the pleural pressure starts or stops acting. A fresh factorization solves the step directly,
+/// dv' = P^-1 b (about every second step on the default model); with a kept one, CG on the matrix-free A starts from
 /// dv' = P^-1 b and stops at a relative residual `cgTolerance` in the preconditioner norm
 /// (r^T P^-1 r <= tol^2 b^T P^-1 b), after about 3 iterations (more in a step where many muscles switch).
 /// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
@@ -121,6 +124,10 @@ struct StepWork {
   double pleuralPressure = 0.0;        ///< [Pa] Ppl of Cavity at the start of the last step (<= 0)
   Eigen::Matrix3Xd cavityPosition;     ///< [m] cavity vertices at the start of the last step (3 x #C)
   Eigen::Matrix3Xd cavityGradient;     ///< [m^2] dV/dx per cavity vertex (3 x #C)
+  Eigen::VectorXd cavityGeneralized;   ///< [m^2, m^3] dV/dq of the cavity over the implicit solver's entries (6 #B + 3 #N)
+                                       ///< at the start of the last step, filled while Ppl < 0
+  double pleuralStiffness = 0.0;       ///< [Pa/m^3] 1/C while the pleural pressure acts (Ppl < 0), else 0
+  Eigen::VectorXd cavityReduced;       ///< [m^2, m^3] J^T dV/dq, scratch of the factorization (6 #B + 3 #N)
   double gutVolume = 0.0;              ///< [m^3] V at the start of the last step
   double gutPressure = 0.0;            ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
   Eigen::VectorXd elementForce;        ///< [N] scalar force per element of the last step (#E)
@@ -172,6 +179,10 @@ struct StepWork {
   Eigen::VectorXd rankOne;             ///< [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
   Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
   double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
+  Eigen::VectorXd rankTwo;             ///< [kg^1/2] v = dt J^T g_c / sqrt(C) over the free coordinates, the pleural
+                                       ///< stiffness at the factorization; empty when it had none
+  Eigen::VectorXd rankTwoSolve;        ///< [1/kg^1/2] (A0 + u u^T)^-1 v (#free)
+  double rankTwoScale = 1.0;           ///< [-] 1 / (1 + v^T (A0 + u u^T)^-1 v)
   Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
   double factorDt = 0.0;               ///< [s] dt of the factorization
   Eigen::VectorXd factorAxial;         ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
