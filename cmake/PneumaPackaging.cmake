@@ -19,6 +19,7 @@ install(FILES ${CMAKE_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/d
 
 # man pages from each program's --help, written to a temporary file and renamed (help2man: Debian's help2man)
 find_program(PNEUMA_HELP2MAN help2man)
+find_program(PNEUMA_GZIP gzip)
 if(PNEUMA_HELP2MAN)
   set(pneuma_man_pages)
   foreach(program IN ITEMS pneuma pneuma-cli)
@@ -37,6 +38,15 @@ if(PNEUMA_HELP2MAN)
       DEPENDS ${program}
       COMMENT "Writing the man page ${program}.1 from ${program} --help"
       VERBATIM)
+    if(PNEUMA_GZIP)
+      # installed compressed, as Debian's policy asks (gzip -n: no name or time stamp, reproducible)
+      add_custom_command(
+        OUTPUT ${page}.gz
+        COMMAND ${PNEUMA_GZIP} -9 -n -k -f ${page}
+        DEPENDS ${page}
+        VERBATIM)
+      set(page ${page}.gz)
+    endif()
     list(APPEND pneuma_man_pages ${page})
   endforeach()
   add_custom_target(pneuma_man_pages ALL DEPENDS ${pneuma_man_pages})
