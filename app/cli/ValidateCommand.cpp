@@ -8,6 +8,7 @@
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Experiments.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Resources.h"
 #include "viz/AtomicFile.h"
 #include "viz/Plot.h"
 
@@ -141,7 +142,7 @@ void runValidate(const ValidateArgs& args) {
   try {
     model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
     for (const char* name : {"calm", "deep", "panting", "forced-exhale"})
-      styles.push_back(sim::loadBreathStyle(name, resourceDir() + "/presets"));
+      styles.push_back(sim::loadBreathStyle(name, sim::resourceDir() + "/presets"));
   } catch (const sim::Error& e) {
     fail(kExitBadInput, e.what());
   }

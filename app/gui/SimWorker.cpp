@@ -1,6 +1,7 @@
 #include "gui/SimWorker.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Resources.h"
 #include "viz/VtkSeriesWriter.h"
 
 #include <QTimer>
@@ -174,8 +175,7 @@ void SimWorker::collect(const sim::Simulation& simulation) {
 }
 
 void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mode) {
-  // presets live in <resources>/presets/affect, beside the breath styles
-  const std::string resources = std::filesystem::path(sim::defaultPresetDir()).parent_path().string();
+  const std::string resources = sim::resourceDir();
   if (m_pattern) {
     m_pattern->push(sim::pattern::loadAffect(name, resources).layers, mode);
     return;

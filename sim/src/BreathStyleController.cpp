@@ -2,6 +2,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/Resources.h"
 
 #include <nlohmann/json.hpp>
 
@@ -108,11 +109,7 @@ std::string serializeBreathStyle(const BreathStyle& s) {
   return j.dump(2) + "\n";
 }
 
-std::string defaultPresetDir() {
-  if (const char* env = std::getenv("PNEUMA_RESOURCE_DIR"); env != nullptr && *env != '\0')
-    return std::string(env) + "/presets";
-  return PNEUMA_SIM_PRESET_DIR;
-}
+std::string defaultPresetDir() { return resourceDir() + "/presets"; }
 
 std::vector<std::string> breathStyleNames(const std::string& presetDir) {
   std::vector<std::string> names;

@@ -68,8 +68,7 @@ double expiratoryDrive(const BreathStyle& s, double phase);
 /// Serialises a preset to JSON text with the fields parseBreathStyle() reads (round-trips exactly).
 std::string serializeBreathStyle(const BreathStyle& s);
 
-/// Directory holding the breath-style presets: $PNEUMA_RESOURCE_DIR/presets when that variable is
-/// set, else the source tree's resources/presets.
+/// Directory holding the breath-style presets: resourceDir()/presets (Resources.h).
 std::string defaultPresetDir();
 
 /// Names of the presets (*.json) in `presetDir`, sorted.
