@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 
 namespace pneuma::sim {
@@ -60,6 +61,21 @@ TEST(Breathing, CalmTidalVolumeAndRate) {
 TEST(Breathing, CalmExpirationFallsWithoutRebound) {
   REQUIRE_DEFAULT_MODEL();
   expectPassed(breathStyleChecks(runs({"calm"})), {"calm.expiration_rebound"});
+}
+
+// the mechanism, not only the volume: in a calm breath the central tendon descends as in M-mode ultrasound
+// (18 +/- 3 mm in men, Boussuges et al. 2009, Chest 135:391; 12-25 mm here) and more than it moves forward (the
+// dome hung on horizontal strands swung 19-28 mm forward while rising), and the belly moves out (Konno & Mead)
+TEST(Breathing, CalmDomeDescendsRatherThanSwingingForward) {
+  REQUIRE_DEFAULT_MODEL();
+  const Motion& m = run("calm").summary.motion;
+  RecordProperty("dome_descent_mm", std::to_string(m.domeDescent * 1e3));
+  RecordProperty("dome_anterior_mm", std::to_string(m.domeAnterior * 1e3));
+  EXPECT_GT(m.domeDescent, 0.012);
+  EXPECT_LT(m.domeDescent, 0.025);
+  EXPECT_LT(std::abs(m.domeAnterior), m.domeDescent);
+  EXPECT_GT(m.umbilicusAnterior, 0.0);
+  EXPECT_GT(m.lowerRibExpansion, 0.0);  // the lower ribs widen, if still by less than the 2 mm of issue 13
 }
 
 // Table 2 slow/deep: 12 b/m; tidal volume above calm and within 1-3 L
