@@ -78,6 +78,25 @@ TEST(Breathing, CalmDomeDescendsRatherThanSwingingForward) {
   EXPECT_GT(m.lowerRibExpansion, 0.0);  // the lower ribs widen, if still by less than the 2 mm of issue 13
 }
 
+// rib cage and abdomen move together (phase 12-23 deg in healthy young adults, Chen et al. 2015; below 30 here,
+// 115 deg before the breath styles' drives were reworked) and the flow is a spirogram's: one inspiration and one
+// expiration per breath; deep breathing lowers the dome by 20-35 mm per litre (Boussuges et al. 2009: 70 +/- 11 mm
+// over an inspiratory capacity of 2-3.5 L)
+TEST(Breathing, RibCageAndAbdomenInPhaseAndDomeDescentPerLitre) {
+  REQUIRE_DEFAULT_MODEL();
+  const Motion& calm = run("calm").summary.motion;
+  RecordProperty("rc_ab_phase_deg", std::to_string(calm.phaseAngle * 180.0 / M_PI));
+  EXPECT_LT(std::abs(calm.phaseAngle), 30.0 * M_PI / 180.0);
+  EXPECT_GT(calm.ribCageTidal, 0.0);
+  EXPECT_GT(calm.abdomenTidal, 0.0);
+  EXPECT_EQ(calm.flowSignChanges, 2.0);
+  const StyleRun& deep = run("deep");
+  const double perLitre = deep.summary.motion.domeDescent / (deep.summary.tidalVolume * 1e3);  // [m/L]
+  RecordProperty("deep_dome_mm_per_l", std::to_string(perLitre * 1e3));
+  EXPECT_GT(perLitre, 0.020);
+  EXPECT_LT(perLitre, 0.035);
+}
+
 // Table 2 slow/deep: 12 b/m; tidal volume above calm and within 1-3 L
 TEST(Breathing, DeepLargerThanCalmWithinHumanRange) {
   REQUIRE_DEFAULT_MODEL();
