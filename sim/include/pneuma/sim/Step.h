@@ -145,7 +145,7 @@ struct StepConstants {
   /// implicit solver entry -> free coordinate, or -1 (fixed or dependent)
   Eigen::VectorXi freeIndex;
   Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
-  /// SolverMemory::system's value slot of every streamed 3 x 3 block, -1 if dropped (see Step.cpp)
+  /// SolverMemory::system's value slot of every streamed 3 x 3 block, -1 if dropped (see StepImplicit.cpp)
   std::vector<int> systemPattern;
 };
 
