@@ -1,64 +1,18 @@
 #pragma once
 /// @file Step.h
-/// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step):
+/// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step); docs/integrator.md has
+/// the design, the integrators, the linear solve and the reasons for them.
 ///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity),
 ///                  joint friction (Eq. 3), joint stiffness (spine; rib-neck hinges, Joints), visceral drag
-///                  (Gut::drag), gravity
-///   2. integrate   velocities and positions with the chosen integrator
+///                  (Gut::drag), gravity                                            (StepForces.cpp)
+///   2. integrate   velocities: SymplecticEuler, the paper's explicit scheme (Step.cpp), or the default
+///                  ImplicitEulerJoints, linearly implicit Euler in the joint tree's coordinates by CG with
+///                  a kept block LDL^T factorization as preconditioner (StepImplicit.cpp); then positions
 ///   3. joints      ball-joint constraints: velocity impulses, then position projection (error < 0.1 mm)
-/// Metrics are computed separately, at the output rate (computeMetrics()).
-///
-/// Integrators
-/// - SymplecticEuler: the paper's reference scheme (Section 6.1), v += F/m dt, then x += v dt, for
-///   nodes and bodies (quaternions integrated with the new angular velocity). Explicit, so dt is
-///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max). Default dt 10 us: on
-///   the default model its limit is the diaphragm damping on the light dome nodes (dt < 2 m / sum b) and the
-///   10-25 g ribs; 20 us blows up within 0.1 s (real-time factor about 0.1).
-/// - ImplicitEulerJoints (the default): linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH
-///   1998), solving (M + dt D + dt^2 K) dv = dt (f - dt K v) in the coordinates of the joint tree: the linear
-///   velocity of every body hanging on a ball joint is eliminated, v_c = v_p + w_p x r_p - w_c x r_c
-///   (J: reduced -> full velocities), and a preconditioned conjugate gradient solves
-///   J^T (M + dt D + dt^2 K) J dv' = J^T rhs (see "Linear solve" below). K holds the element stiffness along
-///   and across each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx; kept
-///   while the gut is over-full and Eq. 5's force is 0, so a step that compresses the gut meets the pressure
-///   it raises: without it a suddenly contracting rectus squeezed the gut by 10 % in one step at dt 20 ms)
-///   the rank-one pleural stiffness g_c g_c^T / C of the lung recoil while Ppl < 0 (g_c = dV/dq of the cavity over
-///   the bones and nodes its vertices are bound to, so a step meets the recoil its own motion changes) and the
-///   spine and rib-neck joint springs; D holds element damping, joint friction and the visceral drag beta M.
-///   Why this one: the stiff parts of the model (cartilage, the gut's near-incompressibility kappa, joint
-///   friction on 10-25 g ribs) are linear or nearly so, so backward Euler removes their step limit at the
-///   cost of a few CG passes that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so
-///   its numerical damping of high frequencies is harmless, while a position-based (XPBD) scheme would not
-///   follow the paper's force laws (Eq. 2, 4, 5) as directly. The joints hold inside the linear solve, so
-///   joint friction (Eq. 3) couples a rib's spin to the spine about the joint rather than about the rib's
-///   com: friction only dissipates (tested at 150 N m s/rad, 10x the calibrated mu) and the result does
-///   not depend on dt (deep breathing: 921 / 919 / 924 mL at dt 10 / 5 / 2 ms). An earlier variant that
-///   solved in the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
-///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 1/60 s,
-///   one step per 60 Hz frame (docs/cli.md "Performance" has the accuracy by dt).
-/// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
-/// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
-/// mass-weighted projection removes the position drift.
-///
-/// Linear solve (ImplicitEulerJoints): A dv' = b, A = J^T (M + dt D + dt^2 K) J. The preconditioner P is A
-/// itself, assembled sparse over the free coordinates (3x3 blocks: gut nodes, body spins and the free bodies'
-/// linear velocities) without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g),
-/// factored by BlockLdlt, with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 /
-/// (1 + u^T A0^-1 u), and the pleural v v^T (v = dt J^T g_c / sqrt(C)) added the same way on top. The
-/// factorization is kept while it stays a good preconditioner and refreshed when the last solve needed more than
-/// `refactorIterations`, when more than `refactorElementChanges` elements changed their 3x3 stiffness by a quarter
-/// (muscles going slack or taut, activation steps, fast rotation), after `preconditionerRefresh` steps, when dt
-/// changes, or when the pleural pressure starts or stops acting. A fresh factorization solves the step directly,
-/// dv' = P^-1 b (about every second step on the default model); with a kept one, CG on the matrix-free A starts from
-/// dv' = P^-1 b and stops at a relative residual `cgTolerance` in the preconditioner norm
-/// (r^T P^-1 r <= tol^2 b^T P^-1 b), after about 3 iterations (more in a step where many muscles switch).
-/// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
-/// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch
-/// no strand) only the node masses resist, 70 eigenvalues of P^-1 A below 1e-2, which neither Jacobi nor a
-/// coarse space of node aggregates captures (measured: 148 -> 87-116 iterations with 10-80 aggregates). An
-/// exact factorization captures them; the system changes by a few elements per step, so a factorization
-/// serves 3 - 4 steps, and the 3x3-block factorization (1281 free coordinates, 4.1k blocks in L) costs about
-/// 10 CG iterations.
+///                                                                                  (StepJoints.cpp)
+/// Metrics are computed separately, at the output rate (computeMetrics(), Metrics.cpp). StepWork splits what
+/// a step works with into model constants, the solver memory a restart saves with the State, scratch and
+/// outputs.
 
 #include "pneuma/sim/Activation.h"
 #include "pneuma/sim/BlockLdlt.h"
