@@ -84,6 +84,12 @@ long long CheckpointReader::readInt(const std::string& key) {
   return v;
 }
 
+void CheckpointReader::field(const std::string& key, int& v) {
+  const long long n = readInt(key);
+  if (n < INT32_MIN || n > INT32_MAX) fail(key, "integer out of range: " + std::to_string(n));
+  v = static_cast<int>(n);
+}
+
 std::uint64_t CheckpointReader::readUnsigned(const std::string& key) {
   expectKey(key);
   const std::string t = token(key);
@@ -129,84 +135,127 @@ void CheckpointReader::scalar(const std::string& key, int& v) {
   v = static_cast<int>(n);
 }
 
-// ---- the sim's records
+// ---- the sim's records: one list of fields per record, walked by the writer (const records) and the reader
+
+namespace {
+
+template <typename Archive, typename S>
+void stateFields(Archive& a, S& s, Eigen::Matrix4Xd& orientation, Eigen::Index nb, Eigen::Index nn) {
+  a.field("state.time", s.time);
+  a.field("state.steps", s.steps);
+  a.field("state.bodyPosition", s.bodyPosition, 3, nb);
+  a.field("state.bodyOrientation", orientation, 4, nb);  // quaternion coefficients x, y, z, w
+  a.field("state.bodyVelocity", s.bodyVelocity, 3, nb);
+  a.field("state.bodyAngularVelocity", s.bodyAngularVelocity, 3, nb);
+  a.field("state.nodePosition", s.nodePosition, 3, nn);
+  a.field("state.nodeVelocity", s.nodeVelocity, 3, nn);
+}
+
+// `values`: the values of A0 by slot, 9 per 3 x 3 block (none without a factorization)
+template <typename Archive, typename M>
+void solverFields(Archive& a, M& m, Eigen::Matrix<double, 9, Eigen::Dynamic>& values) {
+  a.field("solver.hasFactorization", m.hasFactorization);
+  a.field("solver.systemValues", values, 9, m.hasFactorization ? m.system.valueBlocks() : 0);
+  a.field("solver.rankOne", m.rankOne);
+  a.field("solver.rankOneSolve", m.rankOneSolve);
+  a.field("solver.rankOneScale", m.rankOneScale);
+  a.field("solver.rankTwo", m.rankTwo);
+  a.field("solver.rankTwoSolve", m.rankTwoSolve);
+  a.field("solver.rankTwoScale", m.rankTwoScale);
+  a.field("solver.factorDt", m.factorDt);
+  a.field("solver.factorAxial", m.factorAxial);
+  a.field("solver.factorTransverse", m.factorTransverse);
+  a.field("solver.factorDirection", m.factorDirection);
+  a.field("solver.factorAge", m.factorAge);
+  a.field("solver.cgIterations", m.cgIterations);
+}
+
+template <typename Archive, typename O>
+void outputFields(Archive& a, O& o, Eigen::Index ne) {
+  a.field("outputs.elementForce", o.elementForce, ne, 1);
+  a.field("outputs.elementLength", o.elementLength, ne, 1);
+  a.field("outputs.gutVolume", o.gutVolume);
+  a.field("outputs.gutPressure", o.gutPressure);
+  a.field("outputs.pleuralPressure", o.pleuralPressure);
+  a.field("outputs.maxJointError", o.maxJointError);
+}
+
+// the parts of Metrics that are not a double or an Eigen matrix, as matrices
+struct MetricsParts {
+  Eigen::VectorXi isSlack;
+  Eigen::VectorXd groupMeanTension;
+  Eigen::Matrix2Xd activations;  // r, alpha per group
+};
+
+template <typename Archive, typename M>
+void metricsFields(Archive& a, M& m, MetricsParts& parts) {
+  a.field("metrics.time", m.time);
+  a.field("metrics.lungVolume", m.lungVolume);
+  a.field("metrics.gutVolume", m.gutVolume);
+  a.field("metrics.gutVolumeError", m.gutVolumeError);
+  a.field("metrics.gutPressure", m.gutPressure);
+  a.field("metrics.abdomenVolume", m.abdomenVolume);
+  a.field("metrics.elementForce", m.elementForce);
+  a.field("metrics.isSlack", parts.isSlack);
+  a.field("metrics.groupMeanTension", parts.groupMeanTension, kElementGroupCount, 1);
+  a.field("metrics.activations", parts.activations, 2, kElementGroupCount);
+  a.field("metrics.kineticEnergy", m.kineticEnergy);
+  a.field("metrics.elasticEnergy", m.elasticEnergy);
+  a.field("metrics.gravityEnergy", m.gravityEnergy);
+  a.field("metrics.maxJointError", m.maxJointError);
+  a.field("metrics.landmarks", m.landmarks);
+}
+
+Eigen::Matrix2Xd activationMatrix(const Activations& a) {
+  Eigen::Matrix2Xd m(2, kElementGroupCount);
+  for (int g = 0; g < kElementGroupCount; ++g) m.col(g) << a[at(g)].r, a[at(g)].alpha;
+  return m;
+}
+
+Activations activationsOf(const Eigen::Matrix2Xd& m) {
+  Activations a{};
+  for (int g = 0; g < kElementGroupCount; ++g) a[at(g)] = {m(0, g), m(1, g)};
+  return a;
+}
+
+}  // namespace
 
 void writeState(CheckpointWriter& out, const State& s) {
-  out.write("state.time", s.time);
-  out.write("state.steps", s.steps);
-  Eigen::Matrix4Xd q(4, static_cast<Eigen::Index>(s.bodyOrientation.size()));
-  for (std::size_t b = 0; b < s.bodyOrientation.size(); ++b)
-    q.col(static_cast<Eigen::Index>(b)) = s.bodyOrientation[b].coeffs();
-  out.write("state.bodyPosition", s.bodyPosition);
-  out.write("state.bodyOrientation", q);
-  out.write("state.bodyVelocity", s.bodyVelocity);
-  out.write("state.bodyAngularVelocity", s.bodyAngularVelocity);
-  out.write("state.nodePosition", s.nodePosition);
-  out.write("state.nodeVelocity", s.nodeVelocity);
+  const Eigen::Index nb = static_cast<Eigen::Index>(s.bodyOrientation.size());
+  Eigen::Matrix4Xd q(4, nb);
+  for (Eigen::Index b = 0; b < nb; ++b) q.col(b) = s.bodyOrientation[static_cast<std::size_t>(b)].coeffs();
+  stateFields(out, s, q, nb, s.nodePosition.cols());
 }
 
 State readState(CheckpointReader& in, const Model& model) {
-  const Eigen::Index nb = model.bodies.size(), nn = model.nodes.size();
+  const Eigen::Index nb = model.bodies.size();
   State s;
-  s.time = in.readDouble("state.time");
-  s.steps = in.readInt("state.steps");
   Eigen::Matrix4Xd q;
-  in.readSized("state.bodyPosition", s.bodyPosition, 3, nb);
-  in.readSized("state.bodyOrientation", q, 4, nb);
+  stateFields(in, s, q, nb, static_cast<Eigen::Index>(model.nodes.size()));
   s.bodyOrientation.resize(static_cast<std::size_t>(nb));
   for (Eigen::Index b = 0; b < nb; ++b) s.bodyOrientation[static_cast<std::size_t>(b)].coeffs() = q.col(b);
-  in.readSized("state.bodyVelocity", s.bodyVelocity, 3, nb);
-  in.readSized("state.bodyAngularVelocity", s.bodyAngularVelocity, 3, nb);
-  in.readSized("state.nodePosition", s.nodePosition, 3, nn);
-  in.readSized("state.nodeVelocity", s.nodeVelocity, 3, nn);
   return s;
 }
 
 void writeSolverMemory(CheckpointWriter& out, const SolverMemory& m) {
-  out.write("solver.hasFactorization", m.hasFactorization);
-  // the values of A0 by slot: factoring them again gives the factorization's bits (BlockLdlt::factorize() is
-  // a function of the values and the analysis)
+  // the values of A0, not its factors: BlockLdlt::factorize() is a function of the values and the analysis,
+  // so factoring them again gives the factorization's bits
   const int slots = m.hasFactorization ? m.system.valueBlocks() : 0;
   Eigen::Matrix<double, 9, Eigen::Dynamic> values(9, slots);
   for (int k = 0; k < slots; ++k)
     values.col(k) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(m.system.value(k).data());
-  out.write("solver.systemValues", values);
-  out.write("solver.rankOne", m.rankOne);
-  out.write("solver.rankOneSolve", m.rankOneSolve);
-  out.write("solver.rankOneScale", m.rankOneScale);
-  out.write("solver.rankTwo", m.rankTwo);
-  out.write("solver.rankTwoSolve", m.rankTwoSolve);
-  out.write("solver.rankTwoScale", m.rankTwoScale);
-  out.write("solver.factorDt", m.factorDt);
-  out.write("solver.factorAxial", m.factorAxial);
-  out.write("solver.factorTransverse", m.factorTransverse);
-  out.write("solver.factorDirection", m.factorDirection);
-  out.write("solver.factorAge", m.factorAge);
-  out.write("solver.cgIterations", m.cgIterations);
+  solverFields(out, m, values);
 }
 
 void readSolverMemory(CheckpointReader& in, SolverMemory& m) {
-  m.hasFactorization = in.readBool("solver.hasFactorization");
   Eigen::Matrix<double, 9, Eigen::Dynamic> values;
-  in.readSized("solver.systemValues", values, 9, m.hasFactorization ? m.system.valueBlocks() : 0);
+  solverFields(in, m, values);
   m.system.clearValues();
   if (m.hasFactorization) {
     for (int k = 0; k < m.system.valueBlocks(); ++k)
       Eigen::Map<Eigen::Matrix<double, 9, 1>>(m.system.value(k).data()) = values.col(k);
     if (!m.system.factorize()) in.fail("solver.systemValues", "the stored matrix is not positive definite");
   }
-  in.read("solver.rankOne", m.rankOne);
-  in.read("solver.rankOneSolve", m.rankOneSolve);
-  m.rankOneScale = in.readDouble("solver.rankOneScale");
-  in.read("solver.rankTwo", m.rankTwo);
-  in.read("solver.rankTwoSolve", m.rankTwoSolve);
-  m.rankTwoScale = in.readDouble("solver.rankTwoScale");
-  m.factorDt = in.readDouble("solver.factorDt");
-  in.read("solver.factorAxial", m.factorAxial);
-  in.read("solver.factorTransverse", m.factorTransverse);
-  in.read("solver.factorDirection", m.factorDirection);
-  m.factorAge = static_cast<int>(in.readInt("solver.factorAge"));
-  m.cgIterations = static_cast<int>(in.readInt("solver.cgIterations"));
   const Eigen::Index nf = 3 * static_cast<Eigen::Index>(m.system.blocks());
   const bool fits = m.rankOne.size() == nf && m.rankOneSolve.size() == nf &&
                     (m.rankTwo.size() == 0 || (m.rankTwo.size() == nf && m.rankTwoSolve.size() == nf));
@@ -215,81 +264,39 @@ void readSolverMemory(CheckpointReader& in, SolverMemory& m) {
 }
 
 void writeStepOutputs(CheckpointWriter& out, const StepOutputs& o) {
-  out.write("outputs.elementForce", o.elementForce);
-  out.write("outputs.elementLength", o.elementLength);
-  out.write("outputs.gutVolume", o.gutVolume);
-  out.write("outputs.gutPressure", o.gutPressure);
-  out.write("outputs.pleuralPressure", o.pleuralPressure);
-  out.write("outputs.maxJointError", o.maxJointError);
+  outputFields(out, o, o.elementForce.size());
 }
 
-void readStepOutputs(CheckpointReader& in, StepOutputs& o) {
-  const Eigen::Index ne = o.elementForce.size();
-  in.readSized("outputs.elementForce", o.elementForce, ne, 1);
-  in.readSized("outputs.elementLength", o.elementLength, ne, 1);
-  o.gutVolume = in.readDouble("outputs.gutVolume");
-  o.gutPressure = in.readDouble("outputs.gutPressure");
-  o.pleuralPressure = in.readDouble("outputs.pleuralPressure");
-  o.maxJointError = in.readDouble("outputs.maxJointError");
-}
+void readStepOutputs(CheckpointReader& in, StepOutputs& o) { outputFields(in, o, o.elementForce.size()); }
 
 void writeActivations(CheckpointWriter& out, const std::string& key, const Activations& a) {
-  Eigen::Matrix2Xd m(2, kElementGroupCount);
-  for (int g = 0; g < kElementGroupCount; ++g) m.col(g) << a[at(g)].r, a[at(g)].alpha;
-  out.write(key, m);
+  out.write(key, activationMatrix(a));
 }
 
 Activations readActivations(CheckpointReader& in, const std::string& key) {
   Eigen::Matrix2Xd m;
   in.readSized(key, m, 2, kElementGroupCount);
-  Activations a{};
-  for (int g = 0; g < kElementGroupCount; ++g) a[at(g)] = {m(0, g), m(1, g)};
-  return a;
+  return activationsOf(m);
 }
 
 void writeMetrics(CheckpointWriter& out, const Metrics& m) {
-  out.write("metrics.time", m.time);
-  out.write("metrics.lungVolume", m.lungVolume);
-  out.write("metrics.gutVolume", m.gutVolume);
-  out.write("metrics.gutVolumeError", m.gutVolumeError);
-  out.write("metrics.gutPressure", m.gutPressure);
-  out.write("metrics.abdomenVolume", m.abdomenVolume);
-  out.write("metrics.elementForce", m.elementForce);
-  Eigen::VectorXi slack(static_cast<Eigen::Index>(m.isSlack.size()));
-  for (std::size_t e = 0; e < m.isSlack.size(); ++e) slack(static_cast<Eigen::Index>(e)) = m.isSlack[e];
-  out.write("metrics.isSlack", slack);
-  out.write("metrics.groupMeanTension",
-            Eigen::Map<const Eigen::VectorXd>(m.groupMeanTension.data(), kElementGroupCount));
-  writeActivations(out, "metrics.activations", m.activations);
-  out.write("metrics.kineticEnergy", m.kineticEnergy);
-  out.write("metrics.elasticEnergy", m.elasticEnergy);
-  out.write("metrics.gravityEnergy", m.gravityEnergy);
-  out.write("metrics.maxJointError", m.maxJointError);
-  out.write("metrics.landmarks", m.landmarks);
+  MetricsParts parts;
+  parts.isSlack.resize(static_cast<Eigen::Index>(m.isSlack.size()));
+  for (std::size_t e = 0; e < m.isSlack.size(); ++e)
+    parts.isSlack(static_cast<Eigen::Index>(e)) = m.isSlack[e];
+  parts.groupMeanTension = Eigen::Map<const Eigen::VectorXd>(m.groupMeanTension.data(), kElementGroupCount);
+  parts.activations = activationMatrix(m.activations);
+  metricsFields(out, m, parts);
 }
 
 void readMetrics(CheckpointReader& in, Metrics& m) {
-  m.time = in.readDouble("metrics.time");
-  m.lungVolume = in.readDouble("metrics.lungVolume");
-  m.gutVolume = in.readDouble("metrics.gutVolume");
-  m.gutVolumeError = in.readDouble("metrics.gutVolumeError");
-  m.gutPressure = in.readDouble("metrics.gutPressure");
-  m.abdomenVolume = in.readDouble("metrics.abdomenVolume");
-  in.read("metrics.elementForce", m.elementForce);
-  Eigen::VectorXi slack;
-  in.read("metrics.isSlack", slack);
-  m.isSlack.assign(static_cast<std::size_t>(slack.size()), 0);
-  for (Eigen::Index e = 0; e < slack.size(); ++e)
-    m.isSlack[static_cast<std::size_t>(e)] = static_cast<std::uint8_t>(slack(e));
-  Eigen::VectorXd tension;
-  in.readSized("metrics.groupMeanTension", tension, kElementGroupCount, 1);
-  for (int g = 0; g < kElementGroupCount; ++g) m.groupMeanTension[at(g)] = tension(g);
-  m.activations = readActivations(in, "metrics.activations");
-  m.kineticEnergy = in.readDouble("metrics.kineticEnergy");
-  m.elasticEnergy = in.readDouble("metrics.elasticEnergy");
-  m.gravityEnergy = in.readDouble("metrics.gravityEnergy");
-  m.maxJointError = in.readDouble("metrics.maxJointError");
-  in.read("metrics.landmarks", m.landmarks);
+  MetricsParts parts;
+  metricsFields(in, m, parts);
+  m.isSlack.assign(static_cast<std::size_t>(parts.isSlack.size()), 0);
+  for (Eigen::Index e = 0; e < parts.isSlack.size(); ++e)
+    m.isSlack[static_cast<std::size_t>(e)] = static_cast<std::uint8_t>(parts.isSlack(e));
+  for (int g = 0; g < kElementGroupCount; ++g) m.groupMeanTension[at(g)] = parts.groupMeanTension(g);
+  m.activations = activationsOf(parts.activations);
 }
 
 }  // namespace pneuma::sim

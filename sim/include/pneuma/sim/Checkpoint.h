@@ -33,6 +33,18 @@ class CheckpointWriter {
   void write(const std::string& key, bool value) { write(key, static_cast<long long>(value ? 1 : 0)); }
   void write(const std::string& key, const std::string& value);
   void write(const std::string& key, const char* value) { write(key, std::string(value)); }
+  /// The writer's side of a field list walked by both (Checkpoint.cpp): write(); the shape is the reader's
+  /// check.
+  template <typename T>
+  void field(const std::string& key, const T& value) {
+    write(key, value);
+  }
+  template <typename T>
+  void field(const std::string& key, const T& value, Eigen::Index rows, Eigen::Index cols) {
+    (void)rows;
+    (void)cols;
+    write(key, value);
+  }
   /// A dense double or int matrix: rows, cols, then the entries column by column.
   template <typename Derived>
   void write(const std::string& key, const Eigen::DenseBase<Derived>& m) {
@@ -81,6 +93,20 @@ class CheckpointReader {
     if (m.rows() != rows || m.cols() != cols)
       fail(key, "shape " + std::to_string(m.rows()) + " x " + std::to_string(m.cols()) + ", expected " +
                     std::to_string(rows) + " x " + std::to_string(cols));
+  }
+  /// The reader's side of a field list walked by both (Checkpoint.cpp).
+  void field(const std::string& key, double& v) { v = readDouble(key); }
+  void field(const std::string& key, long long& v) { v = readInt(key); }
+  void field(const std::string& key, int& v);
+  void field(const std::string& key, bool& v) { v = readBool(key); }
+  template <typename Derived>
+  void field(const std::string& key, Eigen::PlainObjectBase<Derived>& m) {
+    read(key, m);
+  }
+  template <typename Derived>
+  void field(const std::string& key, Eigen::PlainObjectBase<Derived>& m, Eigen::Index rows,
+             Eigen::Index cols) {
+    readSized(key, m, rows, cols);
   }
   /// @throws Error naming the source and `key`.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
