@@ -113,7 +113,7 @@ std::string CheckpointReader::readString(const std::string& key) {
 std::pair<Eigen::Index, Eigen::Index> CheckpointReader::beginArray(const std::string& key) {
   expectKey(key);
   long long rows = -1, cols = -1;
-  if (!(m_in >> rows >> cols) || rows < 0 || cols < 0 || (cols > 0 && rows > (1LL << 28) / cols))
+  if (!(m_in >> rows >> cols) || rows < 0 || cols < 0 || (cols > 0 && rows > (1LL << 26) / cols))
     fail(key, "bad array shape");
   return {static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols)};
 }

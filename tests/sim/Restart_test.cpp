@@ -202,6 +202,39 @@ TEST(ExactRestart, LoadRefusesAnotherTimeStep) {
   }
 }
 
+// a damaged file fails with an Error naming the field, before anything is changed
+TEST(ExactRestart, LoadRejectsADamagedFile) {
+  REQUIRE_DEFAULT_MODEL();
+  const auto model = defaultModel();
+  const BreathStyle calm = loadBreathStyle("calm");
+  Simulation a(model, std::make_unique<BreathStyleController>(calm), runOptions());
+  a.advance(0.2);
+  std::ostringstream file;
+  a.save(file);
+  const std::string text = file.str();
+  const auto expectError = [&](const std::string& damaged, const std::string& needle) {
+    Simulation b(model, std::make_unique<BreathStyleController>(calm), runOptions());
+    const State before = b.state();
+    std::istringstream in(damaged);
+    try {
+      b.load(in, "run.ckpt");
+      ADD_FAILURE() << "no Error for " << needle;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+    expectSameState(b.state(), before, "after a failed load");
+  };
+  expectError(text.substr(0, text.size() / 2), "run.ckpt: checkpoint field '");
+  expectError(text.substr(0, text.find("state.nodeVelocity")), "'state.nodeVelocity': the file ends here");
+  std::string renamed = text;
+  renamed.replace(renamed.find("solver.factorAge"), 16, "solver.factorAgx");
+  expectError(renamed, "'solver.factorAge': found 'solver.factorAgx' instead");
+  std::string notANumber = text;
+  const std::size_t at = notANumber.find("state.time ") + 11;
+  notANumber.replace(at, 1, "z");
+  expectError(notANumber, "'state.time': not a number");
+}
+
 // the control experiment: the same restart with the solver memory dropped (a fresh factorization at the
 // restart) does not continue bit-identically, so the tests above see the memory
 TEST(ExactRestart, WithoutTheSolverMemoryTheRunDiverges) {
