@@ -182,57 +182,51 @@ TEST(ExactRestart, AffectPanicContinuesBitIdentically) {
                       "panic");
 }
 
+// the file of a calm run saved after `seconds` [s]
+std::string savedCalmRun(double seconds) {
+  Simulation a(defaultModel(), std::make_unique<BreathStyleController>(loadBreathStyle("calm")),
+               runOptions());
+  a.advance(seconds);
+  std::ostringstream file;
+  a.save(file);
+  return file.str();
+}
+
+// loading `text` into a fresh calm run with `options` throws an Error containing `needle`, and the run is
+// left as it was
+void expectLoadError(const SimulationOptions& options, const std::string& text, const std::string& needle) {
+  Simulation b(defaultModel(), std::make_unique<BreathStyleController>(loadBreathStyle("calm")), options);
+  const State before = b.state();
+  std::istringstream in(text);
+  try {
+    b.load(in, "run.ckpt");
+    ADD_FAILURE() << "no Error for " << needle;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+  expectSameState(b.state(), before, "after a failed load");
+}
+
 TEST(ExactRestart, LoadRefusesAnotherTimeStep) {
   REQUIRE_DEFAULT_MODEL();
-  const auto model = defaultModel();
-  const BreathStyle calm = loadBreathStyle("calm");
-  Simulation a(model, std::make_unique<BreathStyleController>(calm), runOptions());
-  a.advance(0.1);
-  std::stringstream file;
-  a.save(file);
   SimulationOptions other = runOptions();
   other.dt = 0.01;
-  Simulation b(model, std::make_unique<BreathStyleController>(calm), other);
-  try {
-    b.load(file, "run.ckpt");
-    ADD_FAILURE() << "no Error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("run.ckpt: checkpoint field 'simulation.dt'"), std::string::npos)
-        << e.what();
-  }
+  expectLoadError(other, savedCalmRun(0.1), "run.ckpt: checkpoint field 'simulation.dt'");
 }
 
 // a damaged file fails with an Error naming the field, before anything is changed
 TEST(ExactRestart, LoadRejectsADamagedFile) {
   REQUIRE_DEFAULT_MODEL();
-  const auto model = defaultModel();
-  const BreathStyle calm = loadBreathStyle("calm");
-  Simulation a(model, std::make_unique<BreathStyleController>(calm), runOptions());
-  a.advance(0.2);
-  std::ostringstream file;
-  a.save(file);
-  const std::string text = file.str();
-  const auto expectError = [&](const std::string& damaged, const std::string& needle) {
-    Simulation b(model, std::make_unique<BreathStyleController>(calm), runOptions());
-    const State before = b.state();
-    std::istringstream in(damaged);
-    try {
-      b.load(in, "run.ckpt");
-      ADD_FAILURE() << "no Error for " << needle;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
-    expectSameState(b.state(), before, "after a failed load");
-  };
-  expectError(text.substr(0, text.size() / 2), "run.ckpt: checkpoint field '");
-  expectError(text.substr(0, text.find("state.nodeVelocity")), "'state.nodeVelocity': the file ends here");
+  const std::string text = savedCalmRun(0.2);
+  expectLoadError(runOptions(), text.substr(0, text.size() / 2), "run.ckpt: checkpoint field '");
+  expectLoadError(runOptions(), text.substr(0, text.find("state.nodeVelocity")),
+                  "'state.nodeVelocity': the file ends here");
   std::string renamed = text;
   renamed.replace(renamed.find("solver.factorAge"), 16, "solver.factorAgx");
-  expectError(renamed, "'solver.factorAge': found 'solver.factorAgx' instead");
+  expectLoadError(runOptions(), renamed, "'solver.factorAge': found 'solver.factorAgx' instead");
   std::string notANumber = text;
-  const std::size_t at = notANumber.find("state.time ") + 11;
-  notANumber.replace(at, 1, "z");
-  expectError(notANumber, "'state.time': not a number");
+  notANumber.replace(notANumber.find("state.time ") + 11, 1, "z");
+  expectLoadError(runOptions(), notANumber, "'state.time': not a number");
 }
 
 // the control experiment: the same restart with the solver memory dropped (a fresh factorization at the
