@@ -137,6 +137,11 @@ class PatternController : public Controller {
   /// kDriveTimeStep.
   double maxTimeStep() const override { return kDriveTimeStep; }
 
+  /// The pattern clock, the feedback's integral and last frame, the learned rest volume, the tracking
+  /// statistics and the whole LayerStack (pushed layers and its random stream included).
+  void saveState(CheckpointWriter& out) const override;
+  void loadState(CheckpointReader& in) override;
+
   /// Pushes layers live (the app's affect selector); see LayerStack::push().
   void push(const std::vector<Layer>& playOrder, SwitchMode mode);
 
