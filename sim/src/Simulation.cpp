@@ -136,7 +136,6 @@ void Simulation::restore(const SimulationCheckpoint& c) {
   m_work.memory = c.solver;
   m_work.outputs = c.outputs;
   m_state = s;
-  syncBodyFrames(*m_model, m_state, m_work);
   m_latest = c.latest;
   m_activations = c.activations;
   m_nextFrameTime = c.nextFrameTime;

@@ -192,12 +192,10 @@ StepWork makeStepWork(const Model& model) {
   return w;
 }
 
-void syncBodyFrames(const Model& model, const State& state, StepWork& work) {
-  updateBodyFrames(model, state, work);
-}
-
 void step(const Model& model, State& state, double dt, const Activations& act, const StepOptions& options,
           StepWork& work) {
+  // the body frames of this State, so that the step depends on the State and the solver memory only
+  updateBodyFrames(model, state, work);
   // joints: the tree solve keeps the anchors together only if the start velocity does (an initial state may
   // not)
   if (options.integrator == IntegratorKind::ImplicitEulerJoints)

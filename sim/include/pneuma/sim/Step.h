@@ -105,9 +105,8 @@ struct StepConstants {
 
 /// What the implicit solver (ImplicitEulerJoints) carries from one step to the next: the preconditioner's
 /// factorization, the element stiffness it was made with, its age and dt, and the last solve's CG iterations,
-/// which together decide when it is refreshed. The next step depends on the State, on this and on the body
-/// frames of the State (StepScratch::rotation, which syncBodyFrames() recomputes), nothing else, so a restart
-/// that saves the State and this continues bit-identically (Simulation::checkpoint(), Checkpoint.h). Empty
+/// which together decide when it is refreshed. The next step depends on the State and on this, nothing else, so
+/// a restart that saves the State and this continues bit-identically (Simulation::checkpoint(), Checkpoint.h). Empty
 /// (hasFactorization false) in a fresh StepWork: the first implicit step then factors.
 struct SolverMemory {
   bool hasFactorization = false;  ///< a factorization is held (false until the first implicit step)
@@ -132,12 +131,9 @@ struct SolverMemory {
   int cgIterations = 0;
 };
 
-/// Working memory of step(), overwritten within every step before it is read, except the body frames (see
-/// rotation); no allocation per step.
+/// Working memory of step(), overwritten within every step before it is read; no allocation per step.
 struct StepScratch {
-  /// [-] body rotation matrices (#B) of the State as the last step left it (makeStepWork(): the rest pose).
-  /// The next step's first joint check reads them before stage 1 recomputes them: a State put in place by
-  /// other means needs syncBodyFrames()
+  /// [-] body rotation matrices of the step's State (#B), set first thing in step()
   std::vector<Eigen::Matrix3d> rotation;
   /// [1/(kg m^2)] R I^-1 R^T, zero for fixed bodies (#B), as rotation
   std::vector<Eigen::Matrix3d> inverseInertiaWorld;
@@ -209,10 +205,6 @@ struct StepWork {
 /// Computes the constants of `model` (rest volumes, joint tree, the implicit system's pattern) and allocates
 /// the scratch; the solver memory starts empty.
 StepWork makeStepWork(const Model& model);
-
-/// Sets work.scratch.rotation and inverseInertiaWorld to those of `state`, as a step leaves them for the next
-/// one. A restart calls it after putting a saved State in place (Simulation::restore()).
-void syncBodyFrames(const Model& model, const State& state, StepWork& work);
 
 /// Stage 1 alone: clears and accumulates work.scratch.bodyForce [N], bodyTorque [N m] (world, about each com)
 /// and nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), the pleural pressure
