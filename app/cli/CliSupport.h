@@ -3,6 +3,7 @@
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
 /// resources, preparing output directories, number formatting for JSON/CSV.
 
+#include "pneuma/sim/Limits.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Step.h"
 
@@ -43,6 +44,9 @@ void applyIntegrator(const std::string& name, sim::IntegratorKind& kind);
 
 /// The resource directory (presets, scenarios): $PNEUMA_RESOURCE_DIR when set, else the source tree's resources/.
 std::string resourceDir();
+
+/// Fails with kExitBadInput and "<flag>: must be in [lo, hi] unit, got v" unless `range` contains `v`.
+void checkOption(const sim::Range& range, const char* flag, double v);
 
 /// Creates `dir` (and parents) and checks that a file can be written in it; fails with kExitBadInput otherwise.
 void prepareOutputDir(const std::string& dir);

@@ -66,13 +66,12 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (s.name.empty()) s.name = s.controllerName.empty() ? "run" : fs::path(s.controllerName).stem().string();
 
   if (a.isGiven("--duration")) {
-    if (!(a.duration > 0.0) || !std::isfinite(a.duration))
-      fail(kExitBadInput, "--duration: must be > 0 s, got " + formatNumber(a.duration));
+    checkOption(sim::kDurationRange, "--duration", a.duration);
     s.duration = a.duration;
   }
   if (a.scenario.empty() && !a.isGiven("--duration")) fail(kExitBadInput, "--duration is required (simulated seconds)");
   if (a.isGiven("--output-rate")) {
-    if (!(a.outputRate > 0.0)) fail(kExitBadInput, "--output-rate: must be > 0 Hz, got " + formatNumber(a.outputRate));
+    checkOption(sim::kOutputRateRange, "--output-rate", a.outputRate);
     s.outputs.outputRate = a.outputRate;
     s.options.outputRate = a.outputRate;
   }
@@ -80,11 +79,11 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (a.isGiven("--seed")) s.seed = a.seed;
   applyIntegrator(a.integrator, s.options.step.integrator);
   if (a.isGiven("--dt")) {
-    if (!(a.dt > 0.0)) fail(kExitBadInput, "--dt: must be > 0 s, got " + formatNumber(a.dt));
+    checkOption(sim::kTimeStepRange, "--dt", a.dt);
     s.options.dt = a.dt;
   }
   if (a.isGiven("--settle")) {
-    if (!(a.settle >= 0.0)) fail(kExitBadInput, "--settle: must be >= 0 s, got " + formatNumber(a.settle));
+    checkOption(sim::kSettleTimeRange, "--settle", a.settle);
     s.options.settleTime = a.settle;
   }
   try {
@@ -120,6 +119,8 @@ void runSimulate(const SimulateArgs& args) {
     sim::SimulationOptions options = scenario.options;
     options.recordSeconds = sim::kTraceOnlyRecordSeconds;
     simulation = std::make_unique<sim::Simulation>(model, std::move(controller), options);
+    sim::checkStepCount(args.isGiven("--duration") ? "--duration" : "duration_s",
+                        scenario.options.settleTime + scenario.duration, simulation->dt());
   } catch (const sim::Error& e) {
     // a controller given on the command line is named by its flag, not by its scenario-file path
     std::string message = e.what();

@@ -25,10 +25,10 @@ namespace pneuma::sim {
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
   StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
-  double dt = 0.0;              ///< [s] time step; 0 = defaultTimeStep(step.integrator), or the controller's
-                                ///< maxTimeStep() when smaller
-  double settleTime = 2.0;      ///< [s] settling phase before the controller starts, >= 0
-  double outputRate = 60.0;     ///< [Hz] metrics and recording rate, > 0
+  double dt = 0.0;          ///< [s] time step in kTimeStepRange; 0 = defaultTimeStep(step.integrator), or the
+                            ///< controller's maxTimeStep() when smaller
+  double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange
+  double outputRate = 60.0;     ///< [Hz] metrics and recording rate, in kOutputRateRange
   double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
 };
 
@@ -37,7 +37,9 @@ struct SimulationOptions {
 /// "Performance").
 inline constexpr double kTraceOnlyRecordSeconds = 1.0;
 
-/// @throws Error naming the field: dt < 0 or not finite, settleTime < 0, outputRate <= 0, bad step options.
+/// @throws Error naming the field and value: dt neither 0 nor in kTimeStepRange, settleTime outside
+///         kSettleTimeRange, outputRate outside kOutputRateRange (Limits.h), recordSeconds < 0, bad step
+///         options.
 void validateSimulationOptions(const SimulationOptions& o);
 
 class Simulation {
@@ -56,7 +58,8 @@ class Simulation {
 
   /// Steps until `duration` [s] more has been simulated, computing metrics and recording at the
   /// output rate. `onFrame` (optional) is called after every output frame; return false to stop early.
-  /// @throws Error on NaN/Inf or blow-up, naming the time, the element/body/node and a likely cause.
+  /// @throws Error on NaN/Inf or blow-up, naming the time, the element/body/node and a likely cause; and
+  ///         before stepping when `duration` needs more than kMaxStepsPerRun steps of dt().
   void advance(double duration, const std::function<bool(const Simulation&)>& onFrame = {});
   /// One step of dt (metrics are computed if an output frame falls due).
   void stepOnce();
