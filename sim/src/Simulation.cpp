@@ -69,6 +69,14 @@ void Simulation::reset() {
 
 void Simulation::emitFrame() {
   computeMetrics(*m_model, m_state, m_activations, m_options.step, m_work, m_latest);
+  // a lung volume <= 0 means the rib cage has collapsed through itself: physically impossible, so stop
+  if (!(m_latest.lungVolume > 0.0)) {
+    std::ostringstream os;
+    os << "simulation failed at t = " << m_state.time << " s: lung volume " << m_latest.lungVolume * 1e6
+       << " mL is not positive, the rib cage collapsed through itself (likely cause: passive gains too "
+          "small to hold it, or a cavity turned inside out)";
+    throw Error(os.str());
+  }
   m_trace.append(m_latest);
   m_recorder.record(m_state, m_latest);
   m_nextFrameTime += 1.0 / m_options.outputRate;
