@@ -215,12 +215,13 @@ void checkController(const Scenario& scenario, const std::string& resourceDir) {
 }
 
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,
-                                           const std::string& resourceDir) {
+                                           const std::string& resourceDir, const std::atomic<bool>* stop) {
   if (scenario.controller == ControllerKind::Style)
     return std::make_unique<BreathStyleController>(styleOf(scenario, resourceDir));
   // parse the pattern first (cheap, reports bad names and fields), then calibrate the drive on the model
   const pattern::Pattern p = patternOf(scenario, resourceDir);
-  const pattern::DriveCalibration calibration = pattern::calibrateDrive(std::move(model), scenario.options);
+  const pattern::DriveCalibration calibration = pattern::calibrateDrive(
+      std::move(model), scenario.options, pattern::DriveCalibration{}.contractionR, stop);
   return pattern::makePatternController(p, scenario.seed, calibration);
 }
 

@@ -59,6 +59,8 @@ void Simulation::reset() {
   m_work = makeStepWork(*m_model);
   m_activations = m_controller->activations(0.0, Metrics{});
   m_trace.clear();
+  m_frameIndex = 0;
+  m_traceStride = 1;
   m_recorder.clear();
   m_latest = Metrics{};
   m_nextFrameTime = 0.0;
@@ -77,7 +79,12 @@ void Simulation::emitFrame() {
           "small to hold it, or a cavity turned inside out)";
     throw Error(os.str());
   }
-  m_trace.append(m_latest);
+  if (m_frameIndex % m_traceStride == 0) m_trace.append(m_latest);
+  if (m_trace.size() > kMaxTraceFrames) {
+    m_trace.keepEveryOtherFrame();
+    m_traceStride *= 2;
+  }
+  ++m_frameIndex;
   m_recorder.record(m_state, m_latest);
   m_nextFrameTime += 1.0 / m_options.outputRate;
 }
@@ -112,8 +119,13 @@ void Simulation::advance(double duration, const std::function<bool(const Simulat
     throw Error(os.str());
   }
   checkStepCount("duration", duration, m_dt);
+  m_wasStopped = false;
   const double end = m_state.time + duration;
   while (m_state.time < end - 0.5 * m_dt) {
+    if (m_stopFlag != nullptr && m_stopFlag->load(std::memory_order_relaxed)) {
+      m_wasStopped = true;
+      return;
+    }
     if (timedStep() && onFrame && !onFrame(*this)) return;
   }
 }

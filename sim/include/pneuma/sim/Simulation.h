@@ -16,6 +16,7 @@
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -31,6 +32,11 @@ struct SimulationOptions {
   double outputRate = 60.0;     ///< [Hz] metrics and recording rate, in kOutputRateRange
   double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
 };
+
+/// [-] most frames Simulation::trace() holds (9.1 min at 60 Hz, about 10 MB): beyond it the trace keeps every
+/// other frame and from then on records every 2nd (4th, ...) one, so a long run's memory stays bounded and
+/// the summary of a run longer than this is measured on the thinned trace.
+inline constexpr std::size_t kMaxTraceFrames = std::size_t{1} << 15;
 
 /// [s] recorder window of runs that read the trace rather than scrub the timeline (the CLI, the validation
 /// experiments, the benchmarks): filling a long fresh window costs page faults every frame (docs/cli.md,
@@ -63,6 +69,12 @@ class Simulation {
   void advance(double duration, const std::function<bool(const Simulation&)>& onFrame = {});
   /// One step of dt (metrics are computed if an output frame falls due).
   void stepOnce();
+  /// Makes advance() look at `*flag` before every step and return early once it is true, so that a stop
+  /// request (Ctrl-C, set from a signal handler: the flag is lock-free) takes effect within one step whatever
+  /// the output rate. nullptr (the default) checks nothing. The flag must outlive its use here.
+  void setStopFlag(const std::atomic<bool>* flag) { m_stopFlag = flag; }
+  /// True when the latest advance() returned early because the stop flag was raised.
+  bool wasStopped() const { return m_wasStopped; }
 
   const Model& model() const { return *m_model; }
   const State& state() const { return m_state; }
@@ -74,6 +86,8 @@ class Simulation {
   const Metrics& latestMetrics() const { return m_latest; }
   /// Activations applied in the latest step.
   const Activations& currentActivations() const { return m_activations; }
+  /// The light per-frame series of the run for the summary: every output frame, up to kMaxTraceFrames; a
+  /// longer run's trace is thinned evenly (every 2nd, 4th, ... frame).
   const Trace& trace() const { return m_trace; }
   const Recorder& recorder() const { return m_recorder; }
   /// Solver by-products of the latest step (CG iterations, joint error, element forces).
@@ -100,10 +114,14 @@ class Simulation {
   Activations m_activations{};
   Metrics m_latest;
   Trace m_trace;
+  long long m_frameIndex = 0;   // output frames emitted since reset()
+  long long m_traceStride = 1;  // the trace records frames whose index is a multiple of this
   Recorder m_recorder;
   double m_nextFrameTime = 0.0; // [s]
   double m_wallSeconds = 0.0;   // [s] wall-clock time spent stepping, measuring and recording
   double m_simulatedSeconds = 0.0;  // [s] simulated while timed
+  const std::atomic<bool>* m_stopFlag = nullptr;  // checked before every step of advance(); may be null
+  bool m_wasStopped = false;
 };
 
 }  // namespace pneuma::sim
