@@ -33,10 +33,8 @@ struct Interrupted {
   std::string err;
 };
 
-// Runs pneuma-cli with `args`, waits until its stderr holds `waitFor` (or `delay` seconds when waitFor is
-// ""), sends SIGINT, and measures how long the process takes to end.
-Interrupted interruptCli(const std::vector<std::string>& args, const std::string& waitFor, double delay) {
-  const std::string errPath = testing::TempDir() + "pneuma_robust_" + std::to_string(getpid()) + ".err";
+// starts pneuma-cli with `args`, stdout to /dev/null and stderr to `errPath`; returns its pid
+pid_t startCli(const std::vector<std::string>& args, const std::string& errPath) {
   const std::string exe = std::string(PNEUMA_BIN_DIR) + "/pneuma-cli";
   const pid_t pid = fork();
   if (pid == 0) {
@@ -50,6 +48,14 @@ Interrupted interruptCli(const std::vector<std::string>& args, const std::string
     execv(exe.c_str(), argv.data());
     _exit(127);
   }
+  return pid;
+}
+
+// Runs pneuma-cli with `args`, waits until its stderr holds `waitFor` (or `delay` seconds when waitFor is
+// ""), sends SIGINT, and measures how long the process takes to end.
+Interrupted interruptCli(const std::vector<std::string>& args, const std::string& waitFor, double delay) {
+  const std::string errPath = testing::TempDir() + "pneuma_robust_" + std::to_string(getpid()) + ".err";
+  const pid_t pid = startCli(args, errPath);
   const auto start = Clock::now();
   while (!waitFor.empty() && slurp(errPath).find(waitFor) == std::string::npos &&
          Clock::now() - start < std::chrono::seconds(60))
@@ -205,18 +211,7 @@ namespace {
 
 // runs pneuma-cli to the end; returns its exit code and peak resident memory [kB]
 std::pair<int, long> runMeasured(const std::vector<std::string>& args) {
-  const std::string exe = std::string(PNEUMA_BIN_DIR) + "/pneuma-cli";
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fo = open("/dev/null", O_WRONLY);
-    dup2(fo, 1);
-    dup2(fo, 2);
-    std::vector<char*> argv{const_cast<char*>(exe.c_str())};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(exe.c_str(), argv.data());
-    _exit(127);
-  }
+  const pid_t pid = startCli(args, "/dev/null");
   int status = 0;
   struct rusage usage {};
   wait4(pid, &status, 0, &usage);
