@@ -15,6 +15,7 @@ PNEUMA_PACKAGES=(
   libvtk9-dev libvtk9-qt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
+  help2man
 )
 
 pneuma_log() { printf '[pneuma] %s\n' "$*" >&2; }

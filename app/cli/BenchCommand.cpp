@@ -9,6 +9,7 @@
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Simulation.h"
 #include "viz/AtomicFile.h"
 
@@ -96,12 +97,12 @@ void runBench(const BenchArgs& args) {
   std::vector<sim::BreathStyle> styles;
   try {
     model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
-    for (const std::string& name : sim::breathStyleNames(resourceDir() + "/presets"))
-      styles.push_back(sim::loadBreathStyle(name, resourceDir() + "/presets"));
+    for (const std::string& name : sim::breathStyleNames(sim::resourceDir() + "/presets"))
+      styles.push_back(sim::loadBreathStyle(name, sim::resourceDir() + "/presets"));
   } catch (const sim::Error& e) {
     fail(kExitBadInput, e.what());
   }
-  if (styles.empty()) fail(kExitBadInput, "no breath-style presets in " + resourceDir() + "/presets");
+  if (styles.empty()) fail(kExitBadInput, "no breath-style presets in " + sim::resourceDir() + "/presets");
   const double dt = options.dt > 0.0 ? options.dt : sim::defaultTimeStep(options.step.integrator);
   nlohmann::json j;
   j["pneuma_version"] = PNEUMA_VERSION;

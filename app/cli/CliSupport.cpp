@@ -1,5 +1,7 @@
 #include "CliSupport.h"
 
+#include "pneuma/sim/Resources.h"
+
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
@@ -21,26 +23,12 @@ void fail(int code, const std::string& message) {
 }
 
 std::string resolveModelDir(const std::string& requested) {
-  std::string dir = requested;
-  if (dir.empty()) {
-    if (const char* env = std::getenv("PNEUMA_MODEL_DIR"); env != nullptr && *env != '\0') {
-      dir = env;
-    } else {
-      std::error_code ec;
-      const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-      dir = ((ec ? fs::path(".") : exe.parent_path()) / ".." / "models" / "default").lexically_normal().string();
-    }
-  }
+  const std::string dir = requested.empty() ? sim::defaultModelDir() : requested;
   if (!fs::is_directory(dir))
     fail(kExitBadInput, "model directory '" + dir + "' does not exist (build the default model or pass --model DIR)");
   if (!fs::is_regular_file(fs::path(dir) / "model.json"))
     fail(kExitBadInput, "model directory '" + dir + "' has no model.json");
   return dir;
-}
-
-std::string resourceDir() {
-  if (const char* env = std::getenv("PNEUMA_RESOURCE_DIR"); env != nullptr && *env != '\0') return env;
-  return PNEUMA_RESOURCE_DIR;
 }
 
 void prepareOutputDir(const std::string& dir) {
@@ -69,7 +57,9 @@ std::string formatNumber(double v) {
 }
 
 void addModelOption(CLI::App& cmd, std::string& model) {
-  cmd.add_option("--model", model, "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../models/default)");
+  cmd.add_option(
+      "--model", model,
+      "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../share/pneuma/models/default)");
 }
 
 void addIntegratorOption(CLI::App& cmd, std::string& name) {

@@ -29,8 +29,9 @@ enum ExitCode : int {
 /// (throws CLI::RuntimeError, which main() turns into the exit code).
 [[noreturn]] void fail(int code, const std::string& message);
 
-/// The model directory to use: `requested` when given, else $PNEUMA_MODEL_DIR, else
-/// <directory of pneuma-cli>/../models/default. Fails with kExitBadInput when it has no model.json.
+/// The model directory to use: `requested` when given, else sim::defaultModelDir() ($PNEUMA_MODEL_DIR, else
+/// <directory of pneuma-cli>/../share/pneuma/models/default). Fails with kExitBadInput when it has no
+/// model.json.
 std::string resolveModelDir(const std::string& requested);
 
 /// Adds `--model DIR` to `cmd` (resolved later by resolveModelDir()).
@@ -41,9 +42,6 @@ void addIntegratorOption(CLI::App& cmd, std::string& name);
 
 /// Sets `kind` from an --integrator value ("" keeps it); an unknown name fails with kExitBadInput and the valid names.
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind);
-
-/// The resource directory (presets, scenarios): $PNEUMA_RESOURCE_DIR when set, else the source tree's resources/.
-std::string resourceDir();
 
 /// Fails with kExitBadInput and "<flag>: must be in [lo, hi] unit, got v" unless `range` contains `v`.
 void checkOption(const sim::Range& range, const char* flag, double v);

@@ -7,6 +7,7 @@
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Resources.h"
 
 #include <CLI/CLI.hpp>
 
@@ -21,7 +22,7 @@ namespace {
 constexpr int kBadInput = 2;
 
 struct BuildOptions {
-  std::string anatomy = std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/male.json";
+  std::string anatomy = sim::resourceDir() + "/anatomy/male.json";
   std::string out;
   bool isPreviewSkipped = false;
 };

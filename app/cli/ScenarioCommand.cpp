@@ -6,6 +6,7 @@
 #include "Commands.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
 
 #include <CLI/CLI.hpp>
@@ -23,7 +24,7 @@ sim::Scenario loadChecked(const std::string& path) {
   try {
     sim::Scenario s = sim::loadScenario(path);
     try {
-      sim::checkController(s, resourceDir());
+      sim::checkController(s, sim::resourceDir());
     } catch (const sim::Error& e) {
       throw sim::Error(path + ": " + e.what());
     }

@@ -8,6 +8,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/pattern/PatternController.h"
@@ -115,11 +116,11 @@ void runSimulate(const SimulateArgs& args) {
   bool isInterrupted = false;
   try {
     model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
-    sim::checkController(scenario, resourceDir());
+    sim::checkController(scenario, sim::resourceDir());
     if (scenario.controller != sim::ControllerKind::Style)
       std::fprintf(stderr, "calibrating the pattern controller's muscle drive on the model...\n");
     std::unique_ptr<sim::Controller> controller =
-        sim::makeController(scenario, model, resourceDir(), InterruptGuard::flag());
+        sim::makeController(scenario, model, sim::resourceDir(), InterruptGuard::flag());
     // the CLI writes the trace; the recorder's timeline is for the app's scrubbing
     sim::SimulationOptions options = scenario.options;
     options.recordSeconds = sim::kTraceOnlyRecordSeconds;

@@ -8,6 +8,7 @@
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Experiments.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Resources.h"
 #include "viz/AtomicFile.h"
 #include "viz/Plot.h"
 
@@ -141,7 +142,7 @@ void runValidate(const ValidateArgs& args) {
   try {
     model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
     for (const char* name : {"calm", "deep", "panting", "forced-exhale"})
-      styles.push_back(sim::loadBreathStyle(name, resourceDir() + "/presets"));
+      styles.push_back(sim::loadBreathStyle(name, sim::resourceDir() + "/presets"));
   } catch (const sim::Error& e) {
     fail(kExitBadInput, e.what());
   }
@@ -282,7 +283,7 @@ void runValidate(const ValidateArgs& args) {
              << htmlEscape(row.unit) << "</td><td>" << verdictText << "</td><td>" << htmlEscape(row.source) << "</td></tr>\n";
   }
   const char* physIntro = "Physiology: the breath's motion in anatomical axes next to published ranges "
-                          "(summary.json's motion fields; informational until issue 13's mechanics land, not part of the result).";
+                          "(summary.json's motion fields; informational, not part of the result).";
   md << "## Physiology\n\n" << physIntro << "\n\n| style | what | measured | published | | source |\n|---|---|---|---|---|---|\n"
      << physMd.str() << "\n";
   for (const Figure& f : figures) md << "![" << f.caption << "](" << f.stem << ".png)\n\n" << f.caption << "\n\n";

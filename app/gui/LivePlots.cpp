@@ -41,9 +41,8 @@ const std::array<QColor, 4> kTraceColours{QColor(20, 20, 20), QColor(200, 0, 160
 
 LivePlots::LivePlots(QWidget* parent) : QWidget(parent), m_cursor(kNaN) {
   auto* splitter = new QSplitter(Qt::Vertical, this);
-  m_plots = {new PlotView("Lung-cavity volume", "volume [mL]"),
-             new PlotView("Gut volume error", "error [%]"),
-             new PlotView("Activations (r solid, \u03b1 dashed)", "activation [-]"),
+  m_plots = {new PlotView("Lung-cavity volume", "volume [mL]"), new PlotView("Gut volume error", "error [%]"),
+             new PlotView("Activations (r solid, \u03b1 dashed)", "r, \u03b1 [-]"),
              new PlotView("Muscle tension (mean per element)", "tension [N]")};
   m_plots[1]->setReferences({{"+0.5 %", 0.5, QColor(40, 160, 60)},
                              {"-0.5 %", -0.5, QColor(40, 160, 60)},

@@ -5,6 +5,7 @@
 #include "gui/PlotView.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/pattern/Pattern.h"
 #include "viz/AtomicFile.h"
@@ -147,11 +148,7 @@ MainWindow::~MainWindow() {
   m_thread.wait();
 }
 
-QString MainWindow::defaultModelDir() {
-  const QByteArray env = qgetenv("PNEUMA_MODEL_DIR");
-  if (!env.isEmpty()) return QString::fromLocal8Bit(env);
-  return QDir(QApplication::applicationDirPath()).absoluteFilePath("../models/default");
-}
+QString MainWindow::defaultModelDir() { return QString::fromStdString(sim::defaultModelDir()); }
 
 void MainWindow::buildTimeline(QWidget* centre) {
   auto* bar = new QWidget(centre);
@@ -260,8 +257,8 @@ void MainWindow::buildActions() {
   tools->addWidget(new QLabel(" Affect ", this));
   m_affectCombo = new QComboBox(this);
   m_affectCombo->setToolTip("Respiration pattern of an affective state (de Melo et al. 2010)");
-  const std::string resources = QFileInfo(QString::fromStdString(sim::defaultPresetDir())).path().toStdString();
-  for (const std::string& a : sim::pattern::listAffects(resources)) m_affectCombo->addItem(QString::fromStdString(a));
+  for (const std::string& a : sim::pattern::listAffects(sim::resourceDir()))
+    m_affectCombo->addItem(QString::fromStdString(a));
   m_affectCombo->setCurrentText("neutral");  // nothing is pushed yet: offer neutral, not the first in the list (anger)
   tools->addWidget(m_affectCombo);
   m_affectMode = new QComboBox(this);

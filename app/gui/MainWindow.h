@@ -38,7 +38,8 @@ class MainWindow : public QMainWindow {
   explicit MainWindow(QWidget* parent = nullptr);
   ~MainWindow() override;
 
-  /// The model directory used at start-up: $PNEUMA_MODEL_DIR, else <bindir>/../models/default.
+  /// The model directory used at start-up: sim::defaultModelDir() ($PNEUMA_MODEL_DIR, else
+  /// <bindir>/../share/pneuma/models/default).
   static QString defaultModelDir();
 
   /// Loads a model directory and restarts the run on it. On failure the current model stays, the

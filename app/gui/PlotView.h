@@ -2,10 +2,12 @@
 /// @file PlotView.h
 /// A live line chart drawn with QPainter (cheap enough for 60 Hz): series over a rolling time window,
 /// horizontal reference lines (tolerance bands), a time cursor with its read-out, and a note line
-/// (e.g. the current tidal volume). The same content converts to a viz::Plot for PNG/SVG/PDF export
-/// and to CSV, so exports show exactly the plotted data.
+/// (e.g. the current tidal volume). It paints the geometry viz::layoutPlot() computes for its content as a
+/// viz::Plot, the same content and function the PNG/SVG/PDF export uses (at a larger scale), so an export
+/// has the screen's ranges, ticks and legend; the CSV export holds exactly the plotted data.
 
 #include "viz/Plot.h"
+#include "viz/PlotLayout.h"
 
 #include <QColor>
 #include <QString>
@@ -55,8 +57,13 @@ class PlotView : public QWidget {
   /// Value of series `i` at the cursor (nearest sample), NaN when there is none.
   double cursorValue(std::size_t i) const;
 
-  /// The same chart as a viz::Plot (shown window only), for PNG and SVG export.
+  /// The same chart as a viz::Plot (shown window only), for PNG and SVG export: this widget at twice its size
+  /// (or more, to be at least 960 px wide), text and lines scaled alike, so it lays out with the same ticks.
   viz::Plot toPlot() const;
+  /// The chart as a viz::Plot at `scale` times this widget's size and line height.
+  viz::Plot toPlot(double scale) const;
+  /// The geometry painted on screen (viz::layoutPlot() with this widget's size and font).
+  viz::PlotLayout layout() const;
   /// The shown data as CSV: "time [s],<series name> [<unit>],..." then one row per sample.
   std::string toCsv() const;
 
@@ -70,6 +77,7 @@ class PlotView : public QWidget {
 
  private:
   std::size_t firstShown() const;
+  viz::PlotLayout layoutOf(const viz::Plot& plot) const;
   QString unit() const;
 
   QString m_title;

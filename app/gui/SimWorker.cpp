@@ -1,6 +1,7 @@
 #include "gui/SimWorker.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Resources.h"
 #include "viz/VtkSeriesWriter.h"
 
 #include <QTimer>
@@ -174,8 +175,7 @@ void SimWorker::collect(const sim::Simulation& simulation) {
 }
 
 void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mode) {
-  // presets live in <resources>/presets/affect, beside the breath styles
-  const std::string resources = std::filesystem::path(sim::defaultPresetDir()).parent_path().string();
+  const std::string resources = sim::resourceDir();
   if (m_pattern) {
     m_pattern->push(sim::pattern::loadAffect(name, resources).layers, mode);
     return;
@@ -189,19 +189,7 @@ void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mod
 }
 
 void SimWorker::restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const {
-  const sim::Recorder& rec = m_sim->recorder();
-  const sim::RecordedFrame& f = rec.frame(i);
-  rec.restore(i, state);
-  metrics.time = f.time;
-  metrics.lungVolume = f.lungVolume;
-  metrics.gutVolumeError = f.gutVolumeError;
-  // Eq. 4 with V0 / V = 1 / (1 + (V - V0) / V0)
-  const double kappa = m_sim->options().step.kappa >= 0.0 ? m_sim->options().step.kappa : m_model->gut.kappa;
-  metrics.gutPressure = kappa * (1.0 / (1.0 + f.gutVolumeError) - 1.0);
-  metrics.elementForce =
-      Eigen::Map<const Eigen::VectorXf>(f.elementForce.data(), static_cast<Eigen::Index>(f.elementForce.size()))
-          .cast<double>();
-  metrics.isSlack.clear();
+  m_sim->recorder().restore(i, state, metrics);
 }
 
 void SimWorker::exportRun(const std::array<std::string, 3>& request) {

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,12 +36,20 @@ int main(int argc, char** argv) {
   int qtArgc = static_cast<int>(qtArgv.size());
   qtArgv.push_back(nullptr);
 
+  // --help and --version need no display (help2man writes the man page from them at build time)
+  const bool isInfoOnly = std::any_of(qtArgv.begin(), qtArgv.end() - 1, [](const char* a) {
+    const std::string arg = a;
+    return arg == "--help" || arg == "-h" || arg == "-?" || arg == "--help-all" || arg == "--version" ||
+           arg == "-v";
+  });
+
   // without a display Qt would abort with a plugin message: say what to do instead
   const bool hasPlatformArg = std::any_of(qtArgv.begin(), qtArgv.end() - 1, [](const char* a) {
     return std::string(a) == "-platform" || std::string(a) == "--platform";
   });
   const auto isSet = [](const char* name) { return std::getenv(name) && *std::getenv(name); };
-  if (!isSet("DISPLAY") && !isSet("WAYLAND_DISPLAY") && !isSet("QT_QPA_PLATFORM") && !hasPlatformArg) {
+  if (!isInfoOnly && !isSet("DISPLAY") && !isSet("WAYLAND_DISPLAY") && !isSet("QT_QPA_PLATFORM") &&
+      !hasPlatformArg) {
     std::fprintf(stderr,
                  "pneuma: no display (DISPLAY is not set): run it in a desktop session or under "
                  "'xvfb-run -a -s \"-screen 0 1280x800x24\" pneuma ...'; for headless runs use pneuma-cli\n");
@@ -48,7 +57,9 @@ int main(int argc, char** argv) {
   }
 
   QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
-  QApplication app(qtArgc, qtArgv.data());
+  const std::unique_ptr<QCoreApplication> app =
+      isInfoOnly ? std::make_unique<QCoreApplication>(qtArgc, qtArgv.data())
+                 : std::make_unique<QApplication>(qtArgc, qtArgv.data());
   QApplication::setApplicationName("Pneuma");
   QApplication::setApplicationVersion(PNEUMA_VERSION);
 
@@ -56,8 +67,9 @@ int main(int argc, char** argv) {
   parser.setApplicationDescription("Pneuma: a simulated human torso breathing (Zordan et al. 2004).");
   parser.addHelpOption();
   parser.addVersionOption();
-  const QCommandLineOption model("model", "Model directory (default: $PNEUMA_MODEL_DIR or <bindir>/../models/default).",
-                                 "DIR");
+  const QCommandLineOption model(
+      "model", "Model directory (default: $PNEUMA_MODEL_DIR or <bindir>/../share/pneuma/models/default).",
+      "DIR");
   const QCommandLineOption style("style", "Breath style: calm, deep, panting or forced-exhale.", "NAME");
   const QCommandLineOption affect("affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).",
                                   "NAME");
@@ -78,6 +90,7 @@ int main(int argc, char** argv) {
   }
   if (parser.isSet("help")) parser.showHelp(0);
   if (parser.isSet("version")) parser.showVersion();
+  if (isInfoOnly) parser.showHelp(2);  // "--help" was an option's value: no widgets without a QApplication
   if (!parser.positionalArguments().isEmpty()) {
     std::fprintf(stderr, "pneuma: unexpected argument '%s'\n%s", qPrintable(parser.positionalArguments().first()),
                  qPrintable(parser.helpText()));

@@ -1,6 +1,7 @@
 #include "viz/Plot.h"
 
 #include "viz/AtomicFile.h"
+#include "viz/PlotLayout.h"
 
 #include <vtkFreeTypeTools.h>
 #include <vtkImageData.h>
@@ -34,7 +35,8 @@ struct Plot::Primitive {
   bool hasFill = false;       // rect fill
   Color fill{1.0, 1.0, 1.0};  // rect fill colour
   std::string text;           // text content
-  int fontSize = 14;          // [px]
+  double fontSize = 15.0;     // [px]
+  bool isBold = false;        // title
   Anchor anchor = Anchor::Start;
   bool isVertical = false;    // text rotated by -90 degrees (reads bottom to top)
 };
@@ -59,47 +61,28 @@ const char* fontFile() {
 }
 
 /// FreeType text property for a font size in pixels (72 dpi: 1 pt = 1 px).
-void configureText(vtkTextProperty* tp, int fontSize, const Color& c) {
+void configureText(vtkTextProperty* tp, double fontSize, const Color& c, bool isBold) {
   if (*fontFile() != '\0') {
     tp->SetFontFamily(VTK_FONT_FILE);
     tp->SetFontFile(fontFile());
   } else {
     tp->SetFontFamilyToArial();
   }
-  tp->SetFontSize(fontSize);
+  tp->SetFontSize(static_cast<int>(std::lround(fontSize)));
+  tp->SetBold(isBold ? 1 : 0);
   tp->SetColor(c.r, c.g, c.b);
   tp->SetJustificationToLeft();
   tp->SetVerticalJustificationToBottom();
 }
 
 /// Advance width of `text` at `fontSize` [px], measured with the same FreeType font the PNG uses.
-double textWidth(const std::string& text, int fontSize) {
+double textWidth(const std::string& text, double fontSize, bool isBold) {
   if (text.empty()) return 0.0;
   vtkNew<vtkTextProperty> tp;
-  configureText(tp, fontSize, Color{});
+  configureText(tp, fontSize, Color{}, isBold);
   int bbox[4] = {0, 0, 0, 0};
   vtkFreeTypeTools::GetInstance()->GetBoundingBox(tp, vtkStdString(text), 72, bbox);
   return bbox[1] - bbox[0] + 1;
-}
-
-/// Tick positions at 1, 2 or 5 times a power of ten covering [lo, hi] with about `target` ticks.
-std::vector<double> niceTicks(double lo, double hi, int target, double& step) {
-  const double raw = (hi - lo) / std::max(1, target);
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  const double m = raw / mag;
-  step = (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * mag;
-  std::vector<double> ticks;
-  for (double t = std::ceil(lo / step - 1e-9) * step; t <= hi + step * 1e-9; t += step)
-    ticks.push_back(std::abs(t) < step * 1e-9 ? 0.0 : t);
-  return ticks;
-}
-
-/// Tick label with just enough decimals for `step`.
-std::string tickLabel(double v, double step) {
-  const int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
 }
 
 std::string svgColor(const Color& c) {
@@ -181,9 +164,10 @@ class Canvas {
   }
 
   /// Draws FreeType text with its baseline anchored at (x, y); `align` is 0 (start), 0.5 (middle) or 1 (end).
-  void drawText(double x, double y, const std::string& text, int fontSize, double align, bool isVertical, const Color& c) {
+  void drawText(double x, double y, const std::string& text, double fontSize, bool isBold, double align,
+                bool isVertical, const Color& c) {
     vtkNew<vtkTextProperty> tp;
-    configureText(tp, fontSize, c);
+    configureText(tp, fontSize, c, isBold);
     vtkNew<vtkImageData> img;
     int dims[2] = {0, 0};
     auto* ft = vtkFreeTypeTools::GetInstance();
@@ -299,141 +283,125 @@ void Plot::setSize(int widthPx, int heightPx) {
   m_height = heightPx;
 }
 
-std::vector<Plot::Primitive> Plot::layout() const {
+void Plot::setTextSize(double px) {
+  if (!(px >= 6.0 && px <= 200.0))
+    throw std::invalid_argument("Plot text size must be in [6, 200] px, got " + std::to_string(px));
+  m_textSize = px;
+}
+
+void Plot::setNote(std::string note) { m_note = std::move(note); }
+
+void Plot::setXRange(double lo, double hi) {
+  if (!(lo < hi) || !std::isfinite(hi - lo))
+    throw std::invalid_argument("Plot x range must have lo < hi, got [" + std::to_string(lo) + ", " +
+                                std::to_string(hi) + "]");
+  m_hasXRange = true;
+  m_xRange = {lo, hi};
+}
+
+void Plot::setIncludeZero(bool includeZero) { m_includeZero = includeZero; }
+
+PlotLayout Plot::layout() const {
+  TextMetrics m;
+  m.lineHeight = lineHeight();
+  m.width = [size = m_textSize](const std::string& s) { return textWidth(s, size, false); };
+  m.titleWidth = [size = m_textSize](const std::string& s) { return textWidth(s, size, true); };
+  return layoutPlot(*this, m_width, m_height, m);
+}
+
+std::vector<Plot::Primitive> Plot::primitives() const {
   using P = Primitive;
-  const int titleSize = 18, labelSize = 15, tickSize = 13, legendSize = 13;
+  using S = PlotStyle;
+  using Align = PlotLayout::Align;
+  const PlotLayout L = layout();
+  const double k = L.scale();
   std::vector<P> out;
 
-  // data ranges over all finite values
-  const double inf = std::numeric_limits<double>::infinity();
-  double xlo = inf, xhi = -inf, ylo = inf, yhi = -inf;
-  for (const Series& s : m_series)
-    for (std::size_t i = 0; i < s.x.size(); ++i)
-      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
-        xlo = std::min(xlo, s.x[i]), xhi = std::max(xhi, s.x[i]);
-        ylo = std::min(ylo, s.y[i]), yhi = std::max(yhi, s.y[i]);
-      }
-  for (const Series& s : m_references) ylo = std::min(ylo, s.y[0]), yhi = std::max(yhi, s.y[0]);
-  if (!(xlo <= xhi)) xlo = 0.0, xhi = 1.0;
-  if (!(ylo <= yhi)) ylo = 0.0, yhi = 1.0;
-  if (xhi - xlo <= 1e-12 * std::max(1.0, std::abs(xlo))) xlo -= 0.5, xhi += 0.5;
-  if (yhi - ylo <= 1e-12 * std::max(1.0, std::abs(ylo))) ylo -= 1.0, yhi += 1.0;
-  const double pad = 0.06 * (yhi - ylo);
-  ylo -= pad, yhi += pad;
-
-  double xstep = 1.0, ystep = 1.0;
-  const std::vector<double> xticks = niceTicks(xlo, xhi, 8, xstep);
-  const std::vector<double> yticks = niceTicks(ylo, yhi, 6, ystep);
-  double yTickWidth = 0.0;
-  for (double t : yticks) yTickWidth = std::max(yTickWidth, textWidth(tickLabel(t, ystep), tickSize));
-
-  // legend entries; more than three go outside, to the right of the plot box
-  std::vector<const Series*> entries;
-  for (const Series& s : m_series)
-    if (!s.label.empty()) entries.push_back(&s);
-  for (const Series& s : m_references)
-    if (!s.label.empty()) entries.push_back(&s);
-  const bool hasLegend = entries.size() > 1 || !m_references.empty();
-  double legendTextWidth = 0.0;
-  for (const Series* s : entries) legendTextWidth = std::max(legendTextWidth, textWidth(s->label, legendSize));
-  const double legendW = legendTextWidth + 52.0;
-  const bool isLegendOutside = hasLegend && entries.size() > 3;
-
-  // plot box from the margins the labels need
-  const double left = 14.0 + labelSize + 10.0 + yTickWidth + 8.0;
-  const double right = m_width - 24.0 - (isLegendOutside ? legendW + 4.0 : 0.0);
-  const double top = 16.0 + titleSize + 12.0;
-  const double bottom = m_height - (14.0 + labelSize + 10.0 + tickSize + 8.0);
-  auto mapX = [&](double x) { return left + (x - xlo) / (xhi - xlo) * (right - left); };
-  auto mapY = [&](double y) { return bottom - (y - ylo) / (yhi - ylo) * (bottom - top); };
-
-  auto line = [&](double ax, double ay, double bx, double by, const Color& c, double w) {
+  auto line = [&](double ax, double ay, double bx, double by, const Color& c, double w, bool isDashed) {
     P p;
     p.xy = {ax, ay, bx, by};
     p.color = c;
     p.width = w;
+    p.isDashed = isDashed;
     out.push_back(std::move(p));
   };
-  auto text = [&](double x, double y, const std::string& s, int size, P::Anchor anchor, bool isVertical) {
+  // a text of the layout: baseline 0.35 em below the middle of its box (DejaVu's cap height is 0.73 em)
+  auto text = [&](const PlotLayout::Text& t, const Color& c, bool isBold) {
+    if (t.text.empty()) return;
     P p;
     p.kind = P::Kind::Text;
-    p.xy = {x, y};
-    p.text = s;
-    p.fontSize = size;
-    p.anchor = anchor;
-    p.isVertical = isVertical;
+    p.text = t.text;
+    p.fontSize = m_textSize;
+    p.isBold = isBold;
+    p.color = c;
+    p.isVertical = t.isVertical;
+    const double cx = (t.box.left + t.box.right) / 2.0, cy = (t.box.top + t.box.bottom) / 2.0;
+    if (t.isVertical) {
+      p.xy = {cx + 0.35 * m_textSize, cy};
+      p.anchor = P::Anchor::Middle;
+    } else {
+      p.xy = {t.align == Align::Start    ? t.box.left
+              : t.align == Align::Middle ? cx
+                                         : t.box.right,
+              cy + 0.35 * m_textSize};
+      p.anchor = t.align == Align::Start    ? P::Anchor::Start
+                 : t.align == Align::Middle ? P::Anchor::Middle
+                                            : P::Anchor::End;
+    }
     out.push_back(std::move(p));
   };
 
-  // grid, ticks and tick labels
-  const Color grid{0.88, 0.88, 0.88}, axis{0.0, 0.0, 0.0};
-  for (double t : xticks) {
-    const double x = std::round(mapX(t)) + 0.5;
-    line(x, top, x, bottom, grid, 1.0);
-    line(x, bottom, x, bottom + 5.0, axis, 1.0);
-    text(x, bottom + 8.0 + tickSize, tickLabel(t, xstep), tickSize, P::Anchor::Middle, false);
+  // grid, then the data's frame
+  for (double t : L.x.values) {
+    const double x = std::round(L.mapX(t)) + 0.5;
+    line(x, L.area.top, x, L.area.bottom, S::kGrid, S::kGridWidth * k, false);
   }
-  for (double t : yticks) {
-    const double y = std::round(mapY(t)) + 0.5;
-    line(left, y, right, y, grid, 1.0);
-    line(left - 5.0, y, left, y, axis, 1.0);
-    text(left - 8.0, y + 0.35 * tickSize, tickLabel(t, ystep), tickSize, P::Anchor::End, false);
+  for (double t : L.y.values) {
+    const double y = std::round(L.mapY(t)) + 0.5;
+    line(L.area.left, y, L.area.right, y, S::kGrid, S::kGridWidth * k, false);
   }
+  P frame;
+  frame.kind = P::Kind::Rect;
+  frame.xy = {std::round(L.area.left) + 0.5, std::round(L.area.top) + 0.5, std::round(L.area.width()),
+              std::round(L.area.height())};
+  frame.color = S::kFrame;
+  frame.width = S::kGridWidth * k;
+  out.push_back(frame);
 
-  // data, clipped to the plot box by construction of the ranges; non-finite values break the line
-  auto addData = [&](const Series& s, const std::vector<double>& xs) {
+  // reference lines across the box, then the data; values outside the shown x range or non-finite break the
+  // line
+  for (const Series& r : m_references)
+    line(L.area.left, L.mapY(r.y[0]), L.area.right, L.mapY(r.y[0]), r.color, S::kReferenceWidth * k, true);
+  for (const Series& s : m_series) {
     P p;
     p.color = s.color;
-    p.width = 2.0;
+    p.width = S::kDataWidth * k;
     p.isDashed = s.isDashed;
-    for (std::size_t i = 0; i <= xs.size(); ++i) {
-      const bool isFinite = i < xs.size() && std::isfinite(xs[i]) && std::isfinite(s.y[i]);
-      if (isFinite) {
-        p.xy.push_back(mapX(xs[i]));
-        p.xy.push_back(mapY(s.y[i]));
+    for (std::size_t i = 0; i <= s.x.size(); ++i) {
+      const bool isShown = i < s.x.size() && std::isfinite(s.x[i]) && std::isfinite(s.y[i]) &&
+                           s.x[i] >= L.x.lo && s.x[i] <= L.x.hi;
+      if (isShown) {
+        p.xy.push_back(L.mapX(s.x[i]));
+        p.xy.push_back(L.mapY(s.y[i]));
       } else if (!p.xy.empty()) {
         out.push_back(p);
         p.xy.clear();
       }
     }
-  };
-  for (const Series& s : m_references) addData(s, {xlo, xhi});
-  for (const Series& s : m_series) addData(s, s.x);
+  }
 
-  // axes frame
-  P frame;
-  frame.kind = P::Kind::Rect;
-  frame.xy = {std::round(left) + 0.5, std::round(top) + 0.5, std::round(right - left), std::round(bottom - top)};
-  frame.color = axis;
-  frame.width = 1.0;
-  out.push_back(frame);
-
-  // title and axis labels
-  text(m_width / 2.0, 16.0 + titleSize, m_title, titleSize, P::Anchor::Middle, false);
-  text((left + right) / 2.0, m_height - 14.0, m_xLabel, labelSize, P::Anchor::Middle, false);
-  text(14.0 + labelSize, (top + bottom) / 2.0, m_yLabel, labelSize, P::Anchor::Middle, true);
-
-  // legend in the top-right corner of the plot box, or right of it
-  if (hasLegend) {
-    const double rowH = legendSize + 6.0, boxW = legendW, boxH = rowH * entries.size() + 10.0;
-    const double bx = std::round(isLegendOutside ? right + 12.0 : right - boxW - 10.0) + 0.5;
-    const double by = std::round(isLegendOutside ? top : top + 10.0) + 0.5;
-    P box;
-    box.kind = P::Kind::Rect;
-    box.xy = {bx, by, boxW, boxH};
-    box.color = Color{0.6, 0.6, 0.6};
-    box.hasFill = true;
-    out.push_back(box);
-    for (std::size_t i = 0; i < entries.size(); ++i) {
-      const double cy = by + 5.0 + rowH * (i + 0.5);
-      P sample;
-      sample.xy = {bx + 8.0, cy, bx + 38.0, cy};
-      sample.color = entries[i]->color;
-      sample.width = 2.0;
-      sample.isDashed = entries[i]->isDashed;
-      out.push_back(sample);
-      text(bx + 44.0, cy + 0.35 * legendSize, entries[i]->label, legendSize, P::Anchor::Start, false);
-    }
+  // texts and the legend
+  for (const PlotLayout::Text& t : L.xTickLabels) text(t, S::kText, false);
+  for (const PlotLayout::Text& t : L.yTickLabels) text(t, S::kText, false);
+  text(L.xLabel, S::kText, false);
+  text(L.yLabel, S::kText, false);
+  text(L.title, S::kTitle, true);
+  text(L.note, S::kNote, false);
+  for (const PlotLayout::LegendEntry& e : L.legend) {
+    const Series& s = e.isReference ? m_references[e.index] : m_series[e.index];
+    const double mid = (e.box.top + e.box.bottom) / 2.0;
+    line(e.box.left, mid, e.box.left + L.legendSample, mid, s.color, S::kLegendWidth * k, s.isDashed);
+    text(e.label, S::kLegend, false);
   }
   return out;
 }
@@ -445,7 +413,7 @@ std::string Plot::toSvg() const {
       << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << m_width << "\" height=\"" << m_height
       << "\" viewBox=\"0 0 " << m_width << " " << m_height << "\" font-family=\"DejaVu Sans, Verdana, Arial, sans-serif\">\n"
       << "<rect x=\"0\" y=\"0\" width=\"" << m_width << "\" height=\"" << m_height << "\" fill=\"white\"/>\n";
-  for (const P& p : layout()) {
+  for (const P& p : primitives()) {
     switch (p.kind) {
       case P::Kind::Polyline: {
         svg << "<polyline fill=\"none\" stroke=\"" << svgColor(p.color) << "\" stroke-width=\"" << num(p.width)
@@ -463,8 +431,9 @@ std::string Plot::toSvg() const {
         break;
       case P::Kind::Text: {
         const char* anchor = p.anchor == P::Anchor::Start ? "start" : p.anchor == P::Anchor::Middle ? "middle" : "end";
-        svg << "<text x=\"" << num(p.xy[0]) << "\" y=\"" << num(p.xy[1]) << "\" font-size=\"" << p.fontSize
-            << "\" text-anchor=\"" << anchor << "\" fill=\"" << svgColor(p.color) << "\"";
+        svg << "<text x=\"" << num(p.xy[0]) << "\" y=\"" << num(p.xy[1]) << "\" font-size=\""
+            << num(p.fontSize) << "\" text-anchor=\"" << anchor << "\" fill=\"" << svgColor(p.color) << "\"";
+        if (p.isBold) svg << " font-weight=\"bold\"";
         if (p.isVertical) svg << " transform=\"rotate(-90 " << num(p.xy[0]) << " " << num(p.xy[1]) << ")\"";
         svg << ">" << xmlEscape(p.text) << "</text>\n";
         break;
@@ -478,7 +447,7 @@ std::string Plot::toSvg() const {
 std::vector<unsigned char> Plot::toPng() const {
   using P = Primitive;
   Canvas canvas(m_width, m_height);
-  for (const P& p : layout()) {
+  for (const P& p : primitives()) {
     switch (p.kind) {
       case P::Kind::Polyline: canvas.strokePolyline(p.xy, p.width, p.color, p.isDashed); break;
       case P::Kind::Rect: {
@@ -489,7 +458,7 @@ std::vector<unsigned char> Plot::toPng() const {
       }
       case P::Kind::Text: {
         const double align = p.anchor == P::Anchor::Start ? 0.0 : p.anchor == P::Anchor::Middle ? 0.5 : 1.0;
-        canvas.drawText(p.xy[0], p.xy[1], p.text, p.fontSize, align, p.isVertical, p.color);
+        canvas.drawText(p.xy[0], p.xy[1], p.text, p.fontSize, p.isBold, align, p.isVertical, p.color);
         break;
       }
     }

@@ -18,6 +18,8 @@ using sim::ElementGroup;
 
 constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib that makes intercostals oblique
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
+constexpr double kAppositionReach = 0.04;  // [m] farthest rib point an apposed dome node is tied to
+constexpr std::size_t kAppositionRings = 3;  // [-] dome rings inside the rim that lie on the rib cage
 constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
 constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
 constexpr double kScaleneLength = 0.06;  // [m] rib 1 to the scalene anchors above it (cervical spine)
@@ -27,8 +29,8 @@ class ElementSink {
  public:
   ElementSink(const Gains& gains, sim::Model& model) : m_gains(gains), m_model(model) {}
 
-  /// Adds one element; a passive one (`isActive` false) gets kac = 0.
-  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, bool isActive = true) {
+  /// Adds one element; a passive one (`isActive` false) gets kac = 0; `stiffness` [-] scales kpe and b.
+  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, bool isActive = true, double stiffness = 1.0) {
     const double l0 = (a.world - b.world).norm();
     if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
     sim::Elements& e = m_model.elements;
@@ -41,8 +43,8 @@ class ElementSink {
     for (Eigen::VectorXd* v : {&e.restLength, &e.kac, &e.kpe, &e.damping}) v->conservativeResize(n);
     e.restLength(n - 1) = l0;
     e.kac(n - 1) = isActive ? g.kac * scale : 0.0;
-    e.kpe(n - 1) = g.kpe * scale;
-    e.damping(n - 1) = g.damping * scale;
+    e.kpe(n - 1) = stiffness * g.kpe * scale;
+    e.damping(n - 1) = stiffness * g.damping * scale;
   }
 
  private:
@@ -149,6 +151,34 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
       if ((e.world - p).squaredNorm() < (best->world - p).squaredNorm()) best = &e;
     }
     sink.add(ElementGroup::Diaphragm, Endpoint::atNode(node, gut.rest), *best);
+  }
+}
+
+/// Apposition: the outer dome lies on the inner face of the lower rib cage (the zone of apposition), held there by
+/// the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs rather than
+/// bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer & Wilson 2016, J Appl
+/// Physiol 121:391). Each node of the first kAppositionRings rings inside the rim gets a two-sided spring
+/// (Cartilage group, its stiffness and damping times `fraction`) to the nearest point of the inner face of ribs 6-12
+/// within kAppositionReach.
+void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, ElementSink& sink) {
+  if (fraction <= 0.0) return;
+  std::vector<Endpoint> face;
+  for (int level = 6; level <= 12; ++level) {
+    for (int side : {kRight, kLeft}) {
+      const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      const int b = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      for (double s = 0.0; s <= r.length(); s += kCostalSample) face.push_back(Endpoint::onBody(b, r.at(s, 0.5 * r.thickness)));
+    }
+  }
+  for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
+    for (int node : gut.domeRing[ring]) {
+      const Eigen::Vector3d p = gut.rest.col(node);
+      const Endpoint* best = &face.front();
+      for (const Endpoint& e : face)
+        if ((e.world - p).squaredNorm() < (best->world - p).squaredNorm()) best = &e;
+      if ((best->world - p).norm() <= kAppositionReach)
+        sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), *best, false, fraction);
+    }
   }
 }
 
@@ -268,6 +298,7 @@ void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   ElementSink sink(a.gains, model);
   addIntercostals(a, sk, sink);
   addDiaphragm(sk, gut, sink);
+  addApposition(sk, gut, a.gains.appositionFraction, sink);
   addRectus(sk, gut, sink);
   addTransversusObliques(gut, sink);
   addCartilage(sk, sink);

@@ -3,6 +3,7 @@
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Limits.h"
 #include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/Resources.h"
 
 #include <nlohmann/json.hpp>
 
@@ -57,6 +58,7 @@ void validateBreathStyle(const BreathStyle& s) {
   requireRange(p + "intercostal_mean + intercostal_amplitude", s.intercostalMean + s.intercostalAmplitude, 0.0, 1.5,
                true);
   requireRange(p + "rectus_r", s.rectusR, 0.0, 1.5, true);
+  requireRange(p + "intercostal_lead_s", s.intercostalLead, 0.0, 0.5 * 60.0 / s.breathsPerMinute, false);
   if (s.cycles < 0) throw Error(p + "cycles: must be >= 0, got " + std::to_string(s.cycles));
 }
 
@@ -65,7 +67,7 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   const JsonReader j = doc.root();
   j.allowKeys({"name", "note", "breaths_per_minute", "inhale_fraction", "diaphragm_r", "diaphragm_alpha",
                "drive_decay_fraction", "intercostal_mean", "intercostal_amplitude", "intercostal_alpha",
-               "internal_intercostal_alpha", "rectus_r", "rectus_active", "cycles"});
+               "internal_intercostal_alpha", "intercostal_lead_s", "rectus_r", "rectus_active", "cycles"});
   BreathStyle s;
   // required fields, then optional ones that keep their defaults when absent
   s.name = j.at("name").string();
@@ -79,6 +81,7 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   s.driveDecayFraction = j.numberOr("drive_decay_fraction", s.driveDecayFraction);
   s.intercostalAlpha = j.numberOr("intercostal_alpha", s.intercostalAlpha);
   s.internalIntercostalAlpha = j.numberOr("internal_intercostal_alpha", s.internalIntercostalAlpha);
+  s.intercostalLead = j.numberOr("intercostal_lead_s", s.intercostalLead);
   s.rectusR = j.numberOr("rectus_r", s.rectusR);
   if (j.has("rectus_active")) s.rectusActive = j.at("rectus_active").boolean();
   if (j.has("cycles")) s.cycles = static_cast<int>(j.at("cycles").integerIn(0, std::numeric_limits<int>::max()));
@@ -102,17 +105,14 @@ std::string serializeBreathStyle(const BreathStyle& s) {
                             {"intercostal_amplitude", s.intercostalAmplitude},
                             {"intercostal_alpha", s.intercostalAlpha},
                             {"internal_intercostal_alpha", s.internalIntercostalAlpha},
+                            {"intercostal_lead_s", s.intercostalLead},
                             {"rectus_active", s.rectusActive},
                             {"rectus_r", s.rectusR},
                             {"cycles", s.cycles}};
   return j.dump(2) + "\n";
 }
 
-std::string defaultPresetDir() {
-  if (const char* env = std::getenv("PNEUMA_RESOURCE_DIR"); env != nullptr && *env != '\0')
-    return std::string(env) + "/presets";
-  return PNEUMA_SIM_PRESET_DIR;
-}
+std::string defaultPresetDir() { return resourceDir() + "/presets"; }
 
 std::vector<std::string> breathStyleNames(const std::string& presetDir) {
   std::vector<std::string> names;
@@ -169,7 +169,9 @@ Activations BreathStyleController::activations(double t, const Metrics& /*latest
   // inspiratory muscles: diaphragm and external intercostals share the inspiratory drive
   slot(a, ElementGroup::Diaphragm) = in > 0.0 ? GroupActivation{s.diaphragmR, in * s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
   const double ric = s.intercostalMean - s.intercostalAmplitude;  // [-] Table 2's deepest intercostal contraction
-  slot(a, ElementGroup::IntercostalExternal) = {ric, in * s.intercostalAlpha};
+  // their drive runs intercostalLead ahead, so the rib cage, slowed by the rib friction, moves with the belly
+  const double inLead = isRest ? 0.0 : inspiratoryDrive(s, std::fmod(phase + s.intercostalLead / period, 1.0));
+  slot(a, ElementGroup::IntercostalExternal) = {ric, inLead * s.intercostalAlpha};
   // expiratory muscles: internal intercostals and rectus on the expiratory drive (quiet breathing: none)
   slot(a, ElementGroup::IntercostalInternal) = {ric, out * s.internalIntercostalAlpha};
   if (s.rectusActive) slot(a, ElementGroup::Rectus) = {s.rectusR, out};

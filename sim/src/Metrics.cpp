@@ -4,6 +4,8 @@
 #include <cmath>
 #include <complex>
 
+#include "StepInternal.h"
+
 namespace pneuma::sim {
 
 void Trace::append(const Metrics& m) {
@@ -196,6 +198,95 @@ Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNa
   }
 
   return s;
+}
+
+// ---- computeMetrics() (declared in Step.h: it reads the step's outputs)
+
+using namespace detail;
+
+void computeMetrics(const Model& model, const State& state, const Activations& act,
+                    const StepOptions& options, const StepWork& work, Metrics& out) {
+  out.time = state.time;
+  out.activations = act;
+
+  // volumes: lung cavity from its bound surface, gut from the node surface
+  Eigen::Matrix3Xd cavity;
+  anchorPositions(model.cavity.vertices, state, cavity);
+  out.lungVolume = model.cavity.triangles.cols() > 0 ? enclosedVolume(cavity, model.cavity.triangles) : 0.0;
+  out.gutVolume =
+      model.gut.triangles.cols() > 0 ? enclosedVolume(state.nodePosition, model.gut.triangles) : 0.0;
+  out.gutVolumeError = work.constants.restGutVolume > 0.0
+                           ? (out.gutVolume - work.constants.restGutVolume) / work.constants.restGutVolume
+                           : 0.0;
+  const double kappa = effectiveKappa(model, options);
+  out.gutPressure = work.constants.restGutVolume > 0.0
+                        ? gutPressure(kappa, work.constants.restGutVolume, out.gutVolume)
+                        : 0.0;
+  out.abdomenVolume =
+      coneVolume(state.nodePosition, work.constants.wallTriangles, work.constants.restGutCentroid);
+
+  // element forces of the last step, slack state and group tensions
+  const Elements& el = model.elements;
+  out.elementForce = work.outputs.elementForce;
+  out.isSlack.assign(at(el.size()), 0);
+  out.groupMeanTension.fill(0.0);
+  std::array<int, kElementGroupCount> count{};
+  for (int e = 0; e < el.size(); ++e) {
+    const double f = work.outputs.elementForce(e);
+    if (isMuscleGroup(el.group[at(e)]) && f >= 0.0) out.isSlack[at(e)] = 1;
+    out.groupMeanTension[at(static_cast<int>(el.group[at(e)]))] += std::max(-f, 0.0);
+    ++count[at(static_cast<int>(el.group[at(e)]))];
+  }
+  for (int g = 0; g < kElementGroupCount; ++g)
+    if (count[at(g)] > 0) out.groupMeanTension[at(g)] /= count[at(g)];
+
+  // energies: kinetic, elastic (elements at the current pose, gut, joint springs), gravity
+  double kinetic = 0.0, gravity = 0.0;
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    if (model.bodies.isFixed[at(b)]) continue;
+    const Matrix3d r = state.bodyOrientation[at(b)].toRotationMatrix();
+    const Vector3d om = r.transpose() * state.bodyAngularVelocity.col(b);
+    kinetic += 0.5 * model.bodies.mass(b) * state.bodyVelocity.col(b).squaredNorm() +
+               0.5 * om.dot(model.bodies.inertia[at(b)] * om);
+    if (options.gravity)
+      gravity -=
+          model.bodies.mass(b) * model.gravity.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
+  }
+  for (int n = 0; n < model.nodes.size(); ++n) {
+    if (model.nodes.isFixed(n)) continue;
+    kinetic += 0.5 * model.nodes.mass(n) * state.nodeVelocity.col(n).squaredNorm();
+    if (options.gravity)
+      gravity -= model.nodes.mass(n) * model.gravity.dot(state.nodePosition.col(n) - model.nodes.rest.col(n));
+  }
+  double elastic = 0.0;
+  for (int e = 0; e < el.size(); ++e) {
+    const double l = (anchorPosition(el.endB, e, state) - anchorPosition(el.endA, e, state)).norm();
+    const MuscleParams p = muscleParams(model, e, act, options);
+    elastic += isMuscleGroup(el.group[at(e)]) ? muscleEnergy(l, p) : springEnergy(l, p.restLength, p.kpe);
+  }
+  if (work.constants.restGutVolume > 0.0)
+    elastic += gutEnergy(kappa, work.constants.restGutVolume, out.gutVolume);
+  // lung recoil: E = P0 dV + dV^2 / (2 C) while Ppl < 0, the potential of the pleural pressure
+  if (model.cavity.compliance > 0.0) {
+    const double dv = out.lungVolume - work.constants.restCavityVolume;
+    const double c = model.cavity.compliance, p0 = model.cavity.recoilPressure;
+    const double dvZero = -p0 * c;  // [m^3] where Ppl reaches 0
+    const double d = std::max(dv, dvZero);
+    elastic += p0 * (d - dvZero) + (d * d - dvZero * dvZero) / (2.0 * c);
+  }
+  for (int i = 0; i < model.joints.size(); ++i) {
+    const int p = model.joints.parent[at(i)];
+    const Vector3d th = jointRotation(state, p, model.joints.child[at(i)]);
+    elastic +=
+        0.5 * th.dot(jointStiffness(model.joints, i, state.bodyOrientation[at(p)].toRotationMatrix()) * th);
+  }
+  out.kineticEnergy = kinetic;
+  out.elasticEnergy = elastic;
+  out.gravityEnergy = gravity;
+  out.maxJointError = work.outputs.maxJointError;
+
+  // landmarks
+  anchorPositions(model.landmarks.points, state, out.landmarks);
 }
 
 }  // namespace pneuma::sim

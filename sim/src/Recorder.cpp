@@ -23,6 +23,7 @@ void Recorder::record(const State& state, const Metrics& metrics) {
   f.elementForce.assign(metrics.elementForce.data(), metrics.elementForce.data() + metrics.elementForce.size());
   f.lungVolume = metrics.lungVolume;
   f.gutVolumeError = metrics.gutVolumeError;
+  f.gutPressure = metrics.gutPressure;
   m_frames.push_back(std::move(f));
   if (m_capacity > 0 && m_frames.size() > m_capacity) m_frames.pop_front();
 }
@@ -58,6 +59,19 @@ void Recorder::restore(std::size_t i, State& state) const {
   state.bodyVelocity = Eigen::Matrix3Xd::Zero(3, nb);
   state.bodyAngularVelocity = Eigen::Matrix3Xd::Zero(3, nb);
   state.nodeVelocity = Eigen::Matrix3Xd::Zero(3, nn);
+}
+
+void Recorder::restore(std::size_t i, State& state, Metrics& metrics) const {
+  restore(i, state);
+  const RecordedFrame& f = m_frames.at(i);
+  metrics.time = f.time;
+  metrics.lungVolume = f.lungVolume;
+  metrics.gutVolumeError = f.gutVolumeError;
+  metrics.gutPressure = f.gutPressure;
+  metrics.elementForce = Eigen::Map<const Eigen::VectorXf>(f.elementForce.data(),
+                                                           static_cast<Eigen::Index>(f.elementForce.size()))
+                             .cast<double>();
+  metrics.isSlack.clear();
 }
 
 }  // namespace pneuma::sim

@@ -1,12 +1,13 @@
 #include "pneuma/sim/Simulation.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Limits.h"
-#include "pneuma/sim/ModelIO.h"
-
 #include <chrono>
 #include <cmath>
 #include <sstream>
+
+#include "pneuma/sim/Checkpoint.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Limits.h"
+#include "pneuma/sim/ModelIO.h"
 
 namespace pneuma::sim {
 
@@ -128,6 +129,85 @@ void Simulation::advance(double duration, const std::function<bool(const Simulat
     }
     if (timedStep() && onFrame && !onFrame(*this)) return;
   }
+}
+
+SimulationCheckpoint Simulation::checkpoint() const {
+  SimulationCheckpoint c;
+  c.state = m_state;
+  c.solver = m_work.memory;
+  c.outputs = m_work.outputs;
+  c.latest = m_latest;
+  c.activations = m_activations;
+  c.nextFrameTime = m_nextFrameTime;
+  c.controller = m_controller->clone();
+  return c;
+}
+
+void Simulation::restore(const SimulationCheckpoint& c) {
+  const State& s = c.state;
+  const Eigen::Index nb = m_model->bodies.size(), nn = m_model->nodes.size();
+  if (s.bodyPosition.cols() != nb || static_cast<Eigen::Index>(s.bodyOrientation.size()) != nb ||
+      s.bodyVelocity.cols() != nb || s.bodyAngularVelocity.cols() != nb || s.nodePosition.cols() != nn ||
+      s.nodeVelocity.cols() != nn || c.outputs.elementForce.size() != m_model->elements.size())
+    throw Error("Simulation::restore: the checkpoint is not of this model (sizes differ)");
+  if (!c.controller) throw Error("Simulation::restore: the checkpoint holds no controller");
+  std::unique_ptr<Controller> controller = c.controller->clone();
+  m_work.memory = c.solver;
+  m_work.outputs = c.outputs;
+  m_state = s;
+  syncBodyFrames(*m_model, m_state, m_work);
+  m_latest = c.latest;
+  m_activations = c.activations;
+  m_nextFrameTime = c.nextFrameTime;
+  m_controller = std::move(controller);
+  updateTimeStep();
+  m_trace.clear();
+  m_frameIndex = 0;
+  m_traceStride = 1;
+  m_recorder.clear();
+  m_wallSeconds = 0.0;
+  m_simulatedSeconds = 0.0;
+}
+
+void Simulation::save(std::ostream& out) const {
+  CheckpointWriter w(out);
+  w.write("pneuma.checkpoint", 1);
+  w.write("simulation.dt", m_dt);
+  w.write("simulation.nextFrameTime", m_nextFrameTime);
+  writeActivations(w, "simulation.activations", m_activations);
+  writeState(w, m_state);
+  writeSolverMemory(w, m_work.memory);
+  writeStepOutputs(w, m_work.outputs);
+  writeMetrics(w, m_latest);
+  m_controller->saveState(w);
+  w.write("end", 1);
+  if (!out) throw Error("Simulation::save: the checkpoint could not be written");
+}
+
+void Simulation::load(std::istream& in, const std::string& source) {
+  CheckpointReader r(in, source);
+  if (r.readInt("pneuma.checkpoint") != 1) r.fail("pneuma.checkpoint", "unknown version");
+  const double dt = r.readDouble("simulation.dt");
+  if (dt != m_dt) {
+    std::ostringstream os;
+    os << "saved at dt = " << dt << " s, this run steps at " << m_dt << " s";
+    r.fail("simulation.dt", os.str());
+  }
+  SimulationCheckpoint c;
+  c.nextFrameTime = r.readDouble("simulation.nextFrameTime");
+  c.activations = readActivations(r, "simulation.activations");
+  c.state = readState(r, *m_model);
+  StepWork fresh = makeStepWork(*m_model);  // the memory's symbolic analysis
+  c.solver = std::move(fresh.memory);
+  readSolverMemory(r, c.solver);
+  c.outputs = fresh.outputs;
+  readStepOutputs(r, c.outputs);
+  readMetrics(r, c.latest);
+  std::unique_ptr<Controller> controller = m_controller->clone();
+  controller->loadState(r);
+  r.readInt("end");
+  c.controller = std::move(controller);
+  restore(c);
 }
 
 Summary Simulation::summary() const {

@@ -39,7 +39,7 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
   const double chunk = 25.0 * sim.dt();     // [s] simulated per iteration
   double cgIterations = 0.0, frames = 0.0;  // CG iterations of the step before each output frame
   const auto sample = [&](const Simulation& s) {
-    cgIterations += s.stepWork().cgIterations;
+    cgIterations += s.stepWork().memory.cgIterations;
     frames += 1.0;
     return true;
   };
@@ -68,7 +68,7 @@ void stepTime(benchmark::State& state) {
   double cgIterations = 0.0;
   for (auto _ : state) {
     step(model, s, dt, controller.activations(s.time, Metrics{}), o, w);
-    cgIterations += w.cgIterations;
+    cgIterations += w.memory.cgIterations;
     benchmark::DoNotOptimize(s.nodePosition.data());
   }
   state.counters["cg_iterations"] = cgIterations / static_cast<double>(state.iterations());

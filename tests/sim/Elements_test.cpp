@@ -155,11 +155,12 @@ TEST(ForceAssembly, InvariantUnderRigidTransform) {
   StepWork w2 = makeStepWork(model);
   computeForces(model, r, act, o, w2);
 
-  EXPECT_LT((w2.nodeForce - q * w1.nodeForce).norm(), 1e-9 * w1.nodeForce.norm());
-  EXPECT_LT((w2.bodyForce - q * w1.bodyForce).norm(), 1e-9 * w1.bodyForce.norm());
-  EXPECT_LT((w2.bodyTorque - q * w1.bodyTorque).norm(), 1e-9 * w1.bodyTorque.norm());
-  EXPECT_LT((w2.elementForce - w1.elementForce).norm(), 1e-9 * w1.elementForce.norm());
-  EXPECT_GT(w1.elementForce.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT((w2.scratch.nodeForce - q * w1.scratch.nodeForce).norm(), 1e-9 * w1.scratch.nodeForce.norm());
+  EXPECT_LT((w2.scratch.bodyForce - q * w1.scratch.bodyForce).norm(), 1e-9 * w1.scratch.bodyForce.norm());
+  EXPECT_LT((w2.scratch.bodyTorque - q * w1.scratch.bodyTorque).norm(), 1e-9 * w1.scratch.bodyTorque.norm());
+  EXPECT_LT((w2.outputs.elementForce - w1.outputs.elementForce).norm(),
+            1e-9 * w1.outputs.elementForce.norm());
+  EXPECT_GT(w1.outputs.elementForce.cwiseAbs().maxCoeff(), 0.0);
 }
 
 }  // namespace

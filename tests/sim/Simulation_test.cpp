@@ -126,7 +126,11 @@ TEST(BreathStyleController, InspiratoryAndExpiratoryMusclesTakeTurns) {
   EXPECT_NEAR(at(0.5 * inhale, ElementGroup::Diaphragm).alpha, 0.5 * calm.diaphragmAlpha, 1e-12);
   EXPECT_NEAR(at(inhale - 1e-9, ElementGroup::Diaphragm).alpha, calm.diaphragmAlpha, 1e-9);
   EXPECT_DOUBLE_EQ(at(0.5 * inhale, ElementGroup::Diaphragm).r, calm.diaphragmR);
-  EXPECT_NEAR(at(0.5 * inhale, ElementGroup::IntercostalExternal).alpha, 0.5 * calm.intercostalAlpha, 1e-12);
+  // the external intercostals run intercostalLead ahead of the diaphragm (the rib cage lags them)
+  ASSERT_GT(calm.intercostalLead, 0.0);
+  EXPECT_NEAR(at(0.5 * inhale - calm.intercostalLead, ElementGroup::IntercostalExternal).alpha,
+              0.5 * calm.intercostalAlpha, 1e-12);
+  EXPECT_GT(at(0.01, ElementGroup::IntercostalExternal).alpha, at(0.01, ElementGroup::Diaphragm).alpha);
   EXPECT_NEAR(at(0.5 * inhale, ElementGroup::IntercostalExternal).r, calm.intercostalMean - calm.intercostalAmplitude, 1e-12);
   // post-inspiratory braking: half-way down at half the decay window, off after it
   EXPECT_NEAR(at(inhale + 0.5 * calm.driveDecayFraction * exhale, ElementGroup::Diaphragm).alpha, 0.5 * calm.diaphragmAlpha, 1e-9);
@@ -182,6 +186,11 @@ TEST(BreathStyle, DriveFieldsAreRangeChecked) {
   EXPECT_THROW(validateBreathStyle(bad), Error);
   bad = loadBreathStyle("calm");
   bad.internalIntercostalAlpha = -0.1;
+  EXPECT_THROW(validateBreathStyle(bad), Error);
+  bad = loadBreathStyle("calm");  // 4 s cycle: the lead may be at most half of it
+  bad.intercostalLead = 2.5;
+  EXPECT_THROW(validateBreathStyle(bad), Error);
+  bad.intercostalLead = -0.1;
   EXPECT_THROW(validateBreathStyle(bad), Error);
 }
 

@@ -313,6 +313,25 @@ inline State randomVelocityState(const Model& m, double nodeSpeed, double spin, 
   return s;
 }
 
+/// Sets the linear velocity of every jointed body to what its parent's motion and its own spin imply, so that
+/// the joint anchors move together: v_c = v_p + w_p x (a - x_p) - w_c x (a - x_c), a the anchor, parents first.
+inline void jointConsistentVelocities(const Model& m, State& s) {
+  std::vector<char> done(static_cast<std::size_t>(m.bodies.size()), 0);
+  for (int b = 0; b < m.bodies.size(); ++b)
+    done[static_cast<std::size_t>(b)] = std::find(m.joints.child.begin(), m.joints.child.end(), b) == m.joints.child.end();
+  for (int pass = 0; pass < m.joints.size(); ++pass) {
+    for (int j = 0; j < m.joints.size(); ++j) {
+      const int p = m.joints.parent[static_cast<std::size_t>(j)], c = m.joints.child[static_cast<std::size_t>(j)];
+      if (!done[static_cast<std::size_t>(p)] || done[static_cast<std::size_t>(c)]) continue;
+      const Eigen::Vector3d a = s.bodyPosition.col(p) + s.bodyOrientation[static_cast<std::size_t>(p)] *
+                                                            (m.joints.anchor.col(j) - m.bodies.com.col(p));
+      s.bodyVelocity.col(c) = s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(a - s.bodyPosition.col(p)) -
+                              s.bodyAngularVelocity.col(c).cross(a - s.bodyPosition.col(c));
+      done[static_cast<std::size_t>(c)] = 1;
+    }
+  }
+}
+
 /// The energy tests' run: `model` from `state` with every muscle relaxed, stepped by step() and measured
 /// by computeMetrics() after each step. energy() [J] is kinetic plus elastic energy of the latest metrics.
 class RelaxedRun {
@@ -328,6 +347,7 @@ class RelaxedRun {
   }
   double energy() const { return m_metrics.kineticEnergy + m_metrics.elasticEnergy; }
   const Metrics& metrics() const { return m_metrics; }
+  const State& state() const { return m_state; }
   double time() const { return m_state.time; }
 
  private:

@@ -34,7 +34,7 @@ double measurePeriod(const Model& model, State& s, const StepOptions& o, double 
     const double cur = signal(s);
     if (prev < 0.0 && cur >= 0.0) crossings.push_back(s.time - dt * cur / (cur - prev));
     prev = cur;
-    EXPECT_LT(w.maxJointError, 1e-4) << "joint error above 0.1 mm at t = " << s.time;
+    EXPECT_LT(w.outputs.maxJointError, 1e-4) << "joint error above 0.1 mm at t = " << s.time;
   }
   if (crossings.size() < 2) return 0.0;
   return (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);

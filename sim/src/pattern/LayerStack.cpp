@@ -1,9 +1,10 @@
 #include "pneuma/sim/pattern/LayerStack.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "pneuma/sim/Checkpoint.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::sim::pattern {
 
@@ -153,5 +154,130 @@ void LayerStack::setStartVolume(double v) {
 double LayerStack::balance() const { return m_layers.empty() ? 0.5 : m_layers.back().cycle.spec().balance; }
 
 std::string LayerStack::currentLayerName() const { return m_layers.empty() ? std::string() : m_layers.back().name; }
+
+namespace {
+
+void writeCycle(CheckpointWriter& out, const std::string& key, const CycleSpec& c) {
+  out.write(key + ".kind", static_cast<int>(c.kind));
+  out.write(key + ".isRelative", c.isRelative);
+  Eigen::Matrix<double, 9, 1> v;
+  v << c.rate, c.depthMin, c.depthMax, c.ieRatio, c.postInspiratoryPause, c.postExpiratoryPause,
+      c.rateIrregularity, c.depthIrregularity, c.balance;
+  out.write(key + ".values", v);
+  Eigen::Matrix2Xd k(2, static_cast<Eigen::Index>(c.keyframes.size()));
+  for (std::size_t i = 0; i < c.keyframes.size(); ++i)
+    k.col(static_cast<Eigen::Index>(i)) << c.keyframes[i].time, c.keyframes[i].volume;
+  out.write(key + ".keyframes", k);
+}
+
+CycleSpec readCycle(CheckpointReader& in, const std::string& key) {
+  CycleSpec c;
+  const long long kind = in.readInt(key + ".kind");
+  if (kind < 0 || kind > static_cast<int>(CycleKind::Spline)) in.fail(key + ".kind", "unknown cycle kind");
+  c.kind = static_cast<CycleKind>(kind);
+  c.isRelative = in.readBool(key + ".isRelative");
+  Eigen::Matrix<double, 9, 1> v;
+  in.read(key + ".values", v);
+  c.rate = v(0);
+  c.depthMin = v(1);
+  c.depthMax = v(2);
+  c.ieRatio = v(3);
+  c.postInspiratoryPause = v(4);
+  c.postExpiratoryPause = v(5);
+  c.rateIrregularity = v(6);
+  c.depthIrregularity = v(7);
+  c.balance = v(8);
+  Eigen::Matrix2Xd k;
+  in.read(key + ".keyframes", k);
+  for (Eigen::Index i = 0; i < k.cols(); ++i) c.keyframes.push_back({k(0, i), k(1, i)});
+  return c;
+}
+
+}  // namespace
+
+void LayerStack::saveState(CheckpointWriter& out, const std::string& prefix) const {
+  const auto writeLayers = [&](const std::string& key, const std::vector<Active>& layers) {
+    out.write(key, static_cast<long long>(layers.size()));
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+      const std::string k = key + "[" + std::to_string(i) + "]";
+      out.write(k + ".name", layers[i].name);
+      writeCycle(out, k + ".cycle", layers[i].cycle.spec());
+      out.write(k + ".repetitions", layers[i].repetitions);
+      out.write(k + ".done", layers[i].done);
+    }
+  };
+  const auto writePending = [&](const std::string& key, const std::vector<Pending>& pending) {
+    out.write(key, static_cast<long long>(pending.size()));
+    for (std::size_t i = 0; i < pending.size(); ++i) {
+      const std::string k = key + "[" + std::to_string(i) + "]";
+      out.write(k + ".time", pending[i].time);
+      out.write(k + ".mode", static_cast<int>(pending[i].mode));
+      writeLayers(k + ".layers", pending[i].layers);
+    }
+  };
+  out.write(prefix + ".random", m_random.state());
+  writeLayers(prefix + ".layers", m_layers);
+  writePending(prefix + ".scheduled", m_scheduled);
+  writePending(prefix + ".atCycleEnd", m_atCycleEnd);
+  Eigen::Matrix<double, 9, 1> v;
+  v << m_time, m_volume, m_hold, m_breathStart, m_variation.durationScale, m_variation.depthScale,
+      m_blendFrom, m_blendStart, m_blendDuration;
+  out.write(prefix + ".values", v);
+  out.write(prefix + ".hasVolume", m_hasVolume);
+}
+
+void LayerStack::loadState(CheckpointReader& in, const std::string& prefix) {
+  const auto count = [&](const std::string& key) {
+    const long long n = in.readInt(key);
+    if (n < 0 || n > 100000) in.fail(key, "bad count " + std::to_string(n));
+    return static_cast<std::size_t>(n);
+  };
+  const auto readLayers = [&](const std::string& key) {
+    std::vector<Active> layers;
+    const std::size_t n = count(key);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::string k = key + "[" + std::to_string(i) + "]";
+      std::string name = in.readString(k + ".name");
+      const CycleSpec spec = readCycle(in, k + ".cycle");
+      const int repetitions = static_cast<int>(in.readInt(k + ".repetitions"));
+      const int done = static_cast<int>(in.readInt(k + ".done"));
+      try {
+        layers.push_back(Active{std::move(name), Cycle(spec), repetitions, done});
+      } catch (const Error& e) {
+        in.fail(k + ".cycle", e.what());
+      }
+    }
+    return layers;
+  };
+  const auto readPending = [&](const std::string& key) {
+    std::vector<Pending> pending;
+    const std::size_t n = count(key);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::string k = key + "[" + std::to_string(i) + "]";
+      const double time = in.readDouble(k + ".time");
+      const long long mode = in.readInt(k + ".mode");
+      if (mode != static_cast<int>(SwitchMode::EndOfCycle) && mode != static_cast<int>(SwitchMode::Immediate))
+        in.fail(k + ".mode", "unknown switch mode");
+      pending.push_back(Pending{time, static_cast<SwitchMode>(mode), readLayers(k + ".layers")});
+    }
+    return pending;
+  };
+  m_random = SplitMix64(in.readUnsigned(prefix + ".random"));
+  m_layers = readLayers(prefix + ".layers");
+  m_scheduled = readPending(prefix + ".scheduled");
+  m_atCycleEnd = readPending(prefix + ".atCycleEnd");
+  Eigen::Matrix<double, 9, 1> v;
+  in.read(prefix + ".values", v);
+  m_time = v(0);
+  m_volume = v(1);
+  m_hold = v(2);
+  m_breathStart = v(3);
+  m_variation.durationScale = v(4);
+  m_variation.depthScale = v(5);
+  m_blendFrom = v(6);
+  m_blendStart = v(7);
+  m_blendDuration = v(8);
+  m_hasVolume = in.readBool(prefix + ".hasVolume");
+}
 
 }  // namespace pneuma::sim::pattern

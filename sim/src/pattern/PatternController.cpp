@@ -1,10 +1,11 @@
 #include "pneuma/sim/pattern/PatternController.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "pneuma/sim/Checkpoint.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::sim::pattern {
 
@@ -324,6 +325,48 @@ std::string PatternController::describe() const {
 }
 
 std::unique_ptr<Controller> PatternController::clone() const { return std::make_unique<PatternController>(*this); }
+
+void PatternController::saveState(CheckpointWriter& out) const {
+  out.write("pattern.description", m_description);
+  out.write("pattern.isControlling", m_isControlling);
+  Eigen::Matrix<double, 12, 1> v;
+  v << m_calibration.restVolume, m_restVolumeSeen, m_lastTime, m_startTime, m_lastFrameTime,
+      m_lastFrameControlTime, m_target, m_targetRate, m_measured, m_error, m_integral, m_balance;
+  out.write("pattern.values", v);
+  out.write("pattern.tracking.frames", m_tracking.frames);
+  Eigen::Vector3d t(m_tracking.sumSquaredError, m_tracking.targetMin, m_tracking.targetMax);
+  out.write("pattern.tracking.values", t);
+  m_stack.saveState(out, "pattern.stack");
+}
+
+void PatternController::loadState(CheckpointReader& in) {
+  const std::string description = in.readString("pattern.description");
+  if (description != m_description)
+    in.fail("pattern.description", "saved for pattern '" + description.substr(0, 60) + "', not '" +
+                                       m_description.substr(0, 60) + "'");
+  m_isControlling = in.readBool("pattern.isControlling");
+  Eigen::Matrix<double, 12, 1> v;
+  in.read("pattern.values", v);
+  m_calibration.restVolume = v(0);
+  m_restVolumeSeen = v(1);
+  m_lastTime = v(2);
+  m_startTime = v(3);
+  m_lastFrameTime = v(4);
+  m_lastFrameControlTime = v(5);
+  m_target = v(6);
+  m_targetRate = v(7);
+  m_measured = v(8);
+  m_error = v(9);
+  m_integral = v(10);
+  m_balance = v(11);
+  m_tracking.frames = in.readInt("pattern.tracking.frames");
+  Eigen::Vector3d t;
+  in.read("pattern.tracking.values", t);
+  m_tracking.sumSquaredError = t(0);
+  m_tracking.targetMin = t(1);
+  m_tracking.targetMax = t(2);
+  m_stack.loadState(in, "pattern.stack");
+}
 
 std::unique_ptr<PatternController> makePatternController(const Pattern& pattern, std::uint64_t seed,
                                                          const DriveCalibration& calibration) {

@@ -107,6 +107,9 @@ struct Gains {
   double gutDrag = 0.0;               ///< [1/s] visceral drag rate beta (sim::Gut::drag)
   double lungRecoil = 0.0;            ///< [Pa] lung recoil at the rest volume (sim::Cavity::recoilPressure)
   double lungCompliance = 0.0;        ///< [m^3/Pa] lung compliance (sim::Cavity::compliance)
+  /// [-] stiffness and damping of the apposition springs (the outer dome held on the lower ribs' inner face) as a
+  /// fraction of the cartilage group's
+  double appositionFraction = 0.0;
   double costovertebralFriction = 0.0;  ///< [N m s/rad] mu of Eq. 3
   double costovertebralStiffness = 0.0; ///< [N m/rad] about the rib-neck axis
   /// [N m/rad] the costotransverse joint's resistance to rotation off the rib-neck axis (a rib with both its

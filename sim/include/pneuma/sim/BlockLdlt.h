@@ -36,6 +36,7 @@ class BlockLdlt {
   /// Block (r, c) of A's lower triangle at `slot` (rows of block row r, columns of block column c); of a diagonal
   /// block only the lower triangle is read.
   Eigen::Matrix3d& value(int slot) { return m_a[static_cast<std::size_t>(slot)]; }
+  const Eigen::Matrix3d& value(int slot) const { return m_a[static_cast<std::size_t>(slot)]; }
   /// Number of stored blocks of A (slots 0 .. valueBlocks() - 1).
   int valueBlocks() const { return static_cast<int>(m_a.size()); }
   /// Sets every entry of A to zero (the pattern stays).

@@ -12,7 +12,10 @@
 ///    inspiratory muscles' pressure falls to 50 % at 23 % of the exhale and to 0 at 79 % (J Appl Physiol 1985,
 ///    58:1859); w = 0.6 gives 50 % at 30 % and 0 at 60 %. The diaphragm gets alpha = d diaphragmAlpha at
 ///    r = diaphragmR, the external intercostals (with the parasternals they stand for) alpha = d intercostalAlpha
-///    at r = intercostalMean - intercostalAmplitude, Table 2's deepest contraction;
+///    at r = intercostalMean - intercostalAmplitude, Table 2's deepest contraction, with their drive taken
+///    intercostalLead seconds ahead (d(x + lead / T)): the rib friction (Eq. 3) makes the rib cage lag its muscles
+///    by about 0.18 s, so without the lead it moved 40 deg behind the belly in a calm breath (healthy adults:
+///    12-23 deg, Chen et al. 2015); 0.15 s gives 16 deg;
 ///  - expiratory drive e(x) (expiratoryDrive()): 0 during the inhale; over the exhale s(x' / 0.3) (1 - s((x' - 0.85)
 ///    / 0.15)). The internal intercostals get alpha = e internalIntercostalAlpha (0 in quiet breathing, where
 ///    expiration is passive recoil), the rectus alpha = e at r = rectusR when rectusActive (forced exhale).
@@ -43,19 +46,21 @@ struct BreathStyle {
   double intercostalAmplitude = 0.08; ///< [-] amplitude of the intercostal sinusoids (Table 2 "±")
   double intercostalAlpha = 1.0;      ///< [-] external intercostal activation at full inspiratory drive, (0, 1]
   double internalIntercostalAlpha = 0.0;  ///< [-] internal intercostal activation at full expiratory drive, [0, 1]
+  double intercostalLead = 0.0;       ///< [s] the external intercostals' drive runs this far ahead, [0, T / 2]
   bool rectusActive = false;          ///< rectus contracts during exhale (forced exhale only)
   double rectusR = 1.0;               ///< [-] rectus contraction ratio when active
   int cycles = 0;                     ///< [-] 0 = periodic; n > 0 = n cycles, then hold
 };
 
 /// Checks ranges: rate > 0, inhaleFraction in (0, 1), every resulting r in (0, 1.5], driveDecayFraction in (0, 1],
-/// internalIntercostalAlpha in [0, 1], cycles >= 0.
+/// internalIntercostalAlpha in [0, 1], intercostalLead in [0, T / 2], cycles >= 0.
 /// @throws Error naming the field and value.
 void validateBreathStyle(const BreathStyle& s);
 
 /// Parses a preset from JSON text (fields: name, note, breaths_per_minute, inhale_fraction,
 /// diaphragm_r, diaphragm_alpha (optional, default 1), drive_decay_fraction (optional, default 1), intercostal_mean,
-/// intercostal_alpha (optional, default 1), internal_intercostal_alpha (optional, default 0), intercostal_amplitude,
+/// intercostal_alpha (optional, default 1), internal_intercostal_alpha (optional, default 0), intercostal_lead_s
+/// (optional, default 0), intercostal_amplitude,
 /// rectus_active, rectus_r, cycles).
 /// @throws Error naming `source` and the field.
 BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& source);
@@ -68,8 +73,7 @@ double expiratoryDrive(const BreathStyle& s, double phase);
 /// Serialises a preset to JSON text with the fields parseBreathStyle() reads (round-trips exactly).
 std::string serializeBreathStyle(const BreathStyle& s);
 
-/// Directory holding the breath-style presets: $PNEUMA_RESOURCE_DIR/presets when that variable is
-/// set, else the source tree's resources/presets.
+/// Directory holding the breath-style presets: resourceDir()/presets (Resources.h).
 std::string defaultPresetDir();
 
 /// Names of the presets (*.json) in `presetDir`, sorted.

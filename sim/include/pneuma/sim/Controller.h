@@ -13,6 +13,9 @@
 
 namespace pneuma::sim {
 
+class CheckpointWriter;
+class CheckpointReader;
+
 /// A source of muscle activations. Simulation calls activations() once per step with the control
 /// time and the most recent output-frame metrics (feedback controllers read `latest.lungVolume`).
 /// Implementations must be deterministic: the same call sequence gives the same outputs.
@@ -30,6 +33,16 @@ class Controller {
   /// (SimulationOptions::dt = 0) steps at min(defaultTimeStep(integrator), maxTimeStep()). Infinity (the
   /// default) when any step will do; a feedback controller tuned against the plant at a given step says so.
   virtual double maxTimeStep() const { return std::numeric_limits<double>::infinity(); }
+
+  /// Writes what activations() depends on besides the construction parameters (clocks, integrals, random
+  /// streams, learned values, pushed layers), for an exact restart from a file (Simulation::save(),
+  /// Checkpoint.h). A controller whose outputs depend on its call history must override both this and
+  /// loadState(); the defaults, for controllers that are functions of (t, latest) alone, write and read
+  /// nothing.
+  virtual void saveState(CheckpointWriter& out) const { (void)out; }
+  /// Reads what saveState() wrote into a controller made with the same parameters; afterwards it continues
+  /// exactly as the one that was saved. @throws Error when the data does not fit this controller.
+  virtual void loadState(CheckpointReader& in) { (void)in; }
 };
 
 }  // namespace pneuma::sim

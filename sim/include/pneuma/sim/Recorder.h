@@ -1,8 +1,10 @@
 #pragma once
 /// @file Recorder.h
 /// Compact in-memory recording of states at the output rate, with random access, for timeline
-/// scrubbing. Poses and forces are stored as float (half the memory of double, ample for display);
-/// a bounded capacity keeps the most recent frames.
+/// scrubbing: what the views show of a frame (poses, element forces, lung volume, gut volume error and
+/// pressure), stored as it was measured, so that a restored frame shows what the run showed then. Poses and
+/// forces are stored as float (half the memory of double, ample for display); a bounded capacity keeps the
+/// most recent frames. Resuming a run is Simulation::checkpoint() / save(), not this.
 
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/State.h"
@@ -21,6 +23,7 @@ struct RecordedFrame {
   std::vector<float> elementForce;   ///< [N] signed scalar force per element              (#E)
   double lungVolume = 0.0;           ///< [m^3]
   double gutVolumeError = 0.0;       ///< [-]
+  double gutPressure = 0.0;          ///< [Pa] Metrics::gutPressure, with the kappa of the run at that frame
 };
 
 class Recorder {
@@ -38,8 +41,12 @@ class Recorder {
   /// Index of the frame nearest to `time` [s]; 0 when empty.
   std::size_t indexAt(double time) const;
   /// Writes frame `i`'s positions and orientations into `state` (resized to match), with zero
-  /// velocities and state.time = frame time. For display only: resuming from it is not bit-exact.
+  /// velocities and state.time = frame time; poses at float precision, for display (an exact restart is
+  /// Simulation::checkpoint()).
   void restore(std::size_t i, State& state) const;
+  /// As restore(i, state), and sets the recorded fields of `metrics` to the frame's: time, lungVolume,
+  /// gutVolumeError, gutPressure and elementForce (others are left as they are; isSlack is cleared).
+  void restore(std::size_t i, State& state, Metrics& metrics) const;
   void clear() { m_frames.clear(); }
   std::size_t capacity() const { return m_capacity; }
   /// Changes the capacity (0 = unlimited), dropping the oldest frames beyond it.

@@ -9,17 +9,19 @@
 /// t = settleTime on, the controller runs with control time t - settleTime. Summary figures are
 /// measured from settleTime on.
 
+#include <atomic>
+#include <functional>
+#include <istream>
+#include <memory>
+#include <ostream>
+#include <string>
+
 #include "pneuma/sim/Controller.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/Recorder.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
-
-#include <atomic>
-#include <functional>
-#include <memory>
-#include <string>
 
 namespace pneuma::sim {
 
@@ -48,6 +50,19 @@ inline constexpr double kTraceOnlyRecordSeconds = 1.0;
 ///         options.
 void validateSimulationOptions(const SimulationOptions& o);
 
+/// Everything a run continues from besides the model, the options and the controller's parameters. A run
+/// restored from it steps bit-identically to the run it was taken from: in the same process
+/// (Simulation::checkpoint(), restore()) and through a file (Simulation::save(), load()).
+struct SimulationCheckpoint {
+  State state;          ///< positions, velocities, time and step count
+  SolverMemory solver;  ///< the implicit solver's memory (Step.h): factorization, its age, last CG count
+  StepOutputs outputs;  ///< the last step's by-products (element forces, joint error)
+  Metrics latest;       ///< the latest output frame, which the controller reads next
+  Activations activations{};                     ///< applied in the last step
+  double nextFrameTime = 0.0;                    ///< [s] when the next output frame falls due
+  std::shared_ptr<const Controller> controller;  ///< a copy of the controller with its internal state
+};
+
 class Simulation {
  public:
   /// Validates the model (masses, gains >= 0), the controller's first activations and the options.
@@ -75,6 +90,21 @@ class Simulation {
   void setStopFlag(const std::atomic<bool>* flag) { m_stopFlag = flag; }
   /// True when the latest advance() returned early because the stop flag was raised.
   bool wasStopped() const { return m_wasStopped; }
+
+  /// A copy of everything the run continues from (SimulationCheckpoint), at the current step.
+  SimulationCheckpoint checkpoint() const;
+  /// Continues from `checkpoint`, taken from a run on the same model: state, solver memory, last outputs,
+  /// latest frame, frame clock and a copy of its controller. The options stay; the trace, the recorder and
+  /// the real-time factor start over (a resumed run's summary covers the frames after the restart).
+  /// @throws Error when the checkpoint's sizes are not the model's or it holds no controller.
+  void restore(const SimulationCheckpoint& checkpoint);
+  /// Writes checkpoint() as text (Checkpoint.h); load() on a Simulation of the same model and options, with a
+  /// controller made with the same parameters, continues bit-identically.
+  void save(std::ostream& out) const;
+  /// Reads what save() wrote and restore()s it; the controller state is read into a copy of the current
+  /// controller. @throws Error naming `source` and the field when the data is not a checkpoint of this model,
+  /// dt or controller.
+  void load(std::istream& in, const std::string& source = "checkpoint");
 
   const Model& model() const { return *m_model; }
   const State& state() const { return m_state; }

@@ -1,61 +1,18 @@
 #pragma once
 /// @file Step.h
-/// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step):
-///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity, explicit),
+/// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step); docs/integrator.md has
+/// the design, the integrators, the linear solve and the reasons for them.
+///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity),
 ///                  joint friction (Eq. 3), joint stiffness (spine; rib-neck hinges, Joints), visceral drag
-///                  (Gut::drag), gravity
-///   2. integrate   velocities and positions with the chosen integrator
+///                  (Gut::drag), gravity                                            (StepForces.cpp)
+///   2. integrate   velocities: SymplecticEuler, the paper's explicit scheme (Step.cpp), or the default
+///                  ImplicitEulerJoints, linearly implicit Euler in the joint tree's coordinates by CG with
+///                  a kept block LDL^T factorization as preconditioner (StepImplicit.cpp); then positions
 ///   3. joints      ball-joint constraints: velocity impulses, then position projection (error < 0.1 mm)
-/// Metrics are computed separately, at the output rate (computeMetrics()).
-///
-/// Integrators
-/// - SymplecticEuler: the paper's reference scheme (Section 6.1), v += F/m dt, then x += v dt, for
-///   nodes and bodies (quaternions integrated with the new angular velocity). Explicit, so dt is
-///   bounded by the stiffest spring / the gut's volumetric mode (dt < 2 / omega_max). Default dt 10 us: on
-///   the default model its limit is the diaphragm damping on the light dome nodes (dt < 2 m / sum b) and the
-///   10-25 g ribs; 20 us blows up within 0.1 s (real-time factor about 0.1).
-/// - ImplicitEulerJoints (the default): linearly implicit (backward) Euler of Baraff and Witkin (SIGGRAPH
-///   1998), solving (M + dt D + dt^2 K) dv = dt (f - dt K v) in the coordinates of the joint tree: the linear
-///   velocity of every body hanging on a ball joint is eliminated, v_c = v_p + w_p x r_p - w_c x r_c
-///   (J: reduced -> full velocities), and a preconditioned conjugate gradient solves
-///   J^T (M + dt D + dt^2 K) J dv' = J^T rhs (see "Linear solve" below). K holds the element stiffness along
-///   and across each taut element, the rank-one gut-pressure stiffness kappa V0/V^2 g g^T (g = dV/dx; kept
-///   while the gut is over-full and Eq. 5's force is 0, so a step that compresses the gut meets the pressure
-///   it raises: without it a suddenly contracting rectus squeezed the gut by 10 % in one step at dt 20 ms)
-///   and the spine joint springs; D holds element damping, joint friction and the visceral drag beta M.
-///   Why this one: the stiff parts of the model (cartilage, the gut's near-incompressibility kappa, joint
-///   friction on 10-25 g ribs) are linear or nearly so, so backward Euler removes their step limit at the
-///   cost of a few CG passes that are as cheap as one force evaluation; breathing is slow (0.2 - 1 Hz), so
-///   its numerical damping of high frequencies is harmless, while a position-based (XPBD) scheme would not
-///   follow the paper's force laws (Eq. 2, 4, 5) as directly. The joints hold inside the linear solve, so
-///   joint friction (Eq. 3) couples a rib's spin to the spine about the joint rather than about the rib's
-///   com: friction only dissipates (tested at 150 N m s/rad, 10x the calibrated mu) and the result does
-///   not depend on dt (deep breathing: 921 / 919 / 924 mL at dt 10 / 5 / 2 ms). An earlier variant that
-///   solved in the full space and imposed the joints afterwards was removed: it was not consistent in dt (1228 vs
-///   1747 mL between 10 and 2 ms) and gained energy under rib friction above 0.5 N m s/rad. Default dt 1/60 s,
-///   one step per 60 Hz frame (docs/cli.md "Performance" has the accuracy by dt).
-/// With both integrators, after the velocity update sequential impulses remove the remaining relative velocity
-/// at every joint (all of it for SymplecticEuler, the linearisation error for ImplicitEulerJoints) and a
-/// mass-weighted projection removes the position drift.
-///
-/// Linear solve (ImplicitEulerJoints): A dv' = b, A = J^T (M + dt D + dt^2 K) J. The preconditioner P is A
-/// itself, assembled sparse over the free coordinates (3x3 blocks: gut nodes, body spins and the free bodies'
-/// linear velocities) without the gut's rank-one pressure stiffness u u^T (u = dt sqrt(kappa V0) / V g),
-/// factored by BlockLdlt, with u u^T added back by Sherman-Morrison: P^-1 = A0^-1 - A0^-1 u u^T A0^-1 /
-/// (1 + u^T A0^-1 u). The factorization is kept while it stays a good preconditioner and refreshed when the last
-/// solve needed more than `refactorIterations`, when more than `refactorElementChanges` elements changed their
-/// 3x3 stiffness by a quarter (muscles going slack or taut, activation steps, fast rotation), after
-/// `preconditionerRefresh` steps, or when dt changes. A fresh factorization solves the step directly, dv' = P^-1 b
-/// (about every second step on the default model); with a kept one, CG on the matrix-free A starts from
-/// dv' = P^-1 b and stops at a relative residual `cgTolerance` in the preconditioner norm
-/// (r^T P^-1 r <= tol^2 b^T P^-1 b), after about 3 iterations (more in a step where many muscles switch).
-/// Why: with block Jacobi (the previous preconditioner) the joint-tree system needed about 140 iterations at
-/// dt 10 ms (190 at 20 ms): the gut wall is a network of taut strands whose floppy modes (moves that stretch
-/// no strand) only the node masses resist, 70 eigenvalues of P^-1 A below 1e-2, which neither Jacobi nor a
-/// coarse space of node aggregates captures (measured: 148 -> 87-116 iterations with 10-80 aggregates). An
-/// exact factorization captures them; the system changes by a few elements per step, so a factorization
-/// serves 3 - 4 steps, and the 3x3-block factorization (1281 free coordinates, 4.1k blocks in L) costs about
-/// 10 CG iterations.
+///                                                                                  (StepJoints.cpp)
+/// Metrics are computed separately, at the output rate (computeMetrics(), Metrics.cpp). StepWork splits what
+/// a step works with into model constants, the solver memory a restart saves with the State, scratch and
+/// outputs.
 
 #include "pneuma/sim/Activation.h"
 #include "pneuma/sim/BlockLdlt.h"
@@ -111,98 +68,170 @@ struct StepOptions {
 /// @throws Error naming the field and value.
 void validateStepOptions(const StepOptions& o);
 
-/// Preallocated scratch memory of step() (no allocation per step) and the by-products of the last
-/// step that metrics need. Make one per (Model, State) pair with makeStepWork().
-struct StepWork {
+/// Constants of step() derived once from the model by makeStepWork() (MuJoCo's mj_setConst): rest volumes,
+/// the endpoint classification, the joint tree and the sparsity of the implicit system. Never written while
+/// stepping.
+struct StepConstants {
   double restGutVolume = 0.0;          ///< [m^3] V0, gut volume at the rest pose
   Eigen::Vector3d restGutCentroid = Eigen::Vector3d::Zero();  ///< [m] centroid of the gut nodes at rest
-  Eigen::Matrix3Xi wallTriangles;      ///< gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
+  /// gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
+  Eigen::Matrix3Xi wallTriangles;
   double restCavityVolume = 0.0;       ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
-  double pleuralPressure = 0.0;        ///< [Pa] Ppl of Cavity at the start of the last step (<= 0)
-  Eigen::Matrix3Xd cavityPosition;     ///< [m] cavity vertices at the start of the last step (3 x #C)
-  Eigen::Matrix3Xd cavityGradient;     ///< [m^2] dV/dx per cavity vertex (3 x #C)
-  double gutVolume = 0.0;              ///< [m^3] V at the start of the last step
-  double gutPressure = 0.0;            ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
-  Eigen::VectorXd elementForce;        ///< [N] scalar force per element of the last step (#E)
-  Eigen::VectorXd elementLength;       ///< [m] (#E)
-  Eigen::Matrix3Xd elementDirection;   ///< [-] unit A->B direction (3 x #E)
-  Eigen::Matrix3Xd leverA, leverB;     ///< [m] endpoint minus body com, world; unused for node endpoints (3 x #E)
-  Eigen::VectorXd elementStiffness;    ///< [N/m] |dF/dl| of taut elements, 0 when slack (#E)
-  Eigen::VectorXd elementGeometric;    ///< [N/m] transverse stiffness |F| / l of elements in tension (#E)
-  Eigen::VectorXd elementDamping;      ///< [N s/m] b of taut elements, 0 when slack (#E)
-  double linearKScale = 0.0;           ///< [s^2] scale of K in the packed linearisation (dt^2)
-  double linearDScale = 0.0;           ///< [s] scale of D in it (dt, or 0 for the right-hand side)
-  int linearNodeCount = 0;             ///< [-] packed elements between two single nodes
-  Eigen::Matrix2Xi linearNodes;        ///< their implicit solver offsets, A and B (2 x #E, first linearNodeCount used)
-  Eigen::Matrix<double, 5, Eigen::Dynamic> linearNodeCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l, then
-                                                              ///< [-] the direction (5 x #E)
-  int linearBodyCount = 0;             ///< [-] packed elements between two bodies
-  Eigen::Matrix2Xi linearBodies;       ///< their implicit solver offsets 6 b, A and B (2 x #E, first linearBodyCount used)
-  Eigen::Matrix<double, 11, Eigen::Dynamic> linearBodyCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l, then
-                                                               ///< [-] the direction and [m] the levers A and B (11 x #E)
-  int linearOtherCount = 0;            ///< [-] packed elements with a weighted-node end or a body and a node end
-  Eigen::VectorXi linearOther;         ///< their element indices (#E, first linearOtherCount used)
-  Eigen::Matrix2Xd linearOtherCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l (2 x #E)
-  Eigen::Matrix2Xi endpointBody;       ///< body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
-  Eigen::Matrix2Xi endpointNode;       ///< the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
-  Eigen::VectorXi fixedDofs;           ///< indices of fixed-body and fixed-node entries of the implicit solver vectors
-  std::vector<Eigen::Matrix3d> inverseInertiaBody;  ///< [1/(kg m^2)] I^-1 in the body frame, zero for fixed bodies (#B)
+  /// body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
+  Eigen::Matrix2Xi endpointBody;
+  /// the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
+  Eigen::Matrix2Xi endpointNode;
+  /// indices of fixed-body and fixed-node entries of the implicit solver vectors
+  Eigen::VectorXi fixedDofs;
+  /// [1/(kg m^2)] I^-1 in the body frame, zero for fixed bodies (#B)
+  std::vector<Eigen::Matrix3d> inverseInertiaBody;
   Eigen::Matrix3Xd jointLocalParent;   ///< [m] joint anchor in the parent's body frame (3 x #J)
   Eigen::Matrix3Xd jointLocalChild;    ///< [m] joint anchor in the child's body frame (3 x #J)
-  std::vector<Eigen::Matrix3d> jointMassInverse;  ///< [kg] inverse effective mass of each joint's point constraint (#J)
-  std::vector<Eigen::Matrix3d> rotation;  ///< [-] body rotation matrices (#B)
-  std::vector<Eigen::Matrix3d> inverseInertiaWorld;  ///< [1/(kg m^2)] R I^-1 R^T, zero for fixed bodies (#B)
-  Eigen::Matrix3Xd bodyForce, bodyTorque;  ///< [N], [N m] world (3 x #B)
-  Eigen::Matrix3Xd nodeForce;          ///< [N] (3 x #N)
-  Eigen::Matrix3Xd gutGradient;        ///< [m^2] dV/dx per node (3 x #N)
-  double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
-  int cgIterations = 0;                ///< [-] CG iterations of the last implicit step
-  Eigen::MatrixXd bodyBlock;           ///< [kg, kg m, kg m^2] body block of the implicit system, J^T . J (6 #B x 6 #B)
-  Eigen::MatrixXd bodyNodeBlock;       ///< [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
+  std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
   std::vector<int> attachedNodes;      ///< nodes sharing an element with a body (#attached)
   Eigen::VectorXi attachedColumn;      ///< node -> its index in attachedNodes, or -1 (#N)
-  Eigen::Matrix2Xi bodyEntries;        ///< (row, col) of the 3 x 3 blocks of bodyBlock that can be nonzero, first
-                                       ///< entries in free coordinates, lower triangle (2 x #blocks)
-  Eigen::Matrix3Xi couplingEntries;    ///< (node entry, body entry, bodyNodeBlock column) of the 3 x 3 body-node
-                                       ///< coupling blocks that can be nonzero (3 x #blocks)
-  Eigen::VectorXi freeIndex;           ///< implicit solver entry -> free coordinate, or -1 (fixed or dependent)
+  /// (row, col) of the 3 x 3 blocks of bodyBlock that can be nonzero, first entries in free coordinates,
+  /// lower triangle (2 x #blocks)
+  Eigen::Matrix2Xi bodyEntries;
+  /// (node entry, body entry, bodyNodeBlock column) of the 3 x 3 body-node coupling blocks that can be
+  /// nonzero (3 x #blocks)
+  Eigen::Matrix3Xi couplingEntries;
+  /// implicit solver entry -> free coordinate, or -1 (fixed or dependent)
+  Eigen::VectorXi freeIndex;
   Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
-  BlockLdlt system;                    ///< the preconditioner's matrix and factorization (#free / 3 blocks square)
-  std::vector<int> systemPattern;      ///< system's value slot of every streamed 3 x 3 block, -1 if dropped (see Step.cpp)
-  Eigen::VectorXd rankOne;             ///< [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
+  /// SolverMemory::system's value slot of every streamed 3 x 3 block, -1 if dropped (see StepImplicit.cpp)
+  std::vector<int> systemPattern;
+};
+
+/// What the implicit solver (ImplicitEulerJoints) carries from one step to the next: the preconditioner's
+/// factorization, the element stiffness it was made with, its age and dt, and the last solve's CG iterations,
+/// which together decide when it is refreshed. The next step depends on the State, on this and on the body
+/// frames of the State (StepScratch::rotation, which syncBodyFrames() recomputes), nothing else, so a restart
+/// that saves the State and this continues bit-identically (Simulation::checkpoint(), Checkpoint.h). Empty
+/// (hasFactorization false) in a fresh StepWork: the first implicit step then factors.
+struct SolverMemory {
+  bool hasFactorization = false;  ///< a factorization is held (false until the first implicit step)
+  /// the preconditioner's matrix A0 and its factorization (#free / 3 blocks square); its symbolic analysis is
+  /// made by makeStepWork()
+  BlockLdlt system;
+  /// [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
+  Eigen::VectorXd rankOne;
   Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
   double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
-  Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
+  /// [kg^1/2] v = dt J^T g_c / sqrt(C) over the free coordinates, the pleural stiffness at the factorization;
+  /// empty when it had none
+  Eigen::VectorXd rankTwo;
+  Eigen::VectorXd rankTwoSolve;        ///< [1/kg^1/2] (A0 + u u^T)^-1 v (#free)
+  double rankTwoScale = 1.0;           ///< [-] 1 / (1 + v^T (A0 + u u^T)^-1 v)
   double factorDt = 0.0;               ///< [s] dt of the factorization
   Eigen::VectorXd factorAxial;         ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
   Eigen::VectorXd factorTransverse;    ///< [kg] dt^2 |F| / l at the factorization (#E)
   Eigen::Matrix3Xd factorDirection;    ///< [-] elementDirection at the factorization (3 x #E)
   int factorAge = 0;                   ///< [-] steps solved with the current factorization
-  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;  ///< implicit solver vectors (6 #B + 3 #N); cgX holds
-                                                      ///< dv' of the last step
-  std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
-  Eigen::Matrix3Xd treeLeverParent, treeLeverChild;  ///< [m] joint anchor minus com, world, at the step start (3 x #J)
+  /// [-] CG iterations of the last implicit step (0 after a refactorization)
+  int cgIterations = 0;
 };
 
-/// Allocates the scratch memory for `model` and computes its rest gut volume.
+/// Working memory of step(), overwritten within every step before it is read, except the body frames (see
+/// rotation); no allocation per step.
+struct StepScratch {
+  /// [-] body rotation matrices (#B) of the State as the last step left it (makeStepWork(): the rest pose).
+  /// The next step's first joint check reads them before stage 1 recomputes them: a State put in place by
+  /// other means needs syncBodyFrames()
+  std::vector<Eigen::Matrix3d> rotation;
+  /// [1/(kg m^2)] R I^-1 R^T, zero for fixed bodies (#B), as rotation
+  std::vector<Eigen::Matrix3d> inverseInertiaWorld;
+  Eigen::Matrix3Xd bodyForce, bodyTorque;  ///< [N], [N m] world, stage 1's sums (3 x #B)
+  Eigen::Matrix3Xd nodeForce;              ///< [N] stage 1's sums (3 x #N)
+  Eigen::Matrix3Xd gutGradient;            ///< [m^2] dV/dx per node (3 x #N)
+  Eigen::Matrix3Xd cavityPosition;         ///< [m] cavity vertices at the start of the step (3 x #C)
+  Eigen::Matrix3Xd cavityGradient;         ///< [m^2] dV/dx per cavity vertex (3 x #C)
+  /// [m^2, m^3] dV/dq of the cavity over the implicit solver's entries (6 #B + 3 #N) at the start of the
+  /// step, filled while Ppl < 0
+  Eigen::VectorXd cavityGeneralized;
+  double pleuralStiffness = 0.0;      ///< [Pa/m^3] 1/C while the pleural pressure acts (Ppl < 0), else 0
+  Eigen::VectorXd cavityReduced;      ///< [m^2, m^3] J^T dV/dq, scratch of the factorization (6 #B + 3 #N)
+  Eigen::Matrix3Xd elementDirection;  ///< [-] unit A->B direction (3 x #E)
+  /// [m] endpoint minus body com, world; unused for node endpoints (3 x #E)
+  Eigen::Matrix3Xd leverA, leverB;
+  Eigen::VectorXd elementStiffness;  ///< [N/m] |dF/dl| of taut elements, 0 when slack (#E)
+  Eigen::VectorXd elementGeometric;  ///< [N/m] transverse stiffness |F| / l of elements in tension (#E)
+  Eigen::VectorXd elementDamping;    ///< [N s/m] b of taut elements, 0 when slack (#E)
+  double linearKScale = 0.0;         ///< [s^2] scale of K in the packed linearisation (dt^2)
+  double linearDScale = 0.0;         ///< [s] scale of D in it (dt, or 0 for the right-hand side)
+  int linearNodeCount = 0;           ///< [-] packed elements between two single nodes
+  /// their implicit solver offsets, A and B (2 x #E, first linearNodeCount used)
+  Eigen::Matrix2Xi linearNodes;
+  /// [kg] kScale k + dScale b, kScale |F| / l, then [-] the direction (5 x #E)
+  Eigen::Matrix<double, 5, Eigen::Dynamic> linearNodeCoeffs;
+  int linearBodyCount = 0;  ///< [-] packed elements between two bodies
+  /// their implicit solver offsets 6 b, A and B (2 x #E, first linearBodyCount used)
+  Eigen::Matrix2Xi linearBodies;
+  /// [kg] kScale k + dScale b, kScale |F| / l, then [-] the direction and [m] the levers A and B (11 x #E)
+  Eigen::Matrix<double, 11, Eigen::Dynamic> linearBodyCoeffs;
+  /// [-] packed elements with a weighted-node end or a body and a node end
+  int linearOtherCount = 0;
+  Eigen::VectorXi linearOther;         ///< their element indices (#E, first linearOtherCount used)
+  Eigen::Matrix2Xd linearOtherCoeffs;  ///< [kg] kScale k + dScale b, kScale |F| / l (2 x #E)
+  /// [kg] inverse effective mass of each joint's point constraint (#J)
+  std::vector<Eigen::Matrix3d> jointMassInverse;
+  /// [kg, kg m, kg m^2] body block of the implicit system, J^T . J (6 #B x 6 #B)
+  Eigen::MatrixXd bodyBlock;
+  /// [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
+  Eigen::MatrixXd bodyNodeBlock;
+  Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
+  /// implicit solver vectors (6 #B + 3 #N); cgX starts each solve at P^-1 b and ends as dv' of the step
+  Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;
+  /// [m] joint anchor minus com, world, at the step start (3 x #J)
+  Eigen::Matrix3Xd treeLeverParent, treeLeverChild;
+};
+
+/// By-products of the last step that the metrics, the blow-up check and the views read.
+struct StepOutputs {
+  Eigen::VectorXd elementForce;   ///< [N] scalar force per element of the last step (#E)
+  Eigen::VectorXd elementLength;  ///< [m] length per element at the start of the last step (#E)
+  double gutVolume = 0.0;         ///< [m^3] V at the start of the last step
+  double gutPressure = 0.0;       ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
+  double pleuralPressure = 0.0;   ///< [Pa] Ppl of Cavity at the start of the last step (<= 0)
+  double maxJointError = 0.0;     ///< [m] largest joint separation after the last step
+};
+
+/// Everything step() works with besides the Model and the State, split as MuJoCo splits mjModel from mjData:
+/// constants of the model, the solver memory a restart needs, scratch, and outputs. Make one per (Model,
+/// State) pair with makeStepWork(); a copy continues exactly like the original.
+struct StepWork {
+  StepConstants constants;  ///< from the model, once
+  SolverMemory memory;      ///< carried from step to step; saved with the State for an exact restart
+  StepScratch scratch;      ///< overwritten within each step
+  StepOutputs outputs;      ///< of the last step
+};
+
+/// Computes the constants of `model` (rest volumes, joint tree, the implicit system's pattern) and allocates
+/// the scratch; the solver memory starts empty.
 StepWork makeStepWork(const Model& model);
 
-/// Stage 1 alone: clears and accumulates work.bodyForce [N], bodyTorque [N m] (world, about each com) and
-/// nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), the pleural pressure (Cavity),
-/// joint friction (Eq. 3) and stiffness, gravity and the gyroscopic term; also fills the per-element, gut and
-/// cavity by-products.
-/// Joint friction is included for ImplicitEulerJoints only; SymplecticEuler integrates it implicitly per joint
-/// right after the velocity update (unconditionally stable for light bones).
+/// Sets work.scratch.rotation and inverseInertiaWorld to those of `state`, as a step leaves them for the next
+/// one. A restart calls it after putting a saved State in place (Simulation::restore()).
+void syncBodyFrames(const Model& model, const State& state, StepWork& work);
+
+/// Stage 1 alone: clears and accumulates work.scratch.bodyForce [N], bodyTorque [N m] (world, about each com)
+/// and nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), the pleural pressure
+/// (Cavity), joint friction (Eq. 3) and stiffness, gravity and the gyroscopic term; also fills the
+/// per-element, gut and cavity by-products. Joint friction is included for ImplicitEulerJoints only;
+/// SymplecticEuler integrates it implicitly per joint right after the velocity update (unconditionally stable
+/// for light bones).
 void computeForces(const Model& model, const State& state, const Activations& act, const StepOptions& options,
                    StepWork& work);
 
 /// Advances `state` by `dt` [s] under activations `act` (forces -> integrate -> joints).
+/// Reads `state`, work.constants, work.memory and the body frames of work.scratch; rewrites work.scratch and
+/// work.outputs; updates work.memory.
 /// Does not check for blow-ups (Simulation does) and does not compute metrics.
 void step(const Model& model, State& state, double dt, const Activations& act, const StepOptions& options,
           StepWork& work);
 
 /// Metrics of `state` (lung and gut volume, element forces of the last step, energies, landmarks).
-/// Element forces come from `work` (the last step); call after step().
+/// Element forces come from `work.outputs` (the last step); call after step().
 void computeMetrics(const Model& model, const State& state, const Activations& act, const StepOptions& options,
                     const StepWork& work, Metrics& out);
 

@@ -21,6 +21,11 @@
 #include <string>
 #include <vector>
 
+namespace pneuma::sim {
+class CheckpointWriter;
+class CheckpointReader;
+}  // namespace pneuma::sim
+
 namespace pneuma::sim::pattern {
 
 /// Repetition count of a layer that never pops.
@@ -78,6 +83,12 @@ class LayerStack {
 
   /// [s] cross-fade duration used when switching into `cycle`: min(0.4 s, a quarter of its nominal breath).
   static double blendDuration(const Cycle& cycle);
+
+  /// Writes the whole stack (layers, pending pushes, random stream, clock, blend) under keys starting with
+  /// `prefix`, for an exact restart; loadState() reads it back into any LayerStack.
+  void saveState(CheckpointWriter& out, const std::string& prefix) const;
+  /// @throws Error when the data is not a stack's (Checkpoint.h) or a stored cycle is invalid.
+  void loadState(CheckpointReader& in, const std::string& prefix);
 
  private:
   struct Active {

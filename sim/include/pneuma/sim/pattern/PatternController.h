@@ -82,12 +82,12 @@ double groupResponse(const DriveCalibration& calibration, ElementGroup g, double
 
 /// Feedback settings.
 struct PatternControllerOptions {
-  /// [-] proportional gain on the fraction error. With the rib friction of the recalibrated model
-  /// (15 N m s/rad) the chest lags its activation by about 0.2 s, and the lag left over by the
-  /// feed-forward needs a stiffer loop than the old fast plant did: K_p 1.2 and K_i 30 /s left panic at
-  /// 8.5 % and startle's hold at 8.2 %, K_p 3 and K_i 100 /s give 2.9 % and 4.4 % (little margin on the
-  /// 5 % hold target, see docs/patterns.md); at K_i 150 /s the hold rings (5.6 %).
-  double kp = 3.0;
+  /// [-] proportional gain on the fraction error. The internal intercostals move the volume within one
+  /// 10 ms step against the lungs' recoil (Cavity), so a stiff loop chatters: at K_p 3 their activation
+  /// switched between 0 and 1 every step through focus's and panic's expirations (tracking RMS 15 % and
+  /// 12 %). K_p 2 / 1.5 / 1 / 0.7 give focus 11.7 / 8.6 / 4.9 / 4.0 % and panic 9.2 / 8.0 / 5.2 / 4.8 %,
+  /// with every hold within 0.8 % (pneuma_sim_pattern_tracking_test); K_i 100 /s carries the slow lag.
+  double kp = 1.0;
   double ki = 100.0;              ///< [1/s] integral gain
   double integralLimit = 0.2;     ///< [-] clamp of the integral term I, in fraction units
   double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
@@ -139,6 +139,11 @@ class PatternController : public Controller {
   std::unique_ptr<Controller> clone() const override;
   /// kDriveTimeStep.
   double maxTimeStep() const override { return kDriveTimeStep; }
+
+  /// The pattern clock, the feedback's integral and last frame, the learned rest volume, the tracking
+  /// statistics and the whole LayerStack (pushed layers and its random stream included).
+  void saveState(CheckpointWriter& out) const override;
+  void loadState(CheckpointReader& in) override;
 
   /// Pushes layers live (the app's affect selector); see LayerStack::push().
   void push(const std::vector<Layer>& playOrder, SwitchMode mode);

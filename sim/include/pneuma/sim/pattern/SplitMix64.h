@@ -10,7 +10,10 @@ namespace pneuma::sim::pattern {
 
 class SplitMix64 {
  public:
+  /// @param seed  the stream's start; a state() passed here continues that stream exactly
   explicit SplitMix64(std::uint64_t seed = 0) : m_state(seed) {}
+  /// The generator's whole state (for exact restarts).
+  std::uint64_t state() const { return m_state; }
 
   /// Next 64 random bits.
   std::uint64_t next() {

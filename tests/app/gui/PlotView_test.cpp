@@ -1,0 +1,92 @@
+// PlotView and its export share one layout (viz::layoutPlot): the same ranges, ticks and legend on screen
+// and in the exported file.
+#include "gui/PlotView.h"
+#include "GuiTestSupport.h"
+#include "viz/PlotLayout.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace pneuma;
+using pneuma::app::PlotView;
+
+namespace {
+
+// 30 s of a 4 s breath around 2500 mL, a dashed target, and a reference line; shown over a 20 s window
+void fill(PlotView& view) {
+  std::vector<double> t, v, target;
+  for (int i = 0; i <= 600; ++i) {
+    t.push_back(0.05 * i);
+    v.push_back(2500.0 + 250.0 * std::sin(2.0 * M_PI * t.back() / 4.0));
+    target.push_back(2500.0 + 230.0 * std::sin(2.0 * M_PI * t.back() / 4.0));
+  }
+  view.setData(t, {{"lung volume", QColor(20, 90, 190), false, v, "simulated"},
+                   {"target volume", QColor(230, 90, 20), true, target, "target"}});
+  view.setReferences({{"500 mL tidal", 2750.0, QColor(40, 160, 60)}});
+  view.setNote("tidal volume 500 mL");
+  view.setWindow(20.0);
+}
+
+}  // namespace
+
+TEST(PlotView, ExportHasTheScreensRangesTicksAndLegend) {
+  app::test::application();
+  for (const QSize size : {QSize(480, 300), QSize(300, 170), QSize(760, 420)}) {
+    SCOPED_TRACE(std::to_string(size.width()) + " x " + std::to_string(size.height()));
+    PlotView view("Lung-cavity volume", "lung-cavity volume [mL]");
+    view.resize(size);
+    fill(view);
+    const viz::PlotLayout screen = view.layout();
+    const viz::Plot exported = view.toPlot();
+    const viz::PlotLayout file = exported.layout();
+    EXPECT_GE(exported.width(), 960);
+    EXPECT_GE(exported.width(), 2 * size.width());
+
+    // the rolling window on both
+    EXPECT_DOUBLE_EQ(screen.x.lo, 10.0);
+    EXPECT_DOUBLE_EQ(screen.x.hi, 30.0);
+    EXPECT_DOUBLE_EQ(file.x.lo, screen.x.lo);
+    EXPECT_DOUBLE_EQ(file.x.hi, screen.x.hi);
+    EXPECT_DOUBLE_EQ(file.y.lo, screen.y.lo);
+    EXPECT_DOUBLE_EQ(file.y.hi, screen.y.hi);
+    // the same ticks and labels, at least two labelled on each axis
+    EXPECT_EQ(file.x.values, screen.x.values);
+    EXPECT_EQ(file.x.labels, screen.x.labels);
+    EXPECT_EQ(file.y.values, screen.y.values);
+    EXPECT_EQ(file.y.labels, screen.y.labels);
+    EXPECT_GE(screen.x.values.size(), 2u);
+    EXPECT_GE(screen.y.values.size(), 2u);
+    // the same legend entries (two series and the reference line)
+    ASSERT_EQ(screen.legend.size(), 3u);
+    ASSERT_EQ(file.legend.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(file.legend[i].label.text, screen.legend[i].label.text);
+    // and the file shows those labels
+    const std::string svg = exported.toSvg();
+    for (const std::string& label : screen.y.labels)
+      EXPECT_NE(svg.find(">" + label + "</text>"), std::string::npos) << label;
+    for (const std::string& label : screen.x.labels)
+      EXPECT_NE(svg.find(">" + label + "</text>"), std::string::npos) << label;
+  }
+}
+
+TEST(PlotView, TicksLieInsideTheBoxAndLabelsDoNotOverlap) {
+  app::test::application();
+  PlotView view("Lung-cavity volume", "lung-cavity volume [mL]");
+  view.resize(420, 260);
+  fill(view);
+  const viz::PlotLayout L = view.layout();
+  for (double t : L.x.values) {
+    EXPECT_GE(L.mapX(t), L.area.left - 1e-9);
+    EXPECT_LE(L.mapX(t), L.area.right + 1e-9);
+  }
+  for (std::size_t i = 0; i + 1 < L.xTickLabels.size(); ++i)
+    EXPECT_LT(L.xTickLabels[i].box.right, L.xTickLabels[i + 1].box.left);
+  for (std::size_t i = 0; i + 1 < L.yTickLabels.size(); ++i)  // ascending values go up the screen
+    EXPECT_GT(L.yTickLabels[i].box.top, L.yTickLabels[i + 1].box.bottom - 1e-9);
+  for (const viz::PlotLayout::Text& t : L.yTickLabels) EXPECT_LE(t.box.right, L.area.left);
+  EXPECT_GT(L.area.top, L.title.box.bottom);
+  for (const viz::PlotLayout::LegendEntry& e : L.legend) EXPECT_LE(e.box.bottom, L.area.top);
+}
