@@ -75,9 +75,9 @@ void Simulation::emitFrame() {
   // a lung volume <= 0 means the rib cage has collapsed through itself: physically impossible, so stop
   if (!(m_latest.lungVolume > 0.0)) {
     std::ostringstream os;
-    os << "simulation failed at t = " << m_state.time << " s: lung volume " << m_latest.lungVolume * 1e6
-       << " mL is not positive, the rib cage collapsed through itself (likely cause: passive gains too "
-          "small to hold it, or a cavity turned inside out)";
+    os << "simulation blew up at t = " << m_state.time << " s: lung volume " << m_latest.lungVolume * 1e6
+       << " mL is not positive (the rib cage collapsed through itself; likely cause: passive gains too small "
+          "to hold it, a cavity turned inside out, or dt too large)";
     throw Error(os.str());
   }
   if (m_frameIndex % m_traceStride == 0) m_trace.append(m_latest);

@@ -283,7 +283,7 @@ TEST(ModelStructure, ARunWhoseLungsTurnInsideOutStopsNamingIt) {
     sim.advance(10.0);
     FAIL() << "ran 10 s without passive gains";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("mL is not positive, the rib cage collapsed through itself"),
+    EXPECT_NE(std::string(e.what()).find("mL is not positive (the rib cage collapsed through itself"),
               std::string::npos)
         << e.what();
   }

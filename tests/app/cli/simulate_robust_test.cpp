@@ -195,8 +195,11 @@ TEST(CliFullDisk, WholeDiskFullLeavesNothingTruncated) {
   int frames = 0;
   expectCompleteFrames(run.out + "/frames", frames);
   EXPECT_TRUE(temporaries(run.out).empty());
-  for (const auto& e : fs::recursive_directory_iterator(run.out))
-    if (e.is_regular_file()) EXPECT_GT(e.file_size(), 0u) << e.path();
+  for (const auto& e : fs::recursive_directory_iterator(run.out)) {
+    if (e.is_regular_file()) {
+      EXPECT_GT(e.file_size(), 0u) << e.path();
+    }
+  }
   if (fs::exists(run.out + "/summary.json")) {
     EXPECT_NO_THROW(nlohmann::json::parse(slurp(run.out + "/summary.json")));
   } else {
@@ -234,9 +237,11 @@ TEST(CliLongRun, AnHourOfCalmStaysSmallInMemoryAndPlots) {
   RecordProperty("max_rss_3600s_kB", std::to_string(longKb));
   EXPECT_LT(longKb, 100 * 1024) << "an hour's run peaked at " << longKb / 1024 << " MB";
   EXPECT_LT(longKb - shortKb, 20 * 1024) << "60 s: " << shortKb << " kB, 3600 s: " << longKb << " kB";
-  for (const auto& e : fs::directory_iterator(longOut))
-    if (e.path().extension() == ".svg" || e.path().extension() == ".png")
+  for (const auto& e : fs::directory_iterator(longOut)) {
+    if (e.path().extension() == ".svg" || e.path().extension() == ".png") {
       EXPECT_LT(e.file_size(), 1000000u) << e.path();
+    }
+  }
 
   const nlohmann::json s = nlohmann::json::parse(slurp(longOut + "/summary.json"));
   const long long frames = s["frames"].get<long long>();
