@@ -87,7 +87,7 @@ std::pair<double, double> measure(std::shared_ptr<const sim::Model> model, const
 
 void runBench(const BenchArgs& args) {
   const std::string modelDir = resolveModelDir(args.model);
-  if (!(args.seconds > 0.0)) fail(kExitBadInput, "--seconds: must be > 0 s, got " + formatNumber(args.seconds));
+  checkOption(sim::kDurationRange, "--seconds", args.seconds);
   if (!args.out.empty()) prepareOutputDir(args.out);
   sim::SimulationOptions options;
   options.settleTime = 0.0;

@@ -45,6 +45,10 @@ void prepareOutputDir(const std::string& dir) {
   fs::remove(probe, ec);
 }
 
+void checkOption(const sim::Range& range, const char* flag, double v) {
+  if (!range.contains(v)) fail(kExitBadInput, std::string(flag) + ": " + range.problem(v));
+}
+
 std::string formatNumber(double v) {
   if (!std::isfinite(v)) return "";
   char buf[32];

@@ -3,6 +3,7 @@
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
 /// resources, preparing output directories, number formatting for JSON/CSV.
 
+#include "pneuma/sim/Limits.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Step.h"
 
@@ -41,6 +42,9 @@ void addIntegratorOption(CLI::App& cmd, std::string& name);
 
 /// Sets `kind` from an --integrator value ("" keeps it); an unknown name fails with kExitBadInput and the valid names.
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind);
+
+/// Fails with kExitBadInput and "<flag>: must be in [lo, hi] unit, got v" unless `range` contains `v`.
+void checkOption(const sim::Range& range, const char* flag, double v);
 
 /// Creates `dir` (and parents) and checks that a file can be written in it; fails with kExitBadInput otherwise.
 void prepareOutputDir(const std::string& dir);

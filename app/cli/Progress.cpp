@@ -11,12 +11,18 @@ namespace pneuma::app {
 
 namespace {
 
-volatile sig_atomic_t g_interrupted = 0;
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the SIGINT handler writes the flag");
 struct sigaction g_previous {};
 
 void onSigint(int) {
-  if (g_interrupted) signal(SIGINT, SIG_DFL);  // a second Ctrl-C: next one kills
-  g_interrupted = 1;
+  if (g_interrupted.load()) {
+    // a second Ctrl-C: end now, as the default action would (both calls are async-signal-safe)
+    signal(SIGINT, SIG_DFL);
+    raise(SIGINT);
+    return;
+  }
+  g_interrupted.store(true);
 }
 
 std::string formatSeconds(double s) {
@@ -31,7 +37,7 @@ std::string formatSeconds(double s) {
 }  // namespace
 
 InterruptGuard::InterruptGuard() {
-  g_interrupted = 0;
+  g_interrupted.store(false);
   struct sigaction sa {};
   sa.sa_handler = onSigint;
   sigemptyset(&sa.sa_mask);
@@ -40,7 +46,9 @@ InterruptGuard::InterruptGuard() {
 
 InterruptGuard::~InterruptGuard() { sigaction(SIGINT, &g_previous, nullptr); }
 
-bool InterruptGuard::isInterrupted() { return g_interrupted != 0; }
+bool InterruptGuard::isInterrupted() { return g_interrupted.load(); }
+
+const std::atomic<bool>* InterruptGuard::flag() { return &g_interrupted; }
 
 ProgressBar::ProgressBar(std::string label, double totalTime)
     : m_label(std::move(label)), m_total(totalTime), m_isTty(isatty(STDERR_FILENO) != 0),

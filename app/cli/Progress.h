@@ -2,14 +2,16 @@
 /// @file Progress.h
 /// Terminal progress bar (simulated time, real-time factor, ETA) and clean Ctrl-C handling for long runs.
 
+#include <atomic>
 #include <chrono>
 #include <string>
 
 namespace pneuma::app {
 
-/// Installs a SIGINT handler that only raises a flag (polled with isInterrupted()) for the lifetime of
-/// the object, so a run can stop at the next frame and still write its outputs. A second Ctrl-C while
-/// the flag is up restores the default action (kills the process).
+/// Installs a SIGINT handler that only raises a flag for the lifetime of the object. The simulation looks at
+/// the flag before every step (sim::Simulation::setStopFlag(), also during the drive calibration), so the
+/// first Ctrl-C stops a run within a step and the run still writes its outputs. A second Ctrl-C ends the
+/// process at once, by SIGINT, without writing anything more (docs/cli.md).
 class InterruptGuard {
  public:
   InterruptGuard();
@@ -18,6 +20,8 @@ class InterruptGuard {
   InterruptGuard& operator=(const InterruptGuard&) = delete;
   /// True once SIGINT arrived.
   static bool isInterrupted();
+  /// The flag the handler raises (lock-free, for sim::Simulation::setStopFlag()).
+  static const std::atomic<bool>* flag();
 };
 
 /// One-line progress bar on stderr, redrawn at most 10 times per second; silent when stderr is not a TTY.

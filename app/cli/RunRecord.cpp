@@ -26,23 +26,19 @@ viz::Color groupPlotColour(int g) {
 
 }  // namespace
 
-RunRecord::RunRecord(const sim::Model& model, bool hasVolumeTarget) : m_model(model), m_hasVolumeTarget(hasVolumeTarget) {}
-
-void RunRecord::append(const sim::Metrics& m, double targetFraction, double measuredFraction) {
-  m_time.push_back(m.time);
-  m_lungVolume.push_back(m.lungVolume);
-  m_abdomenVolume.push_back(m.abdomenVolume);
-  m_gutVolumeError.push_back(m.gutVolumeError);
-  m_activations.push_back(m.activations);
-  m_tension.push_back(m.groupMeanTension);
-  m_landmarks.push_back(m.landmarks);
-  m_target.push_back(targetFraction);
-  m_measured.push_back(measuredFraction);
+RunRecord::RunRecord(const sim::Model& model, bool hasVolumeTarget, const std::string& csvPath)
+    : m_model(model),
+      m_hasVolumeTarget(hasVolumeTarget),
+      m_r(sim::kElementGroupCount, viz::MinMaxSeries(kPlotBuckets)),
+      m_alpha(sim::kElementGroupCount, viz::MinMaxSeries(kPlotBuckets)),
+      m_tension(sim::kElementGroupCount, viz::MinMaxSeries(kPlotBuckets)) {
+  if (csvPath.empty()) return;
+  m_csv = std::make_unique<viz::AtomicFileWriter>(csvPath);
+  writeCsvHeader();
 }
 
-void RunRecord::writeCsv(const std::string& path) const {
+void RunRecord::writeCsvHeader() {
   std::ostringstream csv;
-  // header: one "name [unit]" column each
   csv << "time [s],lung_volume [mL],gut_volume_error [%],rib_cage_volume [mL],abdomen_volume [mL]";
   for (int g = 0; g < sim::kElementGroupCount; ++g)
     if (sim::isMuscleGroup(group(g))) csv << "," << sim::groupName(group(g)) << ".r [-]," << sim::groupName(group(g)) << ".alpha [-]";
@@ -50,23 +46,43 @@ void RunRecord::writeCsv(const std::string& path) const {
   for (const std::string& name : m_model.landmarks.name) csv << "," << name << ".x [mm]," << name << ".y [mm]," << name << ".z [mm]";
   if (m_hasVolumeTarget) csv << ",target_volume_fraction [-],measured_volume_fraction [-]";
   csv << "\n";
+  m_csv->write(csv.str());
+}
 
-  // rows
-  for (std::size_t i = 0; i < m_time.size(); ++i) {
-    csv << formatNumber(m_time[i]) << "," << formatNumber(m_lungVolume[i] * kMl) << "," << formatNumber(m_gutVolumeError[i] * kPct)
-        << "," << formatNumber((m_lungVolume[i] - m_abdomenVolume[i]) * kMl) << "," << formatNumber(m_abdomenVolume[i] * kMl);
-    for (int g = 0; g < sim::kElementGroupCount; ++g)
-      if (sim::isMuscleGroup(group(g)))
-        csv << "," << formatNumber(m_activations[i][static_cast<std::size_t>(g)].r) << ","
-            << formatNumber(m_activations[i][static_cast<std::size_t>(g)].alpha);
-    for (int g = 0; g < sim::kElementGroupCount; ++g) csv << "," << formatNumber(m_tension[i][static_cast<std::size_t>(g)]);
-    for (Eigen::Index l = 0; l < m_landmarks[i].cols(); ++l)
-      csv << "," << formatNumber(m_landmarks[i](0, l) * kMm) << "," << formatNumber(m_landmarks[i](1, l) * kMm) << ","
-          << formatNumber(m_landmarks[i](2, l) * kMm);
-    if (m_hasVolumeTarget) csv << "," << formatNumber(m_target[i]) << "," << formatNumber(m_measured[i]);
-    csv << "\n";
+void RunRecord::append(const sim::Metrics& m, double targetFraction, double measuredFraction) {
+  ++m_frames;
+  const double t = m.time;
+  m_lungVolume.append(t, m.lungVolume);
+  m_gutVolumeError.append(t, m.gutVolumeError);
+  for (std::size_t g = 0; g < static_cast<std::size_t>(sim::kElementGroupCount); ++g) {
+    m_r[g].append(t, m.activations[g].r);
+    m_alpha[g].append(t, m.activations[g].alpha);
+    m_tension[g].append(t, m.groupMeanTension[g]);
   }
-  viz::writeFileAtomically(path, csv.str());
+  m_target.append(t, targetFraction);
+  m_measured.append(t, measuredFraction);
+  if (!m_csv) return;
+
+  std::ostringstream csv;
+  csv << formatNumber(t) << "," << formatNumber(m.lungVolume * kMl) << ","
+      << formatNumber(m.gutVolumeError * kPct) << "," << formatNumber((m.lungVolume - m.abdomenVolume) * kMl)
+      << "," << formatNumber(m.abdomenVolume * kMl);
+  for (int g = 0; g < sim::kElementGroupCount; ++g)
+    if (sim::isMuscleGroup(group(g)))
+      csv << "," << formatNumber(m.activations[static_cast<std::size_t>(g)].r) << ","
+          << formatNumber(m.activations[static_cast<std::size_t>(g)].alpha);
+  for (int g = 0; g < sim::kElementGroupCount; ++g)
+    csv << "," << formatNumber(m.groupMeanTension[static_cast<std::size_t>(g)]);
+  for (Eigen::Index l = 0; l < m.landmarks.cols(); ++l)
+    csv << "," << formatNumber(m.landmarks(0, l) * kMm) << "," << formatNumber(m.landmarks(1, l) * kMm) << ","
+        << formatNumber(m.landmarks(2, l) * kMm);
+  if (m_hasVolumeTarget) csv << "," << formatNumber(targetFraction) << "," << formatNumber(measuredFraction);
+  csv << "\n";
+  m_csv->write(csv.str());
+}
+
+void RunRecord::commitCsv() {
+  if (m_csv) m_csv->commit();
 }
 
 std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std::string& runLabel) const {
@@ -77,50 +93,47 @@ std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std
     written.push_back(stem + ".png");
     written.push_back(stem + ".svg");
   };
-  auto scaled = [](const std::vector<double>& v, double k) {
-    std::vector<double> out(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) out[i] = v[i] * k;
-    return out;
+  // the thinned curve of `s`, values times k
+  auto curve = [](const viz::MinMaxSeries& s, double k, std::vector<double>& t, std::vector<double>& v) {
+    s.points(t, v);
+    for (double& x : v) x *= k;
   };
+  std::vector<double> t, v;
 
   viz::Plot lung("Lung-cavity volume (" + runLabel + ")", "time [s]", "lung-cavity volume [mL]");
-  lung.addSeries("lung-cavity volume", m_time, scaled(m_lungVolume, kMl));
+  curve(m_lungVolume, kMl, t, v);
+  lung.addSeries("lung-cavity volume", t, v);
   save(lung, "lung_volume");
 
   viz::Plot gut("Gut volume error (" + runLabel + ")", "time [s]", "gut volume error (V - V0)/V0 [%]");
-  gut.addSeries("gut volume error", m_time, scaled(m_gutVolumeError, kPct));
+  curve(m_gutVolumeError, kPct, t, v);
+  gut.addSeries("gut volume error", t, v);
   save(gut, "gut_volume_error");
 
-  // activations: contraction ratio r solid, activation alpha dashed, one colour per group
   viz::Plot act("Muscle activations (" + runLabel + ")", "time [s]", "r, alpha [-]");
   viz::Plot ten("Mean element tension per group (" + runLabel + ")", "time [s]", "mean tension per element [N]");
   for (int g = 0; g < sim::kElementGroupCount; ++g) {
-    std::vector<double> r, a, t;
-    for (std::size_t i = 0; i < m_time.size(); ++i) {
-      r.push_back(m_activations[i][static_cast<std::size_t>(g)].r);
-      a.push_back(m_activations[i][static_cast<std::size_t>(g)].alpha);
-      t.push_back(m_tension[i][static_cast<std::size_t>(g)]);
-    }
+    const std::size_t i = static_cast<std::size_t>(g);
     const std::string name = sim::groupName(group(g));
+    const viz::Color c = groupPlotColour(g);
     if (sim::isMuscleGroup(group(g))) {
-      viz::Plot::Series rs{name + " r", m_time, r, {}, false};
-      viz::Plot::Series as{name + " alpha", m_time, a, {}, true};
-      const viz::Color c = groupPlotColour(g);
-      rs.color = c;
-      as.color = c;
-      act.addSeries(rs);
-      act.addSeries(as);
+      curve(m_r[i], 1.0, t, v);
+      act.addSeries(viz::Plot::Series{name + " r", t, v, c, false});
+      curve(m_alpha[i], 1.0, t, v);
+      act.addSeries(viz::Plot::Series{name + " alpha", t, v, c, true});
     }
-    viz::Plot::Series ts{name, m_time, t, groupPlotColour(g), false};
-    ten.addSeries(ts);
+    curve(m_tension[i], 1.0, t, v);
+    ten.addSeries(viz::Plot::Series{name, t, v, c, false});
   }
   save(act, "activations");
   save(ten, "tensions");
 
   if (m_hasVolumeTarget) {
     viz::Plot vf("Volume fraction: pattern target vs measured (" + runLabel + ")", "time [s]", "volume fraction [-]");
-    vf.addSeries(viz::Plot::Series{"target", m_time, m_target, {0.84, 0.15, 0.16}, true});
-    vf.addSeries(viz::Plot::Series{"measured", m_time, m_measured, {0.0, 0.0, 0.0}, false});
+    curve(m_target, 1.0, t, v);
+    vf.addSeries(viz::Plot::Series{"target", t, v, {0.84, 0.15, 0.16}, true});
+    curve(m_measured, 1.0, t, v);
+    vf.addSeries(viz::Plot::Series{"measured", t, v, {0.0, 0.0, 0.0}, false});
     save(vf, "volume_fraction");
   }
   return written;

@@ -3,42 +3,54 @@
 /// The per-frame record of one pneuma-cli run and its exports: timeseries.csv (one header row of
 /// "name [unit]" columns) and the plots (lung-cavity volume, gut volume error, activations, group
 /// tensions, and the volume fraction target vs measured when a pattern drives the breathing).
+/// Memory stays bounded however long the run: the CSV is written row by row as frames arrive (to a temporary
+/// file, renamed by commitCsv()), and the plots keep each series thinned to the minima and maxima of at most
+/// kPlotBuckets buckets (viz::MinMaxSeries), so an hour's plot is as small as a minute's.
 
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
+#include "viz/AtomicFile.h"
+#include "viz/MinMaxSeries.h"
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace pneuma::app {
 
+/// Buckets per plotted series (each keeps a minimum and a maximum): about two per pixel of a 960 px plot.
+inline constexpr std::size_t kPlotBuckets = 1024;
+
 class RunRecord {
  public:
   /// @param hasVolumeTarget true when an affect or pattern controller sets a target volume fraction
-  RunRecord(const sim::Model& model, bool hasVolumeTarget);
+  /// @param csvPath         where commitCsv() puts timeseries.csv; "" writes no CSV
+  /// @throws std::runtime_error "cannot write <csvPath>: <reason>" when the CSV cannot be started.
+  RunRecord(const sim::Model& model, bool hasVolumeTarget, const std::string& csvPath = "");
 
-  /// Appends one output frame. `targetFraction` and `measuredFraction` [-] are used only with a volume target.
+  /// Appends one output frame (a CSV row, and the plotted series). `targetFraction` and `measuredFraction`
+  /// [-] are used only with a volume target. @throws std::runtime_error when the CSV row cannot be written.
   void append(const sim::Metrics& m, double targetFraction = 0.0, double measuredFraction = 0.0);
-  std::size_t size() const { return m_time.size(); }
+  std::size_t size() const { return m_frames; }
 
-  /// Writes timeseries.csv to `path` (temporary file, then rename).
-  void writeCsv(const std::string& path) const;
+  /// Renames the CSV into place (the rows of every frame appended). @throws std::runtime_error as append().
+  void commitCsv();
   /// Writes <dir>/{lung_volume,gut_volume_error,activations,tensions[,volume_fraction]}.{png,svg};
   /// returns the file names written.
   std::vector<std::string> writePlots(const std::string& dir, const std::string& runLabel) const;
 
  private:
+  void writeCsvHeader();
   const sim::Model& m_model;
   bool m_hasVolumeTarget;
-  std::vector<double> m_time;             // [s]
-  std::vector<double> m_lungVolume;       // [m^3]
-  std::vector<double> m_abdomenVolume;    // [m^3] Metrics::abdomenVolume (the rib-cage volume is the lung minus it)
-  std::vector<double> m_gutVolumeError;   // [-]
-  std::vector<sim::Activations> m_activations;
-  std::vector<std::array<double, sim::kElementGroupCount>> m_tension;  // [N]
-  std::vector<Eigen::Matrix3Xd> m_landmarks;  // [m] (3 x #L)
-  std::vector<double> m_target;           // [-]
-  std::vector<double> m_measured;         // [-]
+  std::unique_ptr<viz::AtomicFileWriter> m_csv;  // null without a CSV
+  std::size_t m_frames = 0;
+  viz::MinMaxSeries m_lungVolume{kPlotBuckets};      // [m^3]
+  viz::MinMaxSeries m_gutVolumeError{kPlotBuckets};  // [-]
+  std::vector<viz::MinMaxSeries> m_r, m_alpha;       // [-] per ElementGroup
+  std::vector<viz::MinMaxSeries> m_tension;          // [N] per ElementGroup
+  viz::MinMaxSeries m_target{kPlotBuckets};          // [-]
+  viz::MinMaxSeries m_measured{kPlotBuckets};        // [-]
 };
 
 }  // namespace pneuma::app

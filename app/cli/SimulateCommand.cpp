@@ -67,13 +67,12 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (s.name.empty()) s.name = s.controllerName.empty() ? "run" : fs::path(s.controllerName).stem().string();
 
   if (a.isGiven("--duration")) {
-    if (!(a.duration > 0.0) || !std::isfinite(a.duration))
-      fail(kExitBadInput, "--duration: must be > 0 s, got " + formatNumber(a.duration));
+    checkOption(sim::kDurationRange, "--duration", a.duration);
     s.duration = a.duration;
   }
   if (a.scenario.empty() && !a.isGiven("--duration")) fail(kExitBadInput, "--duration is required (simulated seconds)");
   if (a.isGiven("--output-rate")) {
-    if (!(a.outputRate > 0.0)) fail(kExitBadInput, "--output-rate: must be > 0 Hz, got " + formatNumber(a.outputRate));
+    checkOption(sim::kOutputRateRange, "--output-rate", a.outputRate);
     s.outputs.outputRate = a.outputRate;
     s.options.outputRate = a.outputRate;
   }
@@ -81,11 +80,11 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (a.isGiven("--seed")) s.seed = a.seed;
   applyIntegrator(a.integrator, s.options.step.integrator);
   if (a.isGiven("--dt")) {
-    if (!(a.dt > 0.0)) fail(kExitBadInput, "--dt: must be > 0 s, got " + formatNumber(a.dt));
+    checkOption(sim::kTimeStepRange, "--dt", a.dt);
     s.options.dt = a.dt;
   }
   if (a.isGiven("--settle")) {
-    if (!(a.settle >= 0.0)) fail(kExitBadInput, "--settle: must be >= 0 s, got " + formatNumber(a.settle));
+    checkOption(sim::kSettleTimeRange, "--settle", a.settle);
     s.options.settleTime = a.settle;
   }
   try {
@@ -107,20 +106,30 @@ void runSimulate(const SimulateArgs& args) {
       fail(kExitBadInput, "--out: '" + args.out + "' holds an earlier run (" + earlier + "); add --force to replace it");
   }
 
+  // Ctrl-C from here on: the first stops within one step (the drive calibration too) and the outputs are
+  // still written; a second ends the process at once (InterruptGuard)
+  InterruptGuard guard;
+
   // model, controller and simulation: any bad input is reported by name before anything runs
   std::shared_ptr<const sim::Model> model;
-  std::unique_ptr<sim::Controller> controller;
   std::unique_ptr<sim::Simulation> simulation;
+  bool isInterrupted = false;
   try {
     model = std::make_shared<const sim::Model>(sim::loadModel(modelDir));
     sim::checkController(scenario, sim::resourceDir());
     if (scenario.controller != sim::ControllerKind::Style)
       std::fprintf(stderr, "calibrating the pattern controller's muscle drive on the model...\n");
-    controller = sim::makeController(scenario, model, sim::resourceDir());
+    std::unique_ptr<sim::Controller> controller =
+        sim::makeController(scenario, model, sim::resourceDir(), InterruptGuard::flag());
     // the CLI writes the trace; the recorder's timeline is for the app's scrubbing
     sim::SimulationOptions options = scenario.options;
     options.recordSeconds = sim::kTraceOnlyRecordSeconds;
     simulation = std::make_unique<sim::Simulation>(model, std::move(controller), options);
+    simulation->setStopFlag(InterruptGuard::flag());
+    sim::checkStepCount(args.isGiven("--duration") ? "--duration" : "duration_s",
+                        scenario.options.settleTime + scenario.duration, simulation->dt());
+  } catch (const sim::Interrupted&) {
+    isInterrupted = true;  // Ctrl-C during the calibration: nothing ran, the summary says so
   } catch (const sim::Error& e) {
     // a controller given on the command line is named by its flag, not by its scenario-file path
     std::string message = e.what();
@@ -130,17 +139,32 @@ void runSimulate(const SimulateArgs& args) {
     fail(kExitBadInput, message);
   }
   const bool hasTarget = scenario.controller != sim::ControllerKind::Style;
-  const std::string controllerText = simulation->controller().describe();
+  const std::string controllerText =
+      simulation ? simulation->controller().describe()
+                 : std::string(sim::controllerKindName(scenario.controller)) + " " + scenario.controllerName;
 
-  // run, recording every output frame; Ctrl-C stops at the next frame
-  RunRecord record(*model, hasTarget);
+  // run, recording every output frame; a blow-up or an output that cannot be written (a full disk) ends the
+  // run with what was computed so far
+  // outputs that cannot even be started are refused before the run
+  std::unique_ptr<RunRecord> recordOwner;
+  try {
+    recordOwner = std::make_unique<RunRecord>(
+        *model, hasTarget, scenario.outputs.csv ? args.out + "/timeseries.csv" : std::string());
+  } catch (const std::exception& e) {
+    fail(kExitBadInput, std::string("--out: ") + e.what());
+  }
+  RunRecord& record = *recordOwner;
   std::unique_ptr<viz::VtkSeriesWriter> vtk;
-  if (scenario.outputs.vtk) vtk = std::make_unique<viz::VtkSeriesWriter>(*model, modelDir, args.out, "frames");
-  const double total = scenario.options.settleTime + scenario.duration;  // [s]
-  std::string blowUp;
-  bool isInterrupted = false;
-  {
-    InterruptGuard guard;
+  if (simulation && scenario.outputs.vtk) {
+    try {
+      vtk = std::make_unique<viz::VtkSeriesWriter>(*model, modelDir, args.out, "frames");
+    } catch (const std::exception& e) {
+      fail(kExitBadInput, std::string("--vtk: ") + e.what());
+    }
+  }
+  std::string failure;
+  if (simulation) {
+    const double total = scenario.options.settleTime + scenario.duration;  // [s]
     ProgressBar bar(scenario.name, total);
     try {
       simulation->advance(total, [&](const sim::Simulation& s) {
@@ -149,27 +173,39 @@ void runSimulate(const SimulateArgs& args) {
         else record.append(s.latestMetrics());
         if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());
         bar.update(s.state().time);
-        return !InterruptGuard::isInterrupted();
+        return true;
       });
-    } catch (const sim::Error& e) {
-      blowUp = e.what();
+    } catch (const std::exception& e) {
+      failure = e.what();  // sim::Error (blow-up) or std::runtime_error from a writer
     }
     bar.finish();
-    isInterrupted = InterruptGuard::isInterrupted();
+    isInterrupted = simulation->wasStopped();
   }
 
-  // outputs, each through a temporary file and a rename
+  // outputs, each through a temporary file and a rename; one that cannot be written does not stop the others
   std::vector<std::string> files;
-  if (scenario.outputs.csv) {
-    record.writeCsv(args.out + "/timeseries.csv");
-    files.push_back("timeseries.csv");
-  }
-  if (scenario.outputs.plots && record.size() > 0) {
-    for (const std::string& f : record.writePlots(args.out, scenario.name)) files.push_back(f);
-  }
-  if (vtk) files.push_back(vtk->finish());
+  std::vector<std::string> writeErrors;
+  auto attempt = [&](const std::function<void()>& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      writeErrors.push_back(e.what());
+    }
+  };
+  if (scenario.outputs.csv)
+    attempt([&] {
+      record.commitCsv();
+      files.push_back("timeseries.csv");
+    });
+  if (scenario.outputs.plots && record.size() > 0)
+    attempt([&] {
+      for (const std::string& f : record.writePlots(args.out, scenario.name)) files.push_back(f);
+    });
+  if (vtk) attempt([&] { files.push_back(vtk->finish()); });
+  if (failure.empty() && !writeErrors.empty()) failure = writeErrors.front();
 
-  const sim::Summary sum = simulation->summary();
+  const sim::Summary sum = simulation ? simulation->summary() : sim::Summary{};
+  const nlohmann::json none(nullptr);
   nlohmann::json j;
   j["pneuma_version"] = PNEUMA_VERSION;
   j["model"] = modelDir;
@@ -177,39 +213,56 @@ void runSimulate(const SimulateArgs& args) {
   j["scenario"] = scenario.name;
   j["controller"] = controllerText;
   j["controller_kind"] = sim::controllerKindName(scenario.controller);
-  j["integrator"] = sim::integratorName(simulation->options().step.integrator);
-  j["dt_s"] = simulation->dt();
+  j["integrator"] = sim::integratorName(scenario.options.step.integrator);
+  j["dt_s"] = simulation ? nlohmann::json(simulation->dt()) : none;
   j["steps"] = sum.steps;
   j["seed"] = scenario.seed;
   j["settle_time_s"] = scenario.options.settleTime;
   j["duration_s"] = scenario.duration;
-  j["simulated_time_s"] = simulation->state().time;
-  j["partial"] = isInterrupted || !blowUp.empty();
+  j["simulated_time_s"] = simulation ? simulation->state().time : 0.0;
+  j["partial"] = isInterrupted || !failure.empty();
   j["interrupted"] = isInterrupted;
-  j["error"] = blowUp.empty() ? nlohmann::json(nullptr) : nlohmann::json(blowUp);
-  j["real_time_factor"] = jsonNumber(sum.realTimeFactor);
-  j["tidal_volume_ml"] = jsonNumber(sum.tidalVolume * 1e6);
-  j["breaths_per_minute"] = jsonNumber(sum.breathsPerMinute);
+  j["error"] = failure.empty() ? none : nlohmann::json(failure);
+  const bool ran = simulation && record.size() > 0;
+  j["real_time_factor"] = ran ? jsonNumber(sum.realTimeFactor) : none;
+  j["tidal_volume_ml"] = ran ? jsonNumber(sum.tidalVolume * 1e6) : none;
+  j["breaths_per_minute"] = ran ? jsonNumber(sum.breathsPerMinute) : none;
   j["cycles"] = sum.cycles;
-  j["end_expiratory_volume_ml"] = jsonNumber(sum.endExpiratoryVolume * 1e6);
-  j["end_inspiratory_volume_ml"] = jsonNumber(sum.endInspiratoryVolume * 1e6);
-  j["max_gut_volume_error_pct"] = jsonNumber(sum.maxGutVolumeError * 100.0);
-  j["mean_gut_volume_error_pct"] = jsonNumber(sum.meanGutVolumeError * 100.0);
+  j["end_expiratory_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * 1e6) : none;
+  j["end_inspiratory_volume_ml"] = ran ? jsonNumber(sum.endInspiratoryVolume * 1e6) : none;
+  j["max_gut_volume_error_pct"] = ran ? jsonNumber(sum.maxGutVolumeError * 100.0) : none;
+  j["mean_gut_volume_error_pct"] = ran ? jsonNumber(sum.meanGutVolumeError * 100.0) : none;
   writeMotion(sum.motion, j);
-  const auto* pattern = dynamic_cast<const sim::pattern::PatternController*>(&simulation->controller());
-  j["tracking_rms_pct"] = pattern != nullptr ? jsonNumber(pattern->tracking().rmsPercentOfPeakToPeak()) : nlohmann::json(nullptr);
+  const auto* pattern =
+      simulation ? dynamic_cast<const sim::pattern::PatternController*>(&simulation->controller()) : nullptr;
+  j["tracking_rms_pct"] =
+      pattern != nullptr ? jsonNumber(pattern->tracking().rmsPercentOfPeakToPeak()) : none;
   j["measured_from_s"] = sum.measuredFrom;
   j["frames"] = record.size();
   j["files"] = files;
-  viz::writeFileAtomically(args.out + "/summary.json", j.dump(2) + "\n");
+  bool hasSummary = false;
+  attempt([&] {
+    viz::writeFileAtomically(args.out + "/summary.json", j.dump(2) + "\n");
+    hasSummary = true;
+  });
 
   // a short human-readable report on stdout
   std::printf("%s: %s%s\n", scenario.name.c_str(), controllerText.c_str(),
               isInterrupted ? " (interrupted, partial results)" : "");
-  std::printf("  tidal volume %.0f mL, %.1f breaths/min, max gut volume error %.3f %%, real-time factor %.2f\n",
-              sum.tidalVolume * 1e6, sum.breathsPerMinute, sum.maxGutVolumeError * 100.0, sum.realTimeFactor);
-  std::printf("  wrote %s/summary.json and %zu more files\n", args.out.c_str(), files.size());
-  if (!blowUp.empty()) fail(kExitFailed, blowUp);
+  if (ran)
+    std::printf(
+        "  tidal volume %.0f mL, %.1f breaths/min, max gut volume error %.3f %%, real-time factor %.2f\n",
+        sum.tidalVolume * 1e6, sum.breathsPerMinute, sum.maxGutVolumeError * 100.0, sum.realTimeFactor);
+  std::printf("  wrote %s%zu files in %s\n", hasSummary ? "summary.json and " : "", files.size(),
+              args.out.c_str());
+  if (!failure.empty() || !writeErrors.empty()) {
+    // one line: the run's failure, then every output that could not be written
+    std::string message = failure;
+    for (const std::string& w : writeErrors)
+      if (w != failure) message += "; " + w;
+    if (!hasSummary) message += " (no summary.json)";
+    fail(kExitFailed, message);
+  }
   if (isInterrupted) throw CLI::RuntimeError(kExitInterrupted);
 }
 

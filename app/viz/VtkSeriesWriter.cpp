@@ -129,18 +129,17 @@ struct VtkSeriesWriter::Impl {
     return baseName + "/" + name;
   }
 
+  // encoded in memory, then written through writeFileAtomically(), whose every write is checked: VTK's own
+  // file output can report success on a full disk and leave a truncated frame
   void write(vtkPolyData* pd, const std::string& relative) const {
     const std::string path = (fs::path(outDir) / relative).string();
-    const std::string tmp = temporaryPathFor(path);
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(pd);
-    writer->SetFileName(tmp.c_str());
+    writer->WriteToOutputStringOn();
     writer->SetDataModeToAppended();
-    if (writer->Write() != 1) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error("cannot write " + path);
-    }
-    commitTemporary(tmp, path);
+    if (writer->Write() != 1)
+      throw std::runtime_error("cannot write " + path + ": VTK could not encode the frame");
+    writeFileAtomically(path, writer->GetOutputString());
   }
 
   vtkSmartPointer<vtkPolyData> bones(const sim::State& state) const {

@@ -17,18 +17,19 @@ constexpr double kPaPerCmH2O = 98.0665;  // [Pa/cmH2O]
 
 using Reader = sim::JsonReader;
 
-/// an array of `count` lengths in (0, hiMm] mm, returned in m
-std::vector<double> lengthsMm(const Reader& v, std::size_t count, double hiMm) {
+/// an array of `count` lengths in [loMm, hiMm] mm, returned in m. Every length has a lower bound as well as
+/// an upper one: a body part of 1e-12 mm would reach the mesher as a degenerate surface.
+std::vector<double> lengthsMm(const Reader& v, std::size_t count, double loMm, double hiMm) {
   if (!v.isArray() || v.size() != count) v.fail("must be an array of " + std::to_string(count) + " numbers");
   std::vector<double> out;
-  for (std::size_t i = 0; i < count; ++i) out.push_back(v[i].positiveAtMost(hiMm) * kMm);
+  for (std::size_t i = 0; i < count; ++i) out.push_back(v[i].numberIn(loMm, hiMm) * kMm);
   return out;
 }
-std::array<double, 2> pairMm(const Reader& v, double hiMm) {
-  const std::vector<double> l = lengthsMm(v, 2, hiMm);
+std::array<double, 2> pairMm(const Reader& v, double loMm, double hiMm) {
+  const std::vector<double> l = lengthsMm(v, 2, loMm, hiMm);
   return {l[0], l[1]};
 }
-double mm(const Reader& v, double hiMm) { return v.positiveAtMost(hiMm) * kMm; }
+double mm(const Reader& v, double loMm, double hiMm) { return v.numberIn(loMm, hiMm) * kMm; }
 int count(const Reader& v, int lo, int hi) { return static_cast<int>(v.integerIn(lo, hi)); }
 
 std::string readText(const std::string& path) {
@@ -45,14 +46,14 @@ RibLevel readRib(const Reader& r, std::size_t i) {
   if (r.has("level") && r.at("level").integerIn(1, 12) != static_cast<std::int64_t>(i + 1))
     r.at("level").fail("must be " + std::to_string(i + 1) + " (the ribs are listed in order)");
   RibLevel rib;
-  rib.arcLength = mm(r.at("arc_length_mm"), 600.0);
-  rib.posteriorRatio = r.at("posterior_ratio").positiveAtMost(5.0);
-  rib.anteriorRatio = r.at("anterior_ratio").positiveAtMost(5.0);
+  rib.arcLength = mm(r.at("arc_length_mm"), 30.0, 600.0);
+  rib.posteriorRatio = r.at("posterior_ratio").numberIn(0.05, 5.0);
+  rib.anteriorRatio = r.at("anterior_ratio").numberIn(0.05, 5.0);
   rib.endAngle = r.at("end_angle_deg").numberIn(180.0, 330.0) * kDeg;
   rib.inclination = r.at("inclination_deg").numberIn(-10.0, 80.0) * kDeg;
   rib.lateralTilt = r.at("lateral_tilt_deg").numberIn(-30.0, 60.0) * kDeg;
-  rib.height = mm(r.at("height_mm"), 40.0);
-  rib.thickness = mm(r.at("thickness_mm"), 20.0);
+  rib.height = mm(r.at("height_mm"), 2.0, 40.0);
+  rib.thickness = mm(r.at("thickness_mm"), 1.0, 20.0);
   rib.neckAxis = r.at("neck_axis_deg").numberIn(0.0, 90.0) * kDeg;
   if (rib.thickness > rib.height) r.at("thickness_mm").fail("must not exceed height_mm");
   return rib;
@@ -63,15 +64,15 @@ SpineParams readSpine(const Reader& r) {
                "lumbar_body_width_depth_mm", "t1_body_width_depth_mm", "t12_body_width_depth_mm", "kyphosis_mm",
                "spinous_process_mm", "thoracic_segments"});
   SpineParams s;
-  s.lumbarHeights = lengthsMm(r.at("lumbar_body_heights_mm"), 5, 60.0);
-  s.thoracicHeights = lengthsMm(r.at("thoracic_body_heights_mm"), 12, 40.0);
-  s.lumbarDisc = mm(r.at("lumbar_disc_mm"), 20.0);
-  s.thoracicDisc = mm(r.at("thoracic_disc_mm"), 15.0);
-  s.lumbarBody = pairMm(r.at("lumbar_body_width_depth_mm"), 80.0);
-  s.thoracicBodyTop = pairMm(r.at("t1_body_width_depth_mm"), 80.0);
-  s.thoracicBodyBottom = pairMm(r.at("t12_body_width_depth_mm"), 80.0);
+  s.lumbarHeights = lengthsMm(r.at("lumbar_body_heights_mm"), 5, 5.0, 60.0);
+  s.thoracicHeights = lengthsMm(r.at("thoracic_body_heights_mm"), 12, 4.0, 40.0);
+  s.lumbarDisc = mm(r.at("lumbar_disc_mm"), 1.0, 20.0);
+  s.thoracicDisc = mm(r.at("thoracic_disc_mm"), 1.0, 15.0);
+  s.lumbarBody = pairMm(r.at("lumbar_body_width_depth_mm"), 5.0, 80.0);
+  s.thoracicBodyTop = pairMm(r.at("t1_body_width_depth_mm"), 5.0, 80.0);
+  s.thoracicBodyBottom = pairMm(r.at("t12_body_width_depth_mm"), 5.0, 80.0);
   s.kyphosis = r.at("kyphosis_mm").numberIn(0.0, 80.0) * kMm;
-  s.spinousLength = mm(r.at("spinous_process_mm"), 100.0);
+  s.spinousLength = mm(r.at("spinous_process_mm"), 5.0, 100.0);
   const Reader segs = r.at("thoracic_segments");
   if (!segs.isArray() || segs.size() < 3) segs.fail("needs at least 3 articulated segments");
   int expected = 1;
@@ -92,14 +93,14 @@ SternumParams readSternum(const Reader& r) {
   r.allowKeys({"manubrium_length_mm", "body_length_mm", "xiphoid_length_mm", "manubrium_width_mm", "body_width_mm",
                "thickness_mm", "jugular_notch_vertebra", "jugular_notch_depth_mm", "inclination_deg"});
   SternumParams s;
-  s.manubriumLength = mm(r.at("manubrium_length_mm"), 120.0);
-  s.bodyLength = mm(r.at("body_length_mm"), 200.0);
-  s.xiphoidLength = mm(r.at("xiphoid_length_mm"), 100.0);
-  s.manubriumWidth = mm(r.at("manubrium_width_mm"), 120.0);
-  s.bodyWidth = mm(r.at("body_width_mm"), 80.0);
-  s.thickness = mm(r.at("thickness_mm"), 30.0);
+  s.manubriumLength = mm(r.at("manubrium_length_mm"), 10.0, 120.0);
+  s.bodyLength = mm(r.at("body_length_mm"), 20.0, 200.0);
+  s.xiphoidLength = mm(r.at("xiphoid_length_mm"), 5.0, 100.0);
+  s.manubriumWidth = mm(r.at("manubrium_width_mm"), 10.0, 120.0);
+  s.bodyWidth = mm(r.at("body_width_mm"), 5.0, 80.0);
+  s.thickness = mm(r.at("thickness_mm"), 2.0, 30.0);
   s.notchLevel = r.at("jugular_notch_vertebra").numberIn(1.0, 5.0);
-  s.notchDepth = mm(r.at("jugular_notch_depth_mm"), 300.0);
+  s.notchDepth = mm(r.at("jugular_notch_depth_mm"), 15.0, 300.0);
   s.inclination = r.at("inclination_deg").numberIn(0.0, 60.0) * kDeg;
   return s;
 }
@@ -107,9 +108,9 @@ SternumParams readSternum(const Reader& r) {
 PelvisParams readPelvis(const Reader& r) {
   r.allowKeys({"bi_iliac_breadth_mm", "asis_depth_mm", "iliac_height_mm"});
   PelvisParams p;
-  p.width = mm(r.at("bi_iliac_breadth_mm"), 500.0);
-  p.depth = mm(r.at("asis_depth_mm"), 300.0);
-  p.height = mm(r.at("iliac_height_mm"), 250.0);
+  p.width = mm(r.at("bi_iliac_breadth_mm"), 80.0, 500.0);
+  p.depth = mm(r.at("asis_depth_mm"), 30.0, 300.0);
+  p.height = mm(r.at("iliac_height_mm"), 30.0, 250.0);
   return p;
 }
 
@@ -118,10 +119,10 @@ AbdomenParams readAbdomen(const Reader& r) {
                "central_tendon_fraction", "umbilicus_z_mm"});
   AbdomenParams a;
   a.floorLevel = r.at("pelvic_floor_z_mm").numberIn(-300.0, 0.0) * kMm;
-  a.width = mm(r.at("inner_width_mm"), 600.0);
-  a.anteriorDepth = mm(r.at("anterior_depth_mm"), 400.0);
-  a.posteriorDepth = mm(r.at("posterior_depth_mm"), 200.0);
-  a.domeHeight = mm(r.at("dome_height_mm"), 200.0);
+  a.width = mm(r.at("inner_width_mm"), 60.0, 600.0);
+  a.anteriorDepth = mm(r.at("anterior_depth_mm"), 30.0, 400.0);
+  a.posteriorDepth = mm(r.at("posterior_depth_mm"), 15.0, 200.0);
+  a.domeHeight = mm(r.at("dome_height_mm"), 20.0, 200.0);
   a.tendonFraction = r.at("central_tendon_fraction").numberIn(0.05, 0.8);
   a.umbilicusLevel = r.at("umbilicus_z_mm").numberIn(0.0, 400.0) * kMm;
   return a;

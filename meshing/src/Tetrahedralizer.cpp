@@ -8,10 +8,30 @@
 #include <tetgen.h>
 
 #include <cmath>
+#include <sstream>
 
 namespace pneuma::meshing {
 
+namespace {
+
+// [-] smallest triangle quality handed to TetGen (the default model's gut: 0.24). TetGen 1.5 crashes in its
+// own clean-up (SIGSEGV, no exception to catch) on nearly flat surfaces, e.g. an abdomen 1e-12 mm wide.
+constexpr double kMinTetgenQuality = 0.01;
+
+}  // namespace
+
 TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
+  for (int f = 0; f < surface.triangleCount(); ++f) {
+    const double q = triangleQuality(surface.vertices.col(surface.triangles(0, f)),
+                                     surface.vertices.col(surface.triangles(1, f)),
+                                     surface.vertices.col(surface.triangles(2, f)));
+    if (!(q >= kMinTetgenQuality)) {
+      std::ostringstream s;
+      s << part << ": surface triangle " << f << " is degenerate (quality " << q
+        << ", TetGen needs >= " << kMinTetgenQuality << "): check the anatomy's dimensions";
+      throw sim::Error(s.str());
+    }
+  }
   // the surface as a piecewise-linear complex of triangular facets (tetgenio frees these arrays)
   tetgenio in;
   in.firstnumber = 0;

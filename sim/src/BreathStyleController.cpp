@@ -1,6 +1,7 @@
 #include "pneuma/sim/BreathStyleController.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Limits.h"
 #include "pneuma/sim/JsonReader.h"
 #include "pneuma/sim/Resources.h"
 
@@ -44,8 +45,7 @@ double smoothRise(double u, double width) {
 
 void validateBreathStyle(const BreathStyle& s) {
   const std::string p = "breath style '" + excerptOf(s.name) + "': ";
-  if (!std::isfinite(s.breathsPerMinute) || s.breathsPerMinute <= 0.0 || s.breathsPerMinute > 600.0)
-    requireRange(p + "breaths_per_minute", s.breathsPerMinute, 0.0, 600.0, true);
+  kBreathRateRange.check(p + "breaths_per_minute", s.breathsPerMinute);
   requireRange(p + "inhale_fraction", s.inhaleFraction, 0.0, 0.999, true);
   requireRange(p + "diaphragm_r", s.diaphragmR, 0.0, 1.5, true);
   requireRange(p + "diaphragm_alpha", s.diaphragmAlpha, 0.0, 1.0, true);

@@ -1,6 +1,7 @@
 #include "pneuma/sim/JsonReader.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Limits.h"
 
 #include <nlohmann/json.hpp>
 
@@ -270,6 +271,12 @@ double JsonReader::positive() const {
 double JsonReader::nonNegative() const {
   const double v = number();
   if (v < 0.0) fail("must be >= 0, got " + excerpt());
+  return v;
+}
+
+double JsonReader::numberIn(const Range& range) const {
+  const double v = number();
+  if (!range.contains(v)) fail(range.problem(v));
   return v;
 }
 

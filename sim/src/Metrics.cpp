@@ -16,6 +16,19 @@ void Trace::append(const Metrics& m) {
   landmarks.push_back(m.landmarks);
 }
 
+void Trace::keepEveryOtherFrame() {
+  auto thin = [](auto& series) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < series.size(); i += 2) series[kept++] = std::move(series[i]);
+    series.resize(kept);
+  };
+  thin(time);
+  thin(lungVolume);
+  thin(gutVolumeError);
+  thin(abdomenVolume);
+  thin(landmarks);
+}
+
 void Trace::clear() {
   time.clear();
   lungVolume.clear();

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -149,6 +150,77 @@ double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& t) {
   return v / 6.0;
 }
 
+// A closed, consistently oriented surface: at least a tetrahedron's 4 triangles, and every edge used exactly
+// once in each direction (a flipped triangle uses an edge twice in one direction; a hole leaves an edge
+// unpaired).
+void validateClosedSurface(const Eigen::Matrix3Xi& t, const std::string& field) {
+  if (t.cols() < 4)
+    invalid(field, "must be a closed surface of at least 4 triangles, got " + std::to_string(t.cols()));
+  std::map<std::pair<int, int>, int> directed;  // edge (a, b) in the order of its triangle -> triangle
+  for (int i = 0; i < t.cols(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const std::pair<int, int> e{t(k, i), t((k + 1) % 3, i)};
+      const auto [it, isNew] = directed.emplace(e, i);
+      if (!isNew)
+        invalid(field + "[" + std::to_string(i) + "]",
+                "edge " + std::to_string(e.first) + "-" + std::to_string(e.second) +
+                    " runs the same way as in " + field + "[" + std::to_string(it->second) +
+                    "]: a flipped triangle or more than two per edge");
+    }
+  }
+  for (const auto& [e, i] : directed) {
+    if (directed.count({e.second, e.first}) == 0)
+      invalid(field + "[" + std::to_string(i) + "]",
+              "edge " + std::to_string(e.first) + "-" + std::to_string(e.second) +
+                  " has no neighbouring triangle: the surface is open");
+  }
+}
+
+// rest-pose world positions of anchored points (body frames sit at the centre of mass, unrotated, at rest)
+Eigen::Matrix3Xd restPoints(const AnchorSet& a, const Model& m) {
+  Eigen::Matrix3Xd x(3, a.size());
+  for (int i = 0; i < a.size(); ++i) {
+    const int b = a.body[static_cast<std::size_t>(i)];
+    if (b >= 0) {
+      x.col(i) = m.bodies.com.col(b) + a.local.col(i);
+      continue;
+    }
+    x.col(i).setZero();
+    for (int k = 0; k < 3; ++k)
+      if (a.nodes(k, i) >= 0) x.col(i) += a.weights(k, i) * m.nodes.rest.col(a.nodes(k, i));
+  }
+  return x;
+}
+
+// The joints form a forest hanging from the bodies no joint moves: one joint per child, no body its own
+// ancestor.
+void validateJointTree(const Model& m) {
+  const int nB = m.bodies.size();
+  const int nJ = m.joints.size();
+  std::vector<int> parentJoint(static_cast<std::size_t>(nB), -1);  // the joint that moves each body, or -1
+  for (int j = 0; j < nJ; ++j) {
+    const int c = m.joints.child[static_cast<std::size_t>(j)];
+    int& slot = parentJoint[static_cast<std::size_t>(c)];
+    if (slot >= 0)
+      invalid("joints[" + std::to_string(j) + "].child",
+              "body '" + excerptOf(m.bodies.name[static_cast<std::size_t>(c)]) +
+                  "' is already the child of joints[" + std::to_string(slot) +
+                  "]: a body has one parent joint");
+    slot = j;
+  }
+  for (int b = 0; b < nB; ++b) {
+    int x = b;
+    for (int depth = 0; parentJoint[static_cast<std::size_t>(x)] >= 0; ++depth) {
+      const int j = parentJoint[static_cast<std::size_t>(x)];
+      x = m.joints.parent[static_cast<std::size_t>(j)];
+      if (x == b || depth > nJ)
+        invalid("joints[" + std::to_string(j) + "].parent",
+                "joint cycle: body '" + excerptOf(m.bodies.name[static_cast<std::size_t>(x)]) +
+                    "' is its own ancestor");
+    }
+  }
+}
+
 }  // namespace
 
 // =============================================================================================
@@ -199,6 +271,7 @@ void validateModel(const Model& m) {
     requireFinite(m.joints.axis.col(i), f + ".axis");
     if (std::abs(m.joints.axis.col(i).norm() - 1.0) > 1e-6) invalid(f + ".axis", "must be a unit vector");
   }
+  validateJointTree(m);
 
   // nodes and gut
   if (m.nodes.mass.size() != nN || static_cast<int>(m.nodes.region.size()) != nN)
@@ -212,6 +285,7 @@ void validateModel(const Model& m) {
   validateTriangles(m.gut.triangles, "gut.triangles", nN);
   requireNonNegative(m.gut.drag, "gut.drag");
   if (m.gut.triangles.cols() > 0) {
+    validateClosedSurface(m.gut.triangles, "gut.triangles");
     requirePositive(m.gut.kappa, "gut.kappa");
     const double v0 = enclosedVolume(m.nodes.rest, m.gut.triangles);
     if (v0 <= 0.0) invalid("gut.triangles", "enclosed rest volume must be > 0 (outward orientation), got " + num(v0) + " m^3");
@@ -224,6 +298,8 @@ void validateModel(const Model& m) {
     invalid("elements", "inconsistent array sizes");
   validateAnchors(m.elements.endA, "elements.a", nB, nN);
   validateAnchors(m.elements.endB, "elements.b", nB, nN);
+  if (nE == 0)
+    invalid("elements", "must not be empty: no muscle or cartilage holds the rib cage and the gut");
   for (int i = 0; i < nE; ++i) {
     const std::string f = "elements[" + std::to_string(i) + "]";
     const int g = static_cast<int>(m.elements.group[static_cast<std::size_t>(i)]);
@@ -233,10 +309,19 @@ void validateModel(const Model& m) {
     requireNonNegative(m.elements.kpe[i], f + ".kpe");
     requireNonNegative(m.elements.damping[i], f + ".damping");
   }
+  if (m.elements.kpe.maxCoeff() <= 0.0)
+    invalid("elements.kpe",
+            "all " + std::to_string(nE) +
+                " passive gains are 0: nothing holds the rib cage, and the lungs would turn inside out");
 
   // cavity
   validateAnchors(m.cavity.vertices, "cavity.vertices", nB, nN);
   validateTriangles(m.cavity.triangles, "cavity.triangles", m.cavity.vertices.size());
+  validateClosedSurface(m.cavity.triangles, "cavity.triangles");
+  const double cavityVolume = enclosedVolume(restPoints(m.cavity.vertices, m), m.cavity.triangles);
+  if (!(cavityVolume > 0.0))
+    invalid("cavity.triangles",
+            "enclosed rest volume must be > 0 (outward orientation), got " + num(cavityVolume) + " m^3");
   requireNonNegative(m.cavity.recoilPressure, "cavity.recoil_pressure");
   requireNonNegative(m.cavity.compliance, "cavity.compliance");
 

@@ -3,6 +3,7 @@
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/Limits.h"
 #include "pneuma/sim/pattern/PatternController.h"
 
 #include <nlohmann/json.hpp>
@@ -74,8 +75,8 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
     if (!integratorFromName(name, opt.step.integrator))
       o.at("integrator").fail("unknown integrator '" + excerptOf(name) + "' (valid: " + integratorNames() + ")");
   }
-  if (o.has("dt_s")) opt.dt = o.at("dt_s").positive();
-  if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").nonNegative();
+  if (o.has("dt_s")) opt.dt = o.at("dt_s").numberIn(kTimeStepRange);
+  if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").numberIn(kSettleTimeRange);
   if (o.has("gravity")) opt.step.gravity = o.at("gravity").boolean();
   if (o.has("joint_friction_scale")) opt.step.jointFrictionScale = o.at("joint_friction_scale").nonNegative();
   if (o.has("gut_drag_scale")) opt.step.gutDragScale = o.at("gut_drag_scale").nonNegative();
@@ -86,7 +87,7 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
 
 void parseOutputs(const Field& o, ScenarioOutputs& out) {
   o.allowKeys({"output_rate_hz", "csv", "plots", "vtk"});
-  if (o.has("output_rate_hz")) out.outputRate = o.at("output_rate_hz").positive();
+  if (o.has("output_rate_hz")) out.outputRate = o.at("output_rate_hz").numberIn(kOutputRateRange);
   if (o.has("csv")) out.csv = o.at("csv").boolean();
   if (o.has("plots")) out.plots = o.at("plots").boolean();
   if (o.has("vtk")) out.vtk = o.at("vtk").boolean();
@@ -130,7 +131,7 @@ Scenario parseScenario(const std::string& jsonText, const std::string& sourceNam
     if (s.model.empty()) root.at("model").fail("must not be empty (use \"default\" for the default model)");
     if (s.model != "default") s.model = resolve(s.model, baseDir);
   }
-  s.duration = root.at("duration_s").positive();
+  s.duration = root.at("duration_s").numberIn(kDurationRange);
   if (root.has("seed")) s.seed = root.at("seed").unsignedInteger();
   parseController(root.at("controller"), baseDir, s);
   if (root.has("overrides")) parseOverrides(root.at("overrides"), s.options);
@@ -214,12 +215,13 @@ void checkController(const Scenario& scenario, const std::string& resourceDir) {
 }
 
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,
-                                           const std::string& resourceDir) {
+                                           const std::string& resourceDir, const std::atomic<bool>* stop) {
   if (scenario.controller == ControllerKind::Style)
     return std::make_unique<BreathStyleController>(styleOf(scenario, resourceDir));
   // parse the pattern first (cheap, reports bad names and fields), then calibrate the drive on the model
   const pattern::Pattern p = patternOf(scenario, resourceDir);
-  const pattern::DriveCalibration calibration = pattern::calibrateDrive(std::move(model), scenario.options);
+  const pattern::DriveCalibration calibration = pattern::calibrateDrive(
+      std::move(model), scenario.options, pattern::DriveCalibration{}.contractionR, stop);
   return pattern::makePatternController(p, scenario.seed, calibration);
 }
 

@@ -52,7 +52,7 @@ TEST(AnatomyParams, PresetsLoadInSiUnits) {
 
 TEST(AnatomyParams, NegativeLengthIsRejectedNamingTheField) {
   const std::string e = errorOf([](nlohmann::json& j) { j["ribs"][3]["arc_length_mm"] = -5; });
-  EXPECT_NE(e.find("male.json: ribs[3].arc_length_mm: must be > 0, got -5"), std::string::npos) << e;
+  EXPECT_NE(e.find("male.json: ribs[3].arc_length_mm: must be in [30, 600], got -5"), std::string::npos) << e;
 }
 
 TEST(AnatomyParams, ZeroRibCountIsRejected) {
@@ -92,7 +92,7 @@ TEST(AnatomyParams, StrictJsonNamesTheKeyAndPath) {
   EXPECT_EQ(errorOf([](nlohmann::json& j) { j["sternum"]["body_lenght_mm"] = 1; }),
             "male.json: sternum.body_lenght_mm: unknown field (did you mean body_length_mm?)");
   EXPECT_EQ(errorOf([](nlohmann::json& j) { j["ribs"][2]["posterior_ratio"] = 7; }),
-            "male.json: ribs[2].posterior_ratio: must be in (0, 5], got 7");
+            "male.json: ribs[2].posterior_ratio: must be in [0.05, 5], got 7");
   EXPECT_EQ(errorOf([](nlohmann::json& j) { j["resolution"]["ring_nodes"] = 4294967312LL; }),
             "male.json: resolution.ring_nodes: must be an integer in [8, 96], got 4294967312");
   auto parseError = [](const std::string& anatomy, const std::string& gains) {
@@ -121,6 +121,19 @@ TEST(AnatomyParams, StrictJsonNamesTheKeyAndPath) {
 TEST(AnatomyParams, MalformedJsonAndMissingFileAreErrors) {
   EXPECT_THROW(parseAnatomy("{ not json", read(kDir + "muscle_gains.json")), sim::Error);
   EXPECT_THROW(loadAnatomy(kDir + "does_not_exist.json"), sim::Error);
+}
+
+// degenerate anatomy (issue 15, class 6): a length of 1e-12 mm made TetGen crash (SIGSEGV) on the flattened
+// gut; every length now has a lower bound as well as an upper one
+TEST(AnatomyParams, DegenerateLengthsAreRefusedBeforeMeshing) {
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["abdomen"]["inner_width_mm"] = 1e-12; }),
+            "male.json: abdomen.inner_width_mm: must be in [60, 600], got 1e-12");
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["ribs"][4]["thickness_mm"] = 1e-9; }),
+            "male.json: ribs[4].thickness_mm: must be in [1, 20], got 1e-09");
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["spine"]["thoracic_body_heights_mm"][3] = 0.001; }),
+            "male.json: spine.thoracic_body_heights_mm[3]: must be in [4, 40], got 0.001");
+  EXPECT_EQ(errorOf([](nlohmann::json& j) { j["pelvis"]["asis_depth_mm"] = 2; }),
+            "male.json: pelvis.asis_depth_mm: must be in [30, 300], got 2");
 }
 
 }  // namespace

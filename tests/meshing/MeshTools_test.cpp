@@ -59,6 +59,20 @@ TEST(MeshTools, TetGenVolumeEqualsSurfaceVolume) {
   EXPECT_EQ(t.boundaryTriangles, m.triangleCount());  // switch Y keeps the surface
 }
 
+// a surface flattened to 1e-12 of its height (as by an abdomen 1e-12 mm wide) made TetGen crash with SIGSEGV
+// in its own clean-up; it is refused, naming the part, before TetGen sees it (issue 15, class 6)
+TEST(MeshTools, TetGenIsNotGivenADegenerateSurface) {
+  TriangleMesh flat = remeshIsotropic(tube(), 0.003, "tube");
+  flat.vertices.row(1) *= 1e-12;
+  try {
+    tetrahedralize(flat, "gut");
+    FAIL() << "a flat surface was handed to TetGen";
+  } catch (const sim::Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("gut: surface triangle ", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("is degenerate"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MeshTools, ConvexHullOfCubeCornersAndCentre) {
   Eigen::Matrix3Xd p(3, 9);
   for (int i = 0; i < 8; ++i) p.col(i) = Eigen::Vector3d(i & 1, (i >> 1) & 1, (i >> 2) & 1);

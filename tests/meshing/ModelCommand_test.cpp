@@ -67,7 +67,7 @@ TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {
   const fs::path out = dir / "model";
   const test::CliResult r = runCli({"model", "build", "--anatomy", (dir / "male.json").string(), "--out", out.string(), "--no-preview"});
   EXPECT_EQ(r.exitCode, 2);
-  EXPECT_NE(r.err.find("ribs[2].arc_length_mm: must be > 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ribs[2].arc_length_mm: must be in [30, 600], got -10"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
   fs::remove_all(dir);
 }

@@ -1,11 +1,15 @@
 // Model format: round trip and rejection of corrupted files (docs/model-format.md).
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Simulation.h"
+#include "ToyTorso.h"
 
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
+#include <memory>
 #include <string>
 
 using namespace pneuma::sim;
@@ -143,5 +147,144 @@ TEST(ModelIO, MissingDirectoryNamesThePath) {
     FAIL() << "missing directory was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/pneuma-model/model.json: cannot open"), std::string::npos);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// structure (issue 15, class 7): models that load but describe no body
+
+namespace {
+
+std::string invalidOf(const Model& m) {
+  try {
+    validateModel(m);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+// tinyModel() with a second moving rib, "rib2_left" (body 2), not yet on a joint
+Model tinyModelWithSecondRib() {
+  Model m = tinyModel();
+  m.bodies.name.push_back("rib2_left");
+  m.bodies.isFixed.push_back(0);
+  m.bodies.inertia.push_back(Eigen::Matrix3d::Identity() * 1e-3);
+  m.bodies.mesh.push_back("");
+  m.bodies.mass.conservativeResize(3);
+  m.bodies.mass[2] = 0.1;
+  m.bodies.com.conservativeResize(3, 3);
+  m.bodies.com.col(2) = Eigen::Vector3d(0.0, -0.1, 0.0);
+  return m;
+}
+
+void addJoint(Model& m, int parent, int child) {
+  const int i = m.joints.size();
+  m.joints.name.push_back("j" + std::to_string(i));
+  m.joints.parent.push_back(parent);
+  m.joints.child.push_back(child);
+  m.joints.anchor.conservativeResize(3, i + 1);
+  m.joints.anchor.col(i).setZero();
+  for (Eigen::VectorXd* v : {&m.joints.friction, &m.joints.stiffness, &m.joints.lockStiffness}) {
+    v->conservativeResize(i + 1);
+    (*v)[i] = 0.0;
+  }
+  m.joints.axis.conservativeResize(3, i + 1);
+  m.joints.axis.col(i) = Eigen::Vector3d::UnitX();
+}
+
+}  // namespace
+
+TEST(ModelStructure, TheValidModelsPass) {
+  EXPECT_EQ(invalidOf(tinyModel()), "accepted");
+  Model chain = tinyModelWithSecondRib();
+  addJoint(chain, 1, 2);  // spine -> rib1 -> rib2: a tree
+  EXPECT_EQ(invalidOf(chain), "accepted");
+}
+
+TEST(ModelStructure, JointsMustFormATree) {
+  // rib1 and rib2 each other's parent: a joint cycle, each body its own ancestor
+  Model cycle = tinyModelWithSecondRib();
+  cycle.joints.parent[0] = 2;
+  addJoint(cycle, 1, 2);
+  EXPECT_EQ(invalidOf(cycle), "joints[1].parent: joint cycle: body 'rib1_left' is its own ancestor");
+  // a body hanging below a cycle is checked first: the search ends, naming a body of the cycle
+  Model below = tinyModelWithSecondRib();
+  below.bodies.isFixed[0] = 0;
+  below.joints.parent[0] = 1;  // body 0 hangs from rib1 ...
+  below.joints.child[0] = 0;
+  addJoint(below, 2, 1);  // ... which hangs from rib2, which hangs from rib1
+  addJoint(below, 1, 2);
+  EXPECT_EQ(invalidOf(below), "joints[2].parent: joint cycle: body 'rib1_left' is its own ancestor");
+  // two joints on one child
+  Model twice = tinyModelWithSecondRib();
+  addJoint(twice, 0, 1);
+  EXPECT_EQ(
+      invalidOf(twice),
+      "joints[1].child: body 'rib1_left' is already the child of joints[0]: a body has one parent joint");
+}
+
+TEST(ModelStructure, SurfacesMustBeClosedAndConsistentlyOriented) {
+  // the toy torso's icosphere gut with one triangle taken out: an open surface
+  Model open = test::makeToyTorso(1);
+  ASSERT_EQ(invalidOf(open), "accepted");
+  open.gut.triangles = open.gut.triangles.leftCols(open.gut.triangles.cols() - 1).eval();
+  EXPECT_NE(invalidOf(open).find("has no neighbouring triangle: the surface is open"), std::string::npos)
+      << invalidOf(open);
+  EXPECT_EQ(invalidOf(open).rfind("gut.triangles[", 0), 0u) << invalidOf(open);
+
+  // a cavity of zero or one triangle
+  Model none = tinyModel();
+  none.cavity.triangles.resize(3, 0);
+  EXPECT_EQ(invalidOf(none), "cavity.triangles: must be a closed surface of at least 4 triangles, got 0");
+  Model one = tinyModel();
+  one.cavity.triangles = tinyModel().cavity.triangles.leftCols(1).eval();
+  EXPECT_EQ(invalidOf(one), "cavity.triangles: must be a closed surface of at least 4 triangles, got 1");
+
+  // one flipped cavity triangle
+  Model flipped = tinyModel();
+  std::swap(flipped.cavity.triangles(0, 2), flipped.cavity.triangles(1, 2));
+  EXPECT_NE(invalidOf(flipped).find("runs the same way as in cavity.triangles["), std::string::npos)
+      << invalidOf(flipped);
+  // every cavity triangle flipped: consistent, but inside out
+  Model inverted = tinyModel();
+  for (int i = 0; i < inverted.cavity.triangles.cols(); ++i)
+    std::swap(inverted.cavity.triangles(0, i), inverted.cavity.triangles(1, i));
+  EXPECT_EQ(invalidOf(inverted).rfind("cavity.triangles: enclosed rest volume must be > 0", 0), 0u)
+      << invalidOf(inverted);
+}
+
+TEST(ModelStructure, ElementsMustExistHoldAndEndOnTheModel) {
+  Model none = tinyModel();
+  none.elements = Elements{};
+  EXPECT_EQ(invalidOf(none),
+            "elements: must not be empty: no muscle or cartilage holds the rib cage and the gut");
+  Model slack = tinyModel();
+  slack.elements.kpe.setZero();
+  EXPECT_EQ(invalidOf(slack),
+            "elements.kpe: all 1 passive gains are 0: nothing holds the rib cage, and the lungs would turn "
+            "inside out");
+  Model outside = tinyModel();
+  outside.elements.endA.body[0] = 5;
+  EXPECT_EQ(invalidOf(outside), "elements.a[0].body: index 5 out of range [0, 2)");
+  Model node = tinyModel();
+  node.elements.endB.nodes(0, 0) = 4;
+  EXPECT_EQ(invalidOf(node), "elements.b[0].nodes: index 4 out of range [0, 4)");
+}
+
+// a model that loads but cannot hold itself (every passive gain scaled to 0): the lungs turn inside out, and the
+// run stops with that as its error instead of going on with a negative volume (issue 15, class 7)
+TEST(ModelStructure, ARunWhoseLungsTurnInsideOutStopsNamingIt) {
+  SimulationOptions o;
+  for (double& s : o.step.passiveGainScale) s = 0.0;
+  Simulation sim(std::make_shared<const Model>(test::makeToyTorso(1)),
+                 std::make_unique<BreathStyleController>(loadBreathStyle("calm")), o);
+  try {
+    sim.advance(10.0);
+    FAIL() << "ran 10 s without passive gains";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mL is not positive (the rib cage collapsed through itself"),
+              std::string::npos)
+        << e.what();
   }
 }

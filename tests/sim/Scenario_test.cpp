@@ -105,8 +105,9 @@ TEST(Scenario, BadFieldsAreNamedByTheirJsonPath) {
   expectError(R"({"format": "pneuma-scenario", "version": 2, "duration_s": 5, "controller": {"style": "calm"}})",
               {"version", "unsupported"});
   expectError(R"({"format": "pneuma-scenario", "version": 1, "controller": {"style": "calm"}})", {"duration_s: missing"});
-  expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": -2, "controller": {"style": "calm"}})",
-              {"duration_s: must be > 0"});
+  expectError(
+      R"({"format": "pneuma-scenario", "version": 1, "duration_s": -2, "controller": {"style": "calm"}})",
+      {"duration_s: must be in [0.001, 86400] s, got -2"});
   expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": "long", "controller": {"style": "calm"}})",
               {"duration_s: must be a number"});
   expectError(with(R"("seed": -1)"), {"seed: must be a non-negative integer"});
@@ -115,13 +116,14 @@ TEST(Scenario, BadFieldsAreNamedByTheirJsonPath) {
               {"controller: needs exactly one"});
   expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"pattern": 3}})",
               {"controller.pattern: must be a pattern file path"});
-  expectError(with(R"("overrides": {"dt_s": 0})"), {"overrides.dt_s: must be > 0"});
+  expectError(with(R"("overrides": {"dt_s": 0})"), {"overrides.dt_s: must be in [1e-06, 0.05] s, got 0"});
   expectError(with(R"("overrides": {"integrator": "rk4"})"), {"overrides.integrator", "rk4", "implicit-euler-joints"});
   expectError(with(R"("overrides": {"active_gain_scale": {"diaphram": 2}})"),
               {"overrides.active_gain_scale.diaphram: unknown muscle group", "diaphragm"});
   expectError(with(R"("overrides": {"passive_gain_scale": {"rectus": -1}})"), {"overrides.passive_gain_scale.rectus: must be >= 0"});
   expectError(with(R"("overrides": {"gravity": "yes"})"), {"overrides.gravity: must be true or false"});
-  expectError(with(R"("outputs": {"output_rate_hz": 0})"), {"outputs.output_rate_hz: must be > 0"});
+  expectError(with(R"("outputs": {"output_rate_hz": 0})"),
+              {"outputs.output_rate_hz: must be in [0.01, 10000] Hz, got 0"});
   expectError(with(R"("outputs": {"png": true})"), {"outputs.png: unknown field"});
 }
 

@@ -1,6 +1,7 @@
 #include "pneuma/sim/pattern/Cycle.h"
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Limits.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,12 +83,31 @@ void validateCycle(const CycleSpec& c) {
   }
 
   // relative timing: the pauses must leave time to move
+  const double pauses = c.postInspiratoryPause + c.postExpiratoryPause;
   if (c.isRelative) {
-    if (!std::isfinite(c.rate) || c.rate <= 0.0) fail("rate_bpm", "must be > 0, got " + num(c.rate));
+    kBreathRateRange.check("rate_bpm", c.rate);
     const double period = 60.0 / c.rate;
-    if (period <= c.postInspiratoryPause + c.postExpiratoryPause)
-      fail("rate_bpm", "period 60/" + num(c.rate) + " = " + num(period) + " s leaves no time to breathe after " +
-                           num(c.postInspiratoryPause + c.postExpiratoryPause) + " s of pauses");
+    if (period <= pauses)
+      fail("rate_bpm", "period 60/" + num(c.rate) + " = " + num(period) +
+                           " s leaves no time to breathe after " + num(pauses) + " s of pauses");
+  }
+
+  // a breath of bounded length (the breath scheduler steps from breath to breath), keyframes apart in time
+  const double moving = c.isRelative ? 60.0 / c.rate - pauses : k.back().time;
+  if (!c.isRelative) {
+    const std::string last = "keyframes[" + std::to_string(k.size() - 1) + "].time";
+    if (!kBreathPeriodRange.contains(moving + pauses))
+      fail(last, "the breath (" + num(moving) + " s of keyframes + " + num(pauses) + " s of pauses) " +
+                     kBreathPeriodRange.problem(moving + pauses));
+  }
+  const double timeScale =
+      c.isRelative && !k.empty() ? moving / k.back().time : 1.0;  // [s] per keyframe time
+  for (std::size_t i = 1; i < k.size(); ++i) {
+    const double gap = (k[i].time - k[i - 1].time) * timeScale;  // [s]
+    if (!(gap >= kMinKeyframeGap))
+      fail("keyframes[" + std::to_string(i) + "].time",
+           num(gap) + " s after keyframes[" + std::to_string(i - 1) + "]: keyframes must be at least " +
+               num(kMinKeyframeGap) + " s apart");
   }
 }
 

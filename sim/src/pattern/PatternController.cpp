@@ -144,7 +144,7 @@ double groupResponse(const DriveCalibration& c, ElementGroup g, double alpha) {
 }
 
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options,
-                                double contractionR) {
+                                double contractionR, const std::atomic<bool>* stop) {
   constexpr double kRestWindow = 0.3;   // [s] baseline: end of each rest
   constexpr double kLevelWindow = 0.4;  // [s] response: end of each level
   DriveCalibration c;
@@ -154,7 +154,11 @@ DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const Simula
     // one run per group from the settled torso: the ribs' slow release (rib friction) would otherwise
     // carry one group's answer into the next group's baseline
     Simulation sim(model, std::make_unique<StaircaseController>(kDrivenGroups[n], contractionR), options);
+    sim.setStopFlag(stop);
     sim.advance(start + kGroupTime);
+    if (sim.wasStopped())
+      throw Interrupted(std::string("drive calibration stopped by request at group ") +
+                        groupName(kDrivenGroups[n]));
     const double rest = meanVolume(sim.trace(), start + kRest - kRestWindow, start + kRest);
     if (n == 0) c.restVolume = rest;
     GroupResponse& r = c.response[idx(kDrivenGroups[n])];

@@ -221,7 +221,8 @@ TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
       "overrides": {"dt_s": -1}})";
   r = runCli({"simulate", "--scenario", file, "--out", out});
   EXPECT_EQ(r.exitCode, 2);
-  EXPECT_NE(r.err.find("run.json: overrides.dt_s: must be > 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("run.json: overrides.dt_s: must be in [1e-06, 0.05] s, got -1"), std::string::npos)
+      << r.err;
 }
 
 TEST(CliSimulate, SigintWritesValidPartialSummary) {
@@ -294,13 +295,28 @@ TEST(CliSimulate, BadInputIsOneLineErrorAndExit2) {
   };
   const std::string out = freshOutDir("bad");
   const std::vector<Case> cases = {
-      {{"--model", "/nonexistent/model", "--style", "calm", "--duration", "1", "--out", out}, "/nonexistent/model"},
+      {{"--model", "/nonexistent/model", "--style", "calm", "--duration", "1", "--out", out},
+       "/nonexistent/model"},
       {{"--model", toyModelDir(), "--style", "calm", "--duration", "0", "--out", out}, "--duration"},
       {{"--model", toyModelDir(), "--style", "calm", "--duration", "-3", "--out", out}, "--duration"},
-      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--out", "/proc/pneuma-cannot-write"}, "--out"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--out", "/proc/pneuma-cannot-write"},
+       "--out"},
       {{"--model", toyModelDir(), "--duration", "1", "--out", out}, "--style"},
       {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--dt", "-1", "--out", out}, "--dt"},
-      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--integrator", "rk4", "--out", out}, "rk4"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--integrator", "rk4", "--out", out},
+       "rk4"},
+      // inputs that would never finish (issue 15, class 5): refused at once, naming the option and the value
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--dt", "1e-300", "--out", out},
+       "--dt: must be in [1e-06, 0.05] s, got 1e-300"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1e308", "--out", out},
+       "--duration: must be in [0.001, 86400] s, got 1e+308"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--settle", "1e9", "--out", out},
+       "--settle: must be in [0, 600] s, got 1e+09"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--output-rate", "1e12", "--out",
+        out},
+       "--output-rate: must be in [0.01, 10000] Hz, got 1e+12"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "86400", "--dt", "1e-6", "--out", out},
+       "--duration: 86402 s at dt 1e-06 s needs more than the 1e+09 steps a run may take"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args{"simulate"};

@@ -18,7 +18,8 @@ struct TetMesh {
 
 /// Quality tetrahedralisation of the volume bounded by a closed outward `surface` with TetGen
 /// (switches "pq1.5YQ": piecewise-linear complex, radius-edge ratio <= 1.5, boundary kept unsplit).
-/// @throws sim::Error naming `part` when TetGen rejects the surface.
+/// @throws sim::Error naming `part` when TetGen rejects the surface, or before TetGen runs when a triangle is
+///         degenerate (quality < 0.01: TetGen 1.5 would crash on it).
 TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part);
 
 }  // namespace pneuma::meshing

@@ -14,4 +14,11 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& what) : std::runtime_error(what) {}
 };
 
+/// Raised by a long preparation (the pattern drive's calibration) that stopped because its stop flag was
+/// raised (Ctrl-C): nothing is wrong with the input, the caller asked to stop.
+class Interrupted : public Error {
+ public:
+  explicit Interrupted(const std::string& what) : Error(what) {}
+};
+
 }  // namespace pneuma::sim

@@ -18,6 +18,7 @@
 namespace pneuma::sim {
 
 class JsonReader;
+struct Range;
 
 /// `s` cut to at most `maxChars` bytes at a character boundary, "..." marking the cut: how messages quote
 /// strings that came from a file.
@@ -87,6 +88,8 @@ class JsonReader {
   double nonNegative() const;
   /// A number in [lo, hi].
   double numberIn(double lo, double hi) const;
+  /// A number inside one of the run limits of Limits.h ("must be in [1e-06, 0.05] s, got 1e-300").
+  double numberIn(const Range& range) const;
   /// A number in (0, hi].
   double positiveAtMost(double hi) const;
   /// An integer (no fraction, no exponent) in [lo, hi]; 4294967297 is not 1.

@@ -52,6 +52,8 @@ struct Trace {
   void append(const Metrics& m);
   std::size_t size() const { return time.size(); }
   void clear();
+  /// Keeps frames 0, 2, 4, ... of every series (how a long run's trace stays bounded, Simulation::trace()).
+  void keepEveryOtherFrame();
 };
 
 /// How the body moves in a breath, in anatomical axes (world RAS: x lateral, y anteroposterior, z craniocaudal).

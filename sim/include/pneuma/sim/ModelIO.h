@@ -24,8 +24,11 @@ std::string serializeModel(const Model& model);
 /// Writes `<dir>/model.json` (dir must exist) through a temporary file and a rename.
 void saveModel(const Model& model, const std::string& dir);
 
-/// Checks sizes, index ranges, finite values, positive masses, rest lengths and inertias, and the
-/// presence of the required landmarks. @throws Error naming the field and the reason.
+/// Checks sizes, index ranges, finite values, positive masses, rest lengths and inertias, the presence of the
+/// required landmarks, and the structure: the joints form a tree (one parent joint per body, no body its own
+/// ancestor), the gut and the lung cavity are closed, consistently oriented surfaces enclosing a positive
+/// rest volume, and at least one element with a passive gain > 0 holds them. @throws Error naming the field
+/// and the reason, e.g. "gut.triangles[12]: edge 4-9 has no neighbouring triangle: the surface is open".
 void validateModel(const Model& model);
 
 }  // namespace pneuma::sim

@@ -19,6 +19,7 @@
 
 #include "pneuma/sim/Simulation.h"
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -75,10 +76,13 @@ void checkController(const Scenario& scenario, const std::string& resourceDir);
 /// The controller a scenario asks for: a BreathStyleController for a style (presets in
 /// `resourceDir`/presets), or a pattern::PatternController for an affect (`resourceDir`/presets/affect)
 /// or a pattern, seeded with `scenario.seed` and calibrated on `model` with pattern::calibrateDrive()
-/// (a few simulated seconds per muscle group) under `scenario.options`.
-/// @throws Error "controller.<kind>: <reason>", listing the valid names for an unknown style or affect.
+/// (a few simulated seconds per muscle group) under `scenario.options`; `stop` (may be null) stops the
+/// calibration (Simulation::setStopFlag()).
+/// @throws Error "controller.<kind>: <reason>", listing the valid names for an unknown style or affect;
+///         Interrupted when `*stop` became true during the calibration.
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,
-                                           const std::string& resourceDir);
+                                           const std::string& resourceDir,
+                                           const std::atomic<bool>* stop = nullptr);
 
 /// Writes serializeScenario() to `path` through a temporary file and a rename. @throws Error on I/O failure.
 void saveScenario(const Scenario& scenario, const std::string& path);

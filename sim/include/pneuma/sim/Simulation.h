@@ -9,6 +9,7 @@
 /// t = settleTime on, the controller runs with control time t - settleTime. Summary figures are
 /// measured from settleTime on.
 
+#include <atomic>
 #include <functional>
 #include <istream>
 #include <memory>
@@ -27,19 +28,26 @@ namespace pneuma::sim {
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
   StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
-  double dt = 0.0;              ///< [s] time step; 0 = defaultTimeStep(step.integrator), or the controller's
-                                ///< maxTimeStep() when smaller
-  double settleTime = 2.0;      ///< [s] settling phase before the controller starts, >= 0
-  double outputRate = 60.0;     ///< [Hz] metrics and recording rate, > 0
+  double dt = 0.0;          ///< [s] time step in kTimeStepRange; 0 = defaultTimeStep(step.integrator), or the
+                            ///< controller's maxTimeStep() when smaller
+  double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange
+  double outputRate = 60.0;     ///< [Hz] metrics and recording rate, in kOutputRateRange
   double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
 };
+
+/// [-] most frames Simulation::trace() holds (9.1 min at 60 Hz, about 10 MB): beyond it the trace keeps every
+/// other frame and from then on records every 2nd (4th, ...) one, so a long run's memory stays bounded and
+/// the summary of a run longer than this is measured on the thinned trace.
+inline constexpr std::size_t kMaxTraceFrames = std::size_t{1} << 15;
 
 /// [s] recorder window of runs that read the trace rather than scrub the timeline (the CLI, the validation
 /// experiments, the benchmarks): filling a long fresh window costs page faults every frame (docs/cli.md,
 /// "Performance").
 inline constexpr double kTraceOnlyRecordSeconds = 1.0;
 
-/// @throws Error naming the field: dt < 0 or not finite, settleTime < 0, outputRate <= 0, bad step options.
+/// @throws Error naming the field and value: dt neither 0 nor in kTimeStepRange, settleTime outside
+///         kSettleTimeRange, outputRate outside kOutputRateRange (Limits.h), recordSeconds < 0, bad step
+///         options.
 void validateSimulationOptions(const SimulationOptions& o);
 
 /// Everything a run continues from besides the model, the options and the controller's parameters. A run
@@ -71,10 +79,17 @@ class Simulation {
 
   /// Steps until `duration` [s] more has been simulated, computing metrics and recording at the
   /// output rate. `onFrame` (optional) is called after every output frame; return false to stop early.
-  /// @throws Error on NaN/Inf or blow-up, naming the time, the element/body/node and a likely cause.
+  /// @throws Error on NaN/Inf or blow-up, naming the time, the element/body/node and a likely cause; and
+  ///         before stepping when `duration` needs more than kMaxStepsPerRun steps of dt().
   void advance(double duration, const std::function<bool(const Simulation&)>& onFrame = {});
   /// One step of dt (metrics are computed if an output frame falls due).
   void stepOnce();
+  /// Makes advance() look at `*flag` before every step and return early once it is true, so that a stop
+  /// request (Ctrl-C, set from a signal handler: the flag is lock-free) takes effect within one step whatever
+  /// the output rate. nullptr (the default) checks nothing. The flag must outlive its use here.
+  void setStopFlag(const std::atomic<bool>* flag) { m_stopFlag = flag; }
+  /// True when the latest advance() returned early because the stop flag was raised.
+  bool wasStopped() const { return m_wasStopped; }
 
   /// A copy of everything the run continues from (SimulationCheckpoint), at the current step.
   SimulationCheckpoint checkpoint() const;
@@ -101,6 +116,8 @@ class Simulation {
   const Metrics& latestMetrics() const { return m_latest; }
   /// Activations applied in the latest step.
   const Activations& currentActivations() const { return m_activations; }
+  /// The light per-frame series of the run for the summary: every output frame, up to kMaxTraceFrames; a
+  /// longer run's trace is thinned evenly (every 2nd, 4th, ... frame).
   const Trace& trace() const { return m_trace; }
   const Recorder& recorder() const { return m_recorder; }
   /// Solver by-products of the latest step (CG iterations, joint error, element forces).
@@ -127,10 +144,14 @@ class Simulation {
   Activations m_activations{};
   Metrics m_latest;
   Trace m_trace;
+  long long m_frameIndex = 0;   // output frames emitted since reset()
+  long long m_traceStride = 1;  // the trace records frames whose index is a multiple of this
   Recorder m_recorder;
   double m_nextFrameTime = 0.0; // [s]
   double m_wallSeconds = 0.0;   // [s] wall-clock time spent stepping, measuring and recording
   double m_simulatedSeconds = 0.0;  // [s] simulated while timed
+  const std::atomic<bool>* m_stopFlag = nullptr;  // checked before every step of advance(); may be null
+  bool m_wasStopped = false;
 };
 
 }  // namespace pneuma::sim

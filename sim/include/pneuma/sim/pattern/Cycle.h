@@ -35,7 +35,7 @@ struct Keyframe {
 struct CycleSpec {
   CycleKind kind = CycleKind::Linear;
   bool isRelative = true;              ///< relative: time-warped to `rate`; absolute: keyframe times in [s]
-  double rate = 15.0;                  ///< [breaths/min] relative cycles only; > 0
+  double rate = 15.0;                  ///< [breaths/min] relative cycles only; in kBreathRateRange (Limits.h)
   double depthMin = 0.05;              ///< [-] volume fraction at shape 0, in [0, 1]
   double depthMax = 0.25;              ///< [-] volume fraction at shape 1, in [depthMin, 1]
   double ieRatio = 1.0 / 1.5;          ///< [-] inspiration:expiration duration ratio, > 0; generated shapes only

@@ -38,6 +38,7 @@
 #include "pneuma/sim/pattern/Pattern.h"
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -115,8 +116,10 @@ struct TrackingStats {
 /// default model.
 /// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run; a dt of 0
 ///                 steps at kDriveTimeStep, as the drive itself
+/// @param stop     checked before every step (Simulation::setStopFlag()); may be null
+/// @throws Interrupted when `*stop` became true before the calibration finished.
 DriveCalibration calibrateDrive(std::shared_ptr<const Model> model, const SimulationOptions& options = {},
-                                double contractionR = 0.6);
+                                double contractionR = 0.6, const std::atomic<bool>* stop = nullptr);
 
 /// A Controller that plays a LayerStack on the physical model (see the file comment).
 class PatternController : public Controller {
