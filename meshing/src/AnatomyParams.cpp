@@ -32,13 +32,7 @@ std::array<double, 2> pairMm(const Reader& v, double loMm, double hiMm) {
 double mm(const Reader& v, double loMm, double hiMm) { return v.numberIn(loMm, hiMm) * kMm; }
 int count(const Reader& v, int lo, int hi) { return static_cast<int>(v.integerIn(lo, hi)); }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw sim::Error(path + ": cannot open file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string readText(const std::string& path) { return sim::readInputFile(path); }
 
 RibLevel readRib(const Reader& r, std::size_t i) {
   r.allowKeys({"level", "arc_length_mm", "posterior_ratio", "anterior_ratio", "end_angle_deg", "inclination_deg",

@@ -127,16 +127,12 @@ std::vector<std::string> breathStyleNames(const std::string& presetDir) {
 BreathStyle loadBreathStyle(const std::string& nameOrPath, const std::string& presetDir) {
   const bool isPath = nameOrPath.size() > 5 && nameOrPath.substr(nameOrPath.size() - 5) == ".json";
   const std::string path = isPath ? nameOrPath : presetDir + "/" + nameOrPath + ".json";
-  std::ifstream in(path);
-  if (!in) {
-    if (isPath) throw Error("breath style file '" + path + "': cannot be read");
+  if (!isPath && !std::filesystem::exists(path)) {
     std::string valid;
     for (const std::string& n : breathStyleNames(presetDir)) valid += (valid.empty() ? "" : ", ") + n;
     throw Error("unknown breath style '" + excerptOf(nameOrPath) + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
   }
-  std::stringstream text;
-  text << in.rdbuf();
-  return parseBreathStyle(text.str(), path);
+  return parseBreathStyle(readInputFile(path), path);
 }
 
 BreathStyleController::BreathStyleController(BreathStyle style) : m_style(std::move(style)) {

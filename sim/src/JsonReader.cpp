@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -14,6 +16,22 @@
 namespace pneuma::sim {
 
 using nlohmann::json;
+
+std::string readInputFile(const std::string& path, const std::string& hint) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) throw Error(path + ": cannot open" + hint);
+  if (!std::filesystem::is_regular_file(st)) throw Error(path + ": not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw Error(path + ": cannot open" + hint);
+  if (size > kMaxInputFileBytes) throw Error(path + ": larger than 256 MiB (" + std::to_string(size) + " bytes)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open" + hint);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw Error(path + ": cannot read the whole file");
+  return text;
+}
 
 std::string excerptOf(const std::string& s, std::size_t maxChars) {
   if (s.size() <= maxChars) return s;

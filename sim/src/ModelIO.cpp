@@ -477,11 +477,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
 
 Model loadModel(const std::string& dir) {
   const std::string path = dir + "/model.json";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open (is '" + dir + "' a model directory?)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseModel(text.str(), path);
+  return parseModel(readInputFile(path, " (is '" + dir + "' a model directory?)"), path);
 }
 
 std::string serializeModel(const Model& m) {

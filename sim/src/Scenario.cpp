@@ -148,11 +148,7 @@ Scenario parseScenario(const std::string& jsonText, const std::string& sourceNam
 }
 
 Scenario loadScenario(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("scenario file '" + path + "' cannot be read");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseScenario(ss.str(), path, fs::path(path).parent_path().string());
+  return parseScenario(readInputFile(path), path, fs::path(path).parent_path().string());
 }
 
 std::string serializeScenario(const Scenario& s) {

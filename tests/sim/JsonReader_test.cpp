@@ -149,3 +149,24 @@ TEST(JsonLoaders, ModelRejectsUnknownDuplicateAndWrappedKeys) {
   EXPECT_EQ(errorOf(load, edited(text, "\"format\"", "\"fromat\": 1, \"format\"")),
             "x.json: fromat: unknown field (did you mean format?)");
 }
+
+// a loader given a device, a directory or a missing file fails at once, naming the path: /dev/zero used to be
+// read until memory ran out
+TEST(ReadInputFile, RefusesWhatIsNotARegularFile) {
+  const auto message = [](const std::function<void()>& load) {
+    try {
+      load();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(message([] { readInputFile("/dev/zero"); }).find("/dev/zero: not a regular file"), std::string::npos);
+  EXPECT_NE(message([] { loadScenario("/dev/zero"); }).find("not a regular file"), std::string::npos);
+  EXPECT_NE(message([] { loadBreathStyle("/dev/zero.json"); }).find("/dev/zero.json: cannot open"), std::string::npos);
+  EXPECT_NE(message([] { loadModel("/tmp"); }).find("/tmp/model.json: cannot open (is '/tmp' a model directory?)"),
+            std::string::npos);
+  EXPECT_NE(message([] { readInputFile("/"); }).find("/: not a regular file"), std::string::npos);
+  const std::string text = readInputFile(std::string(PNEUMA_RESOURCE_DIR) + "/presets/calm.json");
+  EXPECT_NE(text.find("\"calm\""), std::string::npos);
+}

@@ -93,13 +93,7 @@ Layer parseLayer(const Node& n) {
   return l;
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot read file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+std::string readText(const std::string& path) { return readInputFile(path); }
 
 std::string affectPath(const std::string& resourceDir, const std::string& name) {
   return (std::filesystem::path(resourceDir) / "presets" / "affect" / (name + ".json")).string();

@@ -24,6 +24,14 @@ struct Range;
 /// strings that came from a file.
 std::string excerptOf(const std::string& s, std::size_t maxChars = 60);
 
+/// [bytes] largest file a loader reads (the default model.json is a few MB)
+constexpr unsigned long long kMaxInputFileBytes = 256ull << 20;
+
+/// The whole text of a file a loader reads (model, anatomy, gains, preset, scenario, pattern).
+/// @throws Error "<path>: cannot open" (missing or unreadable), "<path>: not a regular file" (a directory, a device
+///         such as /dev/zero, a pipe) or "<path>: larger than 256 MiB"; `hint` is appended to the first.
+std::string readInputFile(const std::string& path, const std::string& hint = "");
+
 /// Limits applied while parsing.
 struct JsonLimits {
   int maxDepth = 64;  ///< deepest allowed nesting of arrays and objects (the root object is depth 1)
