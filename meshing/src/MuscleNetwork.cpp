@@ -103,6 +103,14 @@ void addIntercostals(const AnatomyParams& a, const Skeleton& sk, ElementSink& si
   }
 }
 
+/// The candidate nearest to `p` (the first of equals); `candidates` must not be empty.
+const Endpoint& nearest(const std::vector<Endpoint>& candidates, const Eigen::Vector3d& p) {
+  const Endpoint* best = &candidates.front();
+  for (const Endpoint& e : candidates)
+    if ((e.world - p).squaredNorm() < (best->world - p).squaredNorm()) best = &e;
+  return *best;
+}
+
 /// Candidate costal-margin attachments of the diaphragm: lower ribs 7-12, the xiphoid and the crura.
 std::vector<Endpoint> costalMargin(const Skeleton& sk) {
   std::vector<Endpoint> c;
@@ -145,12 +153,7 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
   // rim to the nearest point of the costal margin, xiphoid or crura
   const std::vector<Endpoint> margin = costalMargin(sk);
   for (int node : gut.domeRing.front()) {
-    const Eigen::Vector3d p = gut.rest.col(node);
-    const Endpoint* best = &margin.front();
-    for (const Endpoint& e : margin) {
-      if ((e.world - p).squaredNorm() < (best->world - p).squaredNorm()) best = &e;
-    }
-    sink.add(ElementGroup::Diaphragm, Endpoint::atNode(node, gut.rest), *best);
+    sink.add(ElementGroup::Diaphragm, Endpoint::atNode(node, gut.rest), nearest(margin, gut.rest.col(node)));
   }
 }
 
@@ -172,12 +175,9 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
   }
   for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
     for (int node : gut.domeRing[ring]) {
-      const Eigen::Vector3d p = gut.rest.col(node);
-      const Endpoint* best = &face.front();
-      for (const Endpoint& e : face)
-        if ((e.world - p).squaredNorm() < (best->world - p).squaredNorm()) best = &e;
-      if ((best->world - p).norm() <= kAppositionReach)
-        sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), *best, false, fraction);
+      const Endpoint& rib = nearest(face, gut.rest.col(node));
+      if ((rib.world - gut.rest.col(node)).norm() <= kAppositionReach)
+        sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), rib, false, fraction);
     }
   }
 }
