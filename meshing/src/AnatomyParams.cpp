@@ -136,7 +136,7 @@ Resolution readResolution(const Reader& r) {
 
 Gains readGains(const Reader& r) {
   r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
-               "apposition_stiffness_fraction", "gut_wall_mass_kg",
+               "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
                "diaphragm_mass_kg", "joints"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
@@ -160,6 +160,14 @@ Gains readGains(const Reader& r) {
   g.lungRecoil = r.at("lung_recoil_cmh2o").numberIn(0.0, 30.0) * kPaPerCmH2O;
   g.lungCompliance = r.at("lung_compliance_l_per_cmh2o").numberIn(0.0, 2.0) * 1e-3 / kPaPerCmH2O;
   g.appositionFraction = r.at("apposition_stiffness_fraction").numberIn(0.0, 10.0);
+  // optional: 1 in every space when absent
+  if (r.has("intercostal_external_space_scale")) {
+    const Reader spaces = r.at("intercostal_external_space_scale");
+    if (!spaces.isArray() || spaces.size() != g.externalIntercostalSpaceScale.size())
+      spaces.fail("must be an array of 11 numbers, one per intercostal space (1-11)");
+    for (std::size_t k = 0; k < g.externalIntercostalSpaceScale.size(); ++k)
+      g.externalIntercostalSpaceScale[k] = spaces[k].numberIn(0.0, 10.0);
+  }
   g.wallMass = r.at("gut_wall_mass_kg").positiveAtMost(100.0);
   g.diaphragmMass = r.at("diaphragm_mass_kg").positiveAtMost(10.0);
   const Reader joints = r.at("joints");

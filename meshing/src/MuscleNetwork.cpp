@@ -29,8 +29,8 @@ class ElementSink {
  public:
   ElementSink(const Gains& gains, sim::Model& model) : m_gains(gains), m_model(model) {}
 
-  /// Adds one element; a passive one (`isActive` false) gets kac = 0; `stiffness` [-] scales kpe and b.
-  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, bool isActive = true, double stiffness = 1.0) {
+  /// Adds one element; `active` [-] scales kac (0: a passive element), `stiffness` [-] scales kpe and b.
+  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, double active = 1.0, double stiffness = 1.0) {
     const double l0 = (a.world - b.world).norm();
     if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
     sim::Elements& e = m_model.elements;
@@ -42,7 +42,7 @@ class ElementSink {
     const Eigen::Index n = static_cast<Eigen::Index>(e.group.size());
     for (Eigen::VectorXd* v : {&e.restLength, &e.kac, &e.kpe, &e.damping}) v->conservativeResize(n);
     e.restLength(n - 1) = l0;
-    e.kac(n - 1) = isActive ? g.kac * scale : 0.0;
+    e.kac(n - 1) = active * g.kac * scale;
     e.kpe(n - 1) = stiffness * g.kpe * scale;
     e.damping(n - 1) = stiffness * g.damping * scale;
   }
@@ -85,7 +85,9 @@ void addIntercostals(const AnatomyParams& a, const Skeleton& sk, ElementSink& si
       const RibCurve& low = sk.ribCurve[static_cast<std::size_t>(level)][static_cast<std::size_t>(side)];
       const int bUp = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
       const int bLow = sk.rib[static_cast<std::size_t>(level)][static_cast<std::size_t>(side)];
-      // external layer: tubercle to costochondral junction, outside; internal: rib angle to the front, inside
+      // external layer: tubercle to costochondral junction, outside, its drive graded by space; internal: rib
+      // angle to the front, inside
+      const double externalScale = a.gains.externalIntercostalSpaceScale[static_cast<std::size_t>(level - 1)];
       for (const auto& [group, from, to, shift, inward] :
            {std::tuple{ElementGroup::IntercostalExternal, 0.08, 0.92, kObliqueShift, -1.0},
             std::tuple{ElementGroup::IntercostalInternal, 0.25, 0.99, -kObliqueShift, 1.0}}) {
@@ -96,7 +98,8 @@ void addIntercostals(const AnatomyParams& a, const Skeleton& sk, ElementSink& si
           const double sLow = sameAngleArc(low, top, axisY);
           if ((low.at(sLow) - top).norm() > kMaxIntercostalGap) continue;
           sink.add(group, Endpoint::onBody(bUp, top),
-                   Endpoint::onBody(bLow, low.at(sLow + shift, 0.5 * inward * low.thickness, 0.5 * low.height)));
+                   Endpoint::onBody(bLow, low.at(sLow + shift, 0.5 * inward * low.thickness, 0.5 * low.height)),
+                   group == ElementGroup::IntercostalExternal ? externalScale : 1.0);
         }
       }
     }
@@ -147,7 +150,7 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
     const std::vector<int>& ring = gut.domeRing[r];
     for (std::size_t j = 0; j < ring.size(); ++j) {
       sink.add(ElementGroup::Diaphragm, Endpoint::atNode(ring[j], gut.rest),
-               Endpoint::atNode(ring[(j + 1) % ring.size()], gut.rest), false);
+               Endpoint::atNode(ring[(j + 1) % ring.size()], gut.rest), 0.0);
     }
   }
   // rim to the nearest point of the costal margin, xiphoid or crura
@@ -177,7 +180,7 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
     for (int node : gut.domeRing[ring]) {
       const Endpoint& rib = nearest(face, gut.rest.col(node));
       if ((rib.world - gut.rest.col(node)).norm() <= kAppositionReach)
-        sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), rib, false, fraction);
+        sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), rib, 0.0, fraction);
     }
   }
 }

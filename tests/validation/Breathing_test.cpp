@@ -75,7 +75,10 @@ TEST(Breathing, CalmDomeDescendsRatherThanSwingingForward) {
   EXPECT_LT(m.domeDescent, 0.025);
   EXPECT_LT(std::abs(m.domeAnterior), m.domeDescent);
   EXPECT_GT(m.umbilicusAnterior, 0.0);
-  EXPECT_GT(m.lowerRibExpansion, 0.0);  // the lower ribs widen, if still by less than the 2 mm of issue 13
+  RecordProperty("lower_rib_expansion_mm", std::to_string(m.lowerRibExpansion * 1e3));
+  // bucket-handle widening of the lower ribs (rib 8's lateral distance): at least 2 mm in a calm breath (1.2 mm
+  // while the caudal external intercostals pulled rib 10 toward the fixed floating ribs)
+  EXPECT_GT(m.lowerRibExpansion, 0.002);
 }
 
 // rib cage and abdomen move together (phase 12-23 deg in healthy young adults, Chen et al. 2015; below 30 here,

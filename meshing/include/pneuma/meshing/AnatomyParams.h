@@ -110,6 +110,11 @@ struct Gains {
   /// [-] stiffness and damping of the apposition springs (the outer dome held on the lower ribs' inner face) as a
   /// fraction of the cartilage group's
   double appositionFraction = 0.0;
+  /// [-] scale of the external intercostals' kac in space k (between ribs k and k+1), k = 1..11, entry k - 1:
+  /// the neural drive of the external intercostals falls from the rostral to the caudal spaces, matching their
+  /// inspiratory mechanical advantage, and the caudal spaces are nearly silent in quiet breathing (De Troyer,
+  /// Kirkwood & Wilson 2005, Physiol Rev 85:717; De Troyer, Gorman & Gandevia 2002, J Physiol 546:943)
+  std::array<double, 11> externalIntercostalSpaceScale{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
   double costovertebralFriction = 0.0;  ///< [N m s/rad] mu of Eq. 3
   double costovertebralStiffness = 0.0; ///< [N m/rad] about the rib-neck axis
   /// [N m/rad] the costotransverse joint's resistance to rotation off the rib-neck axis (a rib with both its
