@@ -87,6 +87,12 @@ Motion measureMotion(const Trace& t, const std::vector<std::string>& names, cons
   m.xiphoidAnterior = axis("xiphoid", 1, 1.0);
   m.xiphoidCranial = axis("xiphoid", 2, 1.0);
   m.umbilicusAnterior = axis("umbilicus", 1, 1.0);
+  if (const int u = landmark("umbilicus"); u >= 0) {
+    m.umbilicusAnteriorMin = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < cycles; ++c)
+      m.umbilicusAnteriorMin = std::min(m.umbilicusAnteriorMin, t.landmarks[insp[static_cast<std::size_t>(c)]](1, u) -
+                                                                    t.landmarks[exp[static_cast<std::size_t>(c)]](1, u));
+  }
   const int left = landmark("rib8_lateral_left"), right = landmark("rib8_lateral_right");
   if (left >= 0 && right >= 0)
     m.lowerRibExpansion = change([&](std::size_t i) { return (t.landmarks[i].col(left) - t.landmarks[i].col(right)).norm(); });

@@ -68,6 +68,7 @@ struct Motion {
   double xiphoidCranial = kNaN;      ///< [m] its cranial motion
   double lowerRibExpansion = kNaN;   ///< [m] change of the distance between "rib8_lateral_left" and "_right"
   double umbilicusAnterior = kNaN;   ///< [m] anterior motion of "umbilicus"
+  double umbilicusAnteriorMin = kNaN;  ///< [m] its smallest value over the cycles (> 0: forward on every inhale)
   /// [m^3] abdomen's share of the tidal volume: the change of Metrics::abdomenVolume (Konno & Mead 1967)
   double abdomenTidal = kNaN;
   double ribCageTidal = kNaN;        ///< [m^3] the rest of the lung-volume change, tidal minus abdomenTidal
