@@ -146,7 +146,7 @@ TEST(MainWindow, ExportedPlotFilesHoldThePlottedData) {
   QFile svgFile(out.filePath("volume.svg"));
   ASSERT_TRUE(svgFile.open(QIODevice::ReadOnly));
   const QByteArray svgText = svgFile.readAll();
-  EXPECT_TRUE(svgText.contains("Lung-cavity volume"));
+  EXPECT_TRUE(svgText.contains("Lung volume"));
   EXPECT_TRUE(svgText.contains("volume [mL]"));
 
   // png: decodes, and is not blank
