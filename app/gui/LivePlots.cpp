@@ -128,16 +128,14 @@ bool LivePlots::refresh() {
                       column([](const PlotSample& s) { return 1e6 * s.targetVolume; }), "target"});
   }
   m_plots[0]->setData(time, std::move(volume));
-  // read-out: the lungs (right + left), their tidal volume and the thoracic cavity they sit in
+  // read-out: the two lungs, their split and the tidal volume
   QString note;
   if (n > 0) {
     const PlotSample& last = m_history.back();
     note = QString("lungs %1 mL").arg(1e6 * last.lungVolume, 0, 'f', 0);
     if (std::isfinite(last.rightLungVolume))
-      note += QString(" (R %1, L %2)").arg(1e6 * last.rightLungVolume, 0, 'f', 0).arg(1e6 * last.leftLungVolume, 0, 'f', 0);
-    note += QString("    tidal volume %1 mL    thoracic cavity %2 mL")
-                .arg(1e6 * tidalVolume(), 0, 'f', 0)
-                .arg(1e6 * last.thoracicCavityVolume, 0, 'f', 0);
+      note += QString(" (R %1 L %2)").arg(1e6 * last.rightLungVolume, 0, 'f', 0).arg(1e6 * last.leftLungVolume, 0, 'f', 0);
+    note += QString("  VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
   }
   m_plots[0]->setNote(note);
 

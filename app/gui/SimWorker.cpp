@@ -167,7 +167,6 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   s.lungVolume = m.lungVolume;
   s.rightLungVolume = m.rightLungVolume;
   s.leftLungVolume = m.leftLungVolume;
-  s.thoracicCavityVolume = m.thoracicCavityVolume;
   s.gutVolumeError = m.gutVolumeError;
   s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
                              : std::numeric_limits<double>::quiet_NaN();

@@ -37,7 +37,6 @@ struct PlotSample {
   double lungVolume = 0.0;                ///< [m^3] the two lungs (sim::Metrics::lungVolume)
   double rightLungVolume = 0.0;           ///< [m^3] NaN for a model without lung surfaces
   double leftLungVolume = 0.0;            ///< [m^3] NaN for a model without lung surfaces
-  double thoracicCavityVolume = 0.0;      ///< [m^3] the lung-cavity surface's volume
   double gutVolumeError = 0.0;            ///< [-] signed (V - V0) / V0
   double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung volume; NaN without one
   sim::Activations activations{};         ///< r and alpha per group
