@@ -62,6 +62,8 @@ TEST(SurfaceCrossings, TouchingIsNotCrossing) {
   EXPECT_EQ(crossings(kFloor, triangle({0, 0, 0}, {-1, 0, 0.5}, {0, -1, 0.5})), 0);
   // coplanar and overlapping (a face shared by two surfaces bound to the same wall)
   EXPECT_EQ(crossings(kFloor, triangle({0.1, 0.1, 0}, {0.6, 0.1, 0}, {0.1, 0.6, 0})), 0);
+  // in the plane x = y, one edge standing on the floor's hypotenuse: the floor's edge meets it at a point of both
+  EXPECT_EQ(crossings(kFloor, triangle({0.5, 0.5, -0.1}, {0.5, 0.5, 0.4}, {0.9, 0.9, 0.2})), 0);
   // a piercing edge that passes the floor just outside its hypotenuse
   EXPECT_EQ(crossings(kFloor, triangle({0.6, 0.6, -0.1}, {0.7, 0.6, -0.1}, {0.65, 0.6, 0.5})), 0);
 }
