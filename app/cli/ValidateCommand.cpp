@@ -75,7 +75,7 @@ viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
   double base = 0.0;
   for (const sim::StyleRun& r : runs)
     if (r.style.name == "calm") base = r.summary.endExpiratoryVolume;
-  viz::Plot plot("Lung-cavity volume of the breath styles (cf. Zordan et al. 2004, Fig. 6)", "time since settling [s]",
+  viz::Plot plot("Lung volume of the breath styles (cf. Zordan et al. 2004, Fig. 6)", "time since settling [s]",
                  "volume above calm end-expiration [mL]");
   for (const sim::StyleRun& r : runs) {
     std::vector<double> t, v;
@@ -166,7 +166,7 @@ void runValidate(const ValidateArgs& args) {
 
   // figures
   std::vector<Figure> figures;
-  figures.push_back({"figure6_lung_volume", "Lung-cavity volume of the four breath styles; dashed: the 500 mL calm tidal volume of Figure 6.", figure6(runs)});
+  figures.push_back({"figure6_lung_volume", "Lung volume of the four breath styles; dashed: the 500 mL calm tidal volume of Figure 6.", figure6(runs)});
   if (hasSway) {
     viz::Plot p("Spine sway during deep breathing (cf. Sec. 5)", "time [s]",
                 "anterior position of " + deep->spineBody + " [mm]");

@@ -215,10 +215,22 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   out.time = state.time;
   out.activations = act;
 
-  // volumes: lung cavity from its bound surface, gut from the node surface
+  // volumes: lung cavity from its bound surface, the lungs from it (Lungs), gut from the node surface
   Eigen::Matrix3Xd cavity;
   anchorPositions(model.cavity.vertices, state, cavity);
-  out.lungVolume = model.cavity.triangles.cols() > 0 ? enclosedVolume(cavity, model.cavity.triangles) : 0.0;
+  out.thoracicCavityVolume =
+      model.cavity.triangles.cols() > 0 ? enclosedVolume(cavity, model.cavity.triangles) : 0.0;
+  out.lungVolume = out.thoracicCavityVolume - model.lungs.mediastinumVolume;
+  out.rightLungVolume = out.leftLungVolume = kNaN;
+  if (model.lungs.right.vertexCount() > 0) {
+    Eigen::Matrix3Xd x;
+    lungPositions(model.lungs.right, cavity, x);
+    const double right = enclosedVolume(x, model.lungs.right.triangles);
+    lungPositions(model.lungs.left, cavity, x);
+    const double left = enclosedVolume(x, model.lungs.left.triangles);
+    out.rightLungVolume = out.lungVolume * right / (right + left);
+    out.leftLungVolume = out.lungVolume - out.rightLungVolume;
+  }
   out.gutVolume =
       model.gut.triangles.cols() > 0 ? enclosedVolume(state.nodePosition, model.gut.triangles) : 0.0;
   out.gutVolumeError = work.constants.restGutVolume > 0.0
@@ -274,7 +286,7 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
     elastic += gutEnergy(kappa, work.constants.restGutVolume, out.gutVolume);
   // lung recoil: E = P0 dV + dV^2 / (2 C) while Ppl < 0, the potential of the pleural pressure
   if (model.cavity.compliance > 0.0) {
-    const double dv = out.lungVolume - work.constants.restCavityVolume;
+    const double dv = out.thoracicCavityVolume - work.constants.restCavityVolume;
     const double c = model.cavity.compliance, p0 = model.cavity.recoilPressure;
     const double dvZero = -p0 * c;  // [m^3] where Ppl reaches 0
     const double d = std::max(dv, dvZero);
