@@ -140,7 +140,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
     const QSignalBlocker block(m_styleCombo);
     m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
   }
-  m_params->setSettings(m_settings, 0.0);
+  m_params->setSettings(m_settings, nullptr);
 }
 
 MainWindow::~MainWindow() {
@@ -463,7 +463,7 @@ QString MainWindow::openModel(const QString& dir) {
   m_modelDir = QFileInfo(dir).absoluteFilePath();
   m_selected = {};
   m_plots->clearTraces();
-  m_params->setSettings(m_settings, model->gut.kappa);
+  m_params->setSettings(m_settings, model);
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   m_modelText = QString("Model: %1 (%2 bodies, %3 elements, %4 gut nodes)")
                     .arg(QString::fromStdString(model->name))
@@ -573,7 +573,7 @@ QString MainWindow::setBreathStyle(const QString& name) {
   }
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(name);
-  m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
+  m_params->setSettings(m_settings, m_model);
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   if (m_worker) m_worker->requestSettings(m_settings);
   return {};

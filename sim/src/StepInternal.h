@@ -23,10 +23,6 @@ inline Matrix3d skew(const Vector3d& v) {
   return m;
 }
 
-inline double effectiveKappa(const Model& model, const StepOptions& o) {
-  return o.kappa >= 0.0 ? o.kappa : model.gut.kappa;
-}
-
 // [1/s] beta of the visceral drag
 inline double effectiveDrag(const Model& model, const StepOptions& o) {
   return model.gut.drag * o.gutDragScale;

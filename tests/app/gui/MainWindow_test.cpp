@@ -188,14 +188,14 @@ TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
   EXPECT_TRUE(panel->refusal().contains("not a number"));
   EXPECT_EQ(panel->settings().style.breathsPerMinute, before);
 
-  // a non-positive gut kappa is refused too (the sim would read it as "use the model's")
-  const double kappaBefore = panel->settings().options.step.kappa;
+  // a non-positive gut kappa is refused too, by the sim's own check
+  const std::optional<double> kappaBefore = panel->settings().options.step.kappa;
   for (QLineEdit* f : panel->findChildren<QLineEdit*>())
     if (f->property("label").toString().contains("kPa")) {
       f->setText("-1");
       emit f->editingFinished();
     }
-  EXPECT_TRUE(panel->refusal().contains("must be > 0")) << panel->refusal().toStdString();
+  EXPECT_TRUE(panel->refusal().contains("kappa: must be finite and > 0")) << panel->refusal().toStdString();
   EXPECT_EQ(panel->settings().options.step.kappa, kappaBefore);
 }
 
