@@ -15,7 +15,7 @@ PNEUMA_PACKAGES=(
   libvtk9-dev libvtk9-qt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
-  help2man
+  help2man clang-format
 )
 
 pneuma_log() { printf '[pneuma] %s\n' "$*" >&2; }

@@ -103,7 +103,8 @@ void runBench(const BenchArgs& args) {
     fail(kExitBadInput, e.what());
   }
   if (styles.empty()) fail(kExitBadInput, "no breath-style presets in " + sim::resourceDir() + "/presets");
-  const double dt = options.dt > 0.0 ? options.dt : sim::defaultTimeStep(options.step.integrator);
+  const double dt =
+      sim::resolveOptions(*model, options, sim::BreathStyleController(styles.front()).maxTimeStep()).dt;
   nlohmann::json j;
   j["pneuma_version"] = PNEUMA_VERSION;
   j["model"] = modelDir;

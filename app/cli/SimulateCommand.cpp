@@ -73,7 +73,6 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (a.scenario.empty() && !a.isGiven("--duration")) fail(kExitBadInput, "--duration is required (simulated seconds)");
   if (a.isGiven("--output-rate")) {
     checkOption(sim::kOutputRateRange, "--output-rate", a.outputRate);
-    s.outputs.outputRate = a.outputRate;
     s.options.outputRate = a.outputRate;
   }
   if (a.vtk) s.outputs.vtk = true;

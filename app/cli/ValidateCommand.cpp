@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace pneuma::app {
@@ -33,7 +34,7 @@ struct ValidateArgs {
   std::string out = "validation";
   bool isQuick = false;
   std::string integrator;
-  double dt = 0.0;  // [s] 0 = the integrator's default
+  std::optional<double> dt;  // [s] unset: sim::resolveOptions() picks it
 };
 
 /// A figure of the report: its plot and a caption.
@@ -102,7 +103,7 @@ void runValidate(const ValidateArgs& args) {
     settings.impactDuration = 0.5;
   }
   applyIntegrator(args.integrator, settings.simulation.step.integrator);
-  if (args.dt != 0.0) checkOption(sim::kTimeStepRange, "--dt", args.dt);  // 0: the integrator's default
+  if (args.dt) checkOption(sim::kTimeStepRange, "--dt", *args.dt);
   settings.simulation.dt = args.dt;
   std::shared_ptr<const sim::Model> model;
   std::vector<sim::BreathStyle> styles;
@@ -300,7 +301,8 @@ void addValidateCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "Output directory (default: ./validation)");
   cmd->add_flag("--quick", args->isQuick, "Shorter runs (same checks), for tests and quick looks");
   addIntegratorOption(*cmd, args->integrator);
-  cmd->add_option("--dt", args->dt, "Time step [s] (default: the integrator's default)");
+  cmd->add_option_function<double>(
+      "--dt", [args](double dt) { args->dt = dt; }, "Time step [s] (default: the integrator's default)");
   cmd->callback([args] { runValidate(*args); });
 }
 

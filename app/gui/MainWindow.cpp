@@ -1,14 +1,13 @@
 #include "gui/MainWindow.h"
 
+#include "gui/DocumentController.h"
+#include "gui/ExportController.h"
 #include "gui/LivePlots.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Error.h"
-#include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
-#include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/pattern/Pattern.h"
-#include "viz/AtomicFile.h"
 
 #include <QAction>
 #include <QApplication>
@@ -16,12 +15,10 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
-#include <QDir>
 #include <QDockWidget>
 #include <QElapsedTimer>
 #include <QEventLoop>
 #include <QFileDialog>
-#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -31,25 +28,18 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QMouseEvent>
-#include <QPainter>
-#include <QPdfWriter>
 #include <QPushButton>
 #include <QScrollArea>
 #include <QSlider>
 #include <QStatusBar>
 #include <QStyle>
-#include <QSvgRenderer>
 #include <QTabWidget>
 #include <QTimer>
 #include <QToolBar>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 #include <vtkGenericOpenGLRenderWindow.h>
-#include <vtkImageData.h>
-#include <vtkOggTheoraWriter.h>
 #include <vtkRenderer.h>
-#include <vtkUnsignedCharArray.h>
-#include <vtkPointData.h>
 
 #include <cmath>
 #include <cstdio>
@@ -65,25 +55,33 @@ const std::vector<std::pair<QString, double>> kSpeeds{
     {"0.1\u00d7 real time", 0.1}, {"0.25\u00d7 real time", 0.25}, {"0.5\u00d7 real time", 0.5},
     {"1\u00d7 real time", 1.0},   {"2\u00d7 real time", 2.0},     {"As fast as possible", 0.0}};
 
-// the QImage's pixels as VTK RGB image data (VTK rows run bottom-up)
-void copyToImageData(const QImage& source, vtkImageData* out) {
-  const QImage rgb = source.convertToFormat(QImage::Format_RGB888);
-  const int w = rgb.width() & ~1, h = rgb.height() & ~1;  // Theora wants even sizes
-  out->SetDimensions(w, h, 1);
-  out->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
-  auto* dst = static_cast<unsigned char*>(out->GetScalarPointer());
-  for (int y = 0; y < h; ++y)
-    std::copy_n(rgb.constScanLine(h - 1 - y), 3 * w, dst + static_cast<std::size_t>(3 * w * y));
-  out->Modified();
-}
-
-QString suffixOf(const QString& path) { return QFileInfo(path).suffix().toLower(); }
+// display options the window offers: the check boxes of the structures and the colourings, each tied to its
+// option here (not by position)
+const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructures{
+    {"Bones", &viz::DisplayOptions::showBones},
+    {"Gut", &viz::DisplayOptions::showGut},
+    {"Translucent gut", &viz::DisplayOptions::isGutTranslucent},
+    {"Lung cavity", &viz::DisplayOptions::showCavity},
+    {"Lungs", &viz::DisplayOptions::showLungs},
+    {"Landmarks", &viz::DisplayOptions::showLandmarks},
+    {"Anatomical labels", &viz::DisplayOptions::showLabels}};
+const std::vector<std::pair<const char*, viz::MuscleColouring>> kMuscleColourings{
+    {"Contractive force [N]", viz::MuscleColouring::Force}, {"Muscle group", viz::MuscleColouring::Group}};
+const std::vector<std::pair<const char*, viz::GutColouring>> kGutColourings{
+    {"Plain", viz::GutColouring::Plain},
+    {"Pressure [Pa]", viz::GutColouring::Pressure},
+    {"Displacement [mm]", viz::GutColouring::Displacement}};
+const std::vector<std::pair<const char*, sim::pattern::SwitchMode>> kAffectModes{
+    {"at end of cycle", sim::pattern::SwitchMode::EndOfCycle}, {"immediately", sim::pattern::SwitchMode::Immediate}};
 
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make_unique<viz::ModelScene>()) {
   setWindowTitle("Pneuma");
   resize(1280, 800);
+  m_export = new ExportController({[this] { return grabView(); }, [this](double t) { return scrubTo(t); }}, this);
+  connect(m_export, &ExportController::failed, this, &MainWindow::report);
+  connect(m_export, &ExportController::done, this, [this](const QString& message) { showMessage(message, 5000); });
 
   // centre: the 3D view over the timeline
   auto* centre = new QWidget(this);
@@ -140,7 +138,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
     const QSignalBlocker block(m_styleCombo);
     m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
   }
-  m_params->setSettings(m_settings, 0.0);
+  m_params->setSettings(m_settings, nullptr);
 }
 
 MainWindow::~MainWindow() {
@@ -148,7 +146,7 @@ MainWindow::~MainWindow() {
   m_thread.wait();
 }
 
-QString MainWindow::defaultModelDir() { return QString::fromStdString(sim::defaultModelDir()); }
+QString MainWindow::defaultModelDir() { return DocumentController::defaultModelDir(); }
 
 void MainWindow::buildTimeline(QWidget* centre) {
   auto* bar = new QWidget(centre);
@@ -181,7 +179,7 @@ void MainWindow::buildActions() {
   // file menu
   QMenu* file = menuBar()->addMenu("&File");
   file->addAction("&Open model directory\u2026", this, [this] {
-    const QString dir = QFileDialog::getExistingDirectory(this, "Open model directory", m_modelDir);
+    const QString dir = QFileDialog::getExistingDirectory(this, "Open model directory", m_document.modelDir());
     if (!dir.isEmpty()) openModel(dir);
   }, QKeySequence::Open);
   file->addAction("Open &scenario\u2026", this, [this] {
@@ -262,12 +260,16 @@ void MainWindow::buildActions() {
   m_affectCombo->setCurrentText("neutral");  // nothing is pushed yet: offer neutral, not the first in the list (anger)
   tools->addWidget(m_affectCombo);
   m_affectMode = new QComboBox(this);
-  m_affectMode->addItems({"at end of cycle", "immediately"});
+  for (const auto& [label, mode] : kAffectModes) m_affectMode->addItem(label, static_cast<int>(mode));
   tools->addWidget(m_affectMode);
   QAction* push = tools->addAction("Push");
   push->setToolTip("Push the affect's respiration layers onto the pattern stack");
   connect(push, &QAction::triggered, this,
-          [this] { pushAffect(m_affectCombo->currentText(), m_affectMode->currentIndex() == 1); });
+          [this] {
+            pushAffect(m_affectCombo->currentText(),
+                       static_cast<sim::pattern::SwitchMode>(m_affectMode->currentData().toInt()) ==
+                           sim::pattern::SwitchMode::Immediate);
+          });
   // camera presets: the View menu and the buttons above the display options
   QMenu* view = menuBar()->addMenu("&View");
   for (QPushButton* button : m_cameraButtons) {
@@ -320,19 +322,19 @@ void MainWindow::buildDocks() {
   auto* colouring = new QGroupBox("Colouring", display);
   auto* colourForm = new QFormLayout(colouring);
   m_muscleColour = new QComboBox(colouring);
-  m_muscleColour->addItems({"Contractive force [N]", "Muscle group"});
+  for (const auto& [label, colouring] : kMuscleColourings) m_muscleColour->addItem(label, static_cast<int>(colouring));
   m_gutColour = new QComboBox(colouring);
-  m_gutColour->addItems({"Plain", "Pressure [Pa]", "Displacement [mm]"});
+  for (const auto& [label, colouring] : kGutColourings) m_gutColour->addItem(label, static_cast<int>(colouring));
   colourForm->addRow("Muscles", m_muscleColour);
   colourForm->addRow("Gut", m_gutColour);
   displayLayout->addWidget(colouring);
 
   auto* structures = new QGroupBox("Structures", display);
   auto* structLayout = new QVBoxLayout(structures);
-  for (const char* name : {"Bones", "Gut", "Translucent gut", "Lung cavity", "Lungs", "Landmarks", "Anatomical labels"}) {
+  for (const auto& [name, flag] : kStructures) {
     auto* check = new QCheckBox(name, structures);
     structLayout->addWidget(check);
-    m_structureChecks.push_back(check);
+    m_structureChecks.emplace_back(check, flag);
   }
   displayLayout->addWidget(structures);
 
@@ -367,21 +369,15 @@ void MainWindow::buildDocks() {
   syncDisplayWidgets();
   auto readOptions = [this] {
     viz::DisplayOptions o = m_scene->options();
-    o.muscleColouring = m_muscleColour->currentIndex() == 0 ? viz::MuscleColouring::Force : viz::MuscleColouring::Group;
-    o.gutColouring = static_cast<viz::GutColouring>(m_gutColour->currentIndex());
-    o.showBones = m_structureChecks[0]->isChecked();
-    o.showGut = m_structureChecks[1]->isChecked();
-    o.isGutTranslucent = m_structureChecks[2]->isChecked();
-    o.showCavity = m_structureChecks[3]->isChecked();
-    o.showLungs = m_structureChecks[4]->isChecked();
-    o.showLandmarks = m_structureChecks[5]->isChecked();
-    o.showLabels = m_structureChecks[6]->isChecked();
+    o.muscleColouring = static_cast<viz::MuscleColouring>(m_muscleColour->currentData().toInt());
+    o.gutColouring = static_cast<viz::GutColouring>(m_gutColour->currentData().toInt());
+    for (const auto& [check, flag] : m_structureChecks) o.*flag = check->isChecked();
     for (std::size_t g = 0; g < m_groupChecks.size(); ++g) o.showGroup[g] = m_groupChecks[g]->isChecked();
     setDisplayOptions(o);
   };
   connect(m_muscleColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
   connect(m_gutColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
-  for (QCheckBox* c : m_structureChecks) connect(c, &QCheckBox::toggled, this, readOptions);
+  for (const auto& [check, flag] : m_structureChecks) connect(check, &QCheckBox::toggled, this, readOptions);
   for (QCheckBox* c : m_groupChecks) connect(c, &QCheckBox::toggled, this, readOptions);
 
   m_params = new ParameterPanel(this);
@@ -413,14 +409,13 @@ void MainWindow::syncDisplayWidgets() {
     std::vector<QSignalBlocker> b;
     b.emplace_back(m_muscleColour);
     b.emplace_back(m_gutColour);
-    for (QCheckBox* c : m_structureChecks) b.emplace_back(c);
+    for (const auto& [check, flag] : m_structureChecks) b.emplace_back(check);
     for (QCheckBox* c : m_groupChecks) b.emplace_back(c);
     return b;
   }();
-  m_muscleColour->setCurrentIndex(o.muscleColouring == viz::MuscleColouring::Force ? 0 : 1);
-  m_gutColour->setCurrentIndex(static_cast<int>(o.gutColouring));
-  const bool flags[] = {o.showBones, o.showGut, o.isGutTranslucent, o.showCavity, o.showLungs, o.showLandmarks, o.showLabels};
-  for (std::size_t i = 0; i < m_structureChecks.size(); ++i) m_structureChecks[i]->setChecked(flags[i]);
+  m_muscleColour->setCurrentIndex(m_muscleColour->findData(static_cast<int>(o.muscleColouring)));
+  m_gutColour->setCurrentIndex(m_gutColour->findData(static_cast<int>(o.gutColouring)));
+  for (const auto& [check, flag] : m_structureChecks) check->setChecked(o.*flag);
   for (std::size_t g = 0; g < m_groupChecks.size(); ++g) m_groupChecks[g]->setChecked(o.showGroup[g]);
 }
 
@@ -447,24 +442,21 @@ void MainWindow::report(const QString& title, const QString& message) {
 }
 
 QString MainWindow::openModel(const QString& dir) {
-  std::shared_ptr<const sim::Model> model;
-  std::unique_ptr<sim::Simulation> simulation;
+  DocumentController::OpenedModel opened;
   try {
     // load and validate everything before touching the current run
-    model = std::make_shared<const sim::Model>(sim::loadModel(dir.toStdString()));
-    simulation = std::make_unique<sim::Simulation>(
-        model, std::make_unique<sim::BreathStyleController>(m_settings.style), m_settings.options);
-    m_scene->setModel(*model, dir.toStdString());
+    opened = DocumentController::readModel(dir, m_settings);
+    m_scene->setModel(*opened.model, dir.toStdString());
   } catch (const std::exception& e) {
     const QString message = QString("Cannot open model '%1': %2").arg(dir, e.what());
     report("Model not loaded", message);
     return message;
   }
-  m_model = model;
-  m_modelDir = QFileInfo(dir).absoluteFilePath();
+  m_document.adopt(opened);
+  const std::shared_ptr<const sim::Model>& model = opened.model;
   m_selected = {};
   m_plots->clearTraces();
-  m_params->setSettings(m_settings, model->gut.kappa);
+  m_params->setSettings(m_settings, model);
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   m_modelText = QString("Model: %1 (%2 bodies, %3 elements, %4 gut nodes)")
                     .arg(QString::fromStdString(model->name))
@@ -475,7 +467,7 @@ QString MainWindow::openModel(const QString& dir) {
   setWindowTitle(QString("Pneuma \u2014 %1").arg(QString::fromStdString(model->name)));
 
   if (!m_worker) {
-    m_worker = new SimWorker(model, std::move(simulation), m_settings);
+    m_worker = new SimWorker(model, std::move(opened.simulation), m_settings);
     m_worker->setSpeed(m_speedCombo->currentData().toDouble());
     m_worker->moveToThread(&m_thread);
     connect(&m_thread, &QThread::started, m_worker, &SimWorker::start);
@@ -488,74 +480,37 @@ QString MainWindow::openModel(const QString& dir) {
     });
     m_thread.start();
   } else {
-    m_worker->requestSimulation(model, std::move(simulation), m_settings);
+    m_worker->requestSimulation(model, std::move(opened.simulation), m_settings);
   }
   m_view->renderWindow()->Render();
   return {};
 }
 
-QString MainWindow::modelDirFor(const std::string& scenarioModel) const {
-  return scenarioModel == "default" ? defaultModelDir() : QString::fromStdString(scenarioModel);
-}
-
 QString MainWindow::openScenario(const QString& path) {
-  sim::Scenario scenario;
-  sim::BreathStyle style;
+  DocumentController::OpenedScenario scenario;
   try {
-    scenario = sim::loadScenario(path.toStdString());
-    if (scenario.controller != sim::ControllerKind::Style)
-      throw sim::Error(std::string("controller: the app plays breath styles; '") +
-                       sim::controllerKindName(scenario.controller) + "' scenarios run in pneuma-cli");
-    style = sim::loadBreathStyle(scenario.controllerName);
+    scenario = DocumentController::readScenario(path, m_settings);
   } catch (const std::exception& e) {
     const QString message = QString("Cannot open scenario '%1': %2").arg(path, e.what());
     report("Scenario not loaded", message);
     return message;
   }
   const RunSettings previous = m_settings;
-  m_settings.style = style;
-  m_settings.options = scenario.options;
-  m_settings.options.recordSeconds = kRecordSeconds;
-  const QString error = openModel(modelDirFor(scenario.model));
+  m_settings = scenario.settings;
+  const QString error = openModel(scenario.modelDir);
   if (!error.isEmpty()) {
     m_settings = previous;
     return error;
   }
   const QSignalBlocker block(m_styleCombo);
-  m_styleCombo->setCurrentText(QString::fromStdString(style.name));
-  showMessage(QString("Scenario '%1' loaded").arg(QString::fromStdString(scenario.name)), 5000);
+  m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
+  showMessage(QString("Scenario '%1' loaded").arg(scenario.name), 5000);
   return {};
 }
 
 QString MainWindow::saveScenario(const QString& path) {
-  sim::Scenario scenario;
-  scenario.name = QFileInfo(path).completeBaseName().toStdString();
-  scenario.description = "Saved from the Pneuma desktop app";
-  scenario.model = m_modelDir.isEmpty() ? "default" : m_modelDir.toStdString();
-  scenario.duration = 60.0;
-  scenario.controller = sim::ControllerKind::Style;
-  scenario.options = m_settings.options;
   try {
-    // an edited style travels as its own preset file next to the scenario
-    const sim::BreathStyle& s = m_settings.style;
-    scenario.controllerName = s.name;
-    // compare everything but the note: an unedited preset is referenced by name
-    bool isPreset = false;
-    try {
-      sim::BreathStyle preset = sim::loadBreathStyle(s.name);
-      preset.note = s.note;
-      isPreset = sim::serializeBreathStyle(preset) == sim::serializeBreathStyle(s);
-    } catch (const sim::Error&) {
-    }
-    if (!isPreset) {
-      sim::BreathStyle edited = s;
-      edited.note = "Edited in the Pneuma desktop app";
-      const QFileInfo info(path);
-      const QString stylePath = info.absoluteDir().absoluteFilePath(info.completeBaseName() + ".style.json");
-      viz::writeFileAtomically(stylePath.toStdString(), sim::serializeBreathStyle(edited));
-      scenario.controllerName = stylePath.toStdString();
-    }
-    sim::saveScenario(scenario, path.toStdString());
+    m_document.saveScenario(path, m_settings);
   } catch (const std::exception& e) {
     const QString message = QString("Cannot save scenario '%1': %2").arg(path, e.what());
     report("Scenario not saved", message);
@@ -574,7 +529,7 @@ QString MainWindow::setBreathStyle(const QString& name) {
   }
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(name);
-  m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
+  m_params->setSettings(m_settings, m_document.model());
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   if (m_worker) m_worker->requestSettings(m_settings);
   return {};
@@ -672,7 +627,7 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   const Snapshot& s = *m_shown;
   QElapsedTimer clock;
   clock.start();
-  if (s.model == m_model) m_scene->update(s.state, s.metrics);
+  if (s.model == m_document.model()) m_scene->update(s.state, s.metrics);
   m_view->renderWindow()->Render();
   m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
   m_sinceRender.restart();
@@ -708,7 +663,7 @@ void MainWindow::select(const viz::Pick& pick) {
   const bool isNewSelection = pick.kind != m_selected.kind || pick.index != m_selected.index;
   m_selected = pick;
   if (isNewSelection) m_scene->setHighlight(pick);
-  if (pick.kind == viz::Pick::Kind::None || !m_model || !m_shown) {
+  if (pick.kind == viz::Pick::Kind::None || !m_document.model() || !m_shown) {
     m_selection->setText("Click a muscle element or a bone in the 3D view.");
     return;
   }
@@ -718,7 +673,7 @@ void MainWindow::select(const viz::Pick& pick) {
   if (pick.kind == viz::Pick::Kind::Element) {
     trace.elements = {pick.index};
   } else {
-    const sim::Elements& e = m_model->elements;
+    const sim::Elements& e = m_document.model()->elements;
     for (int i = 0; i < e.size(); ++i)
       if (e.endA.body[static_cast<std::size_t>(i)] == pick.index || e.endB.body[static_cast<std::size_t>(i)] == pick.index)
         trace.elements.push_back(i);
@@ -772,138 +727,17 @@ void MainWindow::exportPlotInteractive(const PlotView* plot) {
   if (!path.isEmpty()) exportPlot(plot, path);
 }
 
-QString MainWindow::exportPlot(const PlotView* plot, const QString& path) {
-  const QString suffix = suffixOf(path);
-  try {
-    const viz::Plot chart = plot->toPlot();
-    if (suffix == "png") {
-      chart.writePng(path.toStdString());
-    } else if (suffix == "svg") {
-      chart.writeSvg(path.toStdString());
-    } else if (suffix == "csv") {
-      viz::writeFileAtomically(path.toStdString(), plot->toCsv());
-    } else if (suffix == "pdf") {
-      // the SVG drawn into a PDF page of the same aspect, through a temporary file
-      QSvgRenderer svg(QByteArray::fromStdString(chart.toSvg()));
-      const std::string temp = viz::temporaryPathFor(path.toStdString());
-      {
-        QPdfWriter pdf(QString::fromStdString(temp));
-        pdf.setTitle(plot->title());
-        pdf.setCreator("Pneuma");
-        pdf.setResolution(96);
-        pdf.setPageSize(QPageSize(QSizeF(svg.defaultSize()), QPageSize::Point));
-        pdf.setPageMargins(QMarginsF(0, 0, 0, 0));
-        QPainter painter;
-        if (!painter.begin(&pdf)) throw std::runtime_error("cannot write " + temp);
-        svg.render(&painter);
-        painter.end();
-      }
-      if (QFileInfo(QString::fromStdString(temp)).size() == 0) {
-        QFile::remove(QString::fromStdString(temp));
-        throw std::runtime_error("cannot write " + path.toStdString());
-      }
-      viz::commitTemporary(temp, path.toStdString());
-    } else {
-      throw std::runtime_error("unknown plot format '." + suffix.toStdString() + "' (use .png, .svg, .pdf or .csv)");
-    }
-  } catch (const std::exception& e) {
-    const QString message = QString("Cannot export plot to '%1': %2").arg(path, e.what());
-    report("Export failed", message);
-    return message;
-  }
-  showMessage(QString("Plot exported to %1").arg(path), 5000);
-  return {};
-}
+QString MainWindow::exportPlot(const PlotView* plot, const QString& path) { return m_export->exportPlot(plot, path); }
 
-QString MainWindow::exportViewImage(const QString& path) {
-  const std::string temp = viz::temporaryPathFor(path.toStdString());
-  try {
-    if (!grabView().save(QString::fromStdString(temp), "PNG")) {
-      QFile::remove(QString::fromStdString(temp));
-      throw std::runtime_error("cannot write " + path.toStdString());
-    }
-    viz::commitTemporary(temp, path.toStdString());
-  } catch (const std::exception& e) {
-    const QString message = QString("Cannot export the 3D view: %1").arg(e.what());
-    report("Export failed", message);
-    return message;
-  }
-  showMessage(QString("3D view saved to %1").arg(path), 5000);
-  return {};
-}
+QString MainWindow::exportViewImage(const QString& path) { return m_export->exportViewImage(path); }
 
 QString MainWindow::exportAnimation(const QString& path, double from, double to, double fps) {
-  const bool isMovie = suffixOf(path) == "ogv";
-  const QFileInfo info(path);
-  std::vector<std::string> written;  // temporaries, renamed only when every frame succeeded
-  try {
-    if (!m_worker || !(to > from) || !(fps > 0.0)) throw std::runtime_error("nothing recorded to export");
-    vtkNew<vtkImageData> image;
-    vtkNew<vtkOggTheoraWriter> movie;
-    const int frames = static_cast<int>(std::floor((to - from) * fps + 1e-6)) + 1;
-    for (int k = 0; k < frames; ++k) {
-      if (!scrubTo(from + k / fps)) throw std::runtime_error("the recording did not answer");
-      const QImage shot = grabView();
-      if (isMovie) {
-        copyToImageData(shot, image);
-        if (k == 0) {
-          written.push_back(viz::temporaryPathFor(path.toStdString()));
-          movie->SetInputData(image);
-          movie->SetFileName(written.back().c_str());
-          movie->SetRate(static_cast<int>(std::lround(fps)));
-          movie->SetQuality(2);
-          movie->Start();
-        }
-        movie->Write();
-        if (movie->GetError()) throw std::runtime_error("the Ogg Theora writer failed on " + path.toStdString());
-      } else {
-        const QString name = info.absoluteDir().absoluteFilePath(
-            QString("%1_%2.png").arg(info.completeBaseName()).arg(k, 4, 10, QChar('0')));
-        written.push_back(viz::temporaryPathFor(name.toStdString()));
-        if (!shot.save(QString::fromStdString(written.back()), "PNG"))
-          throw std::runtime_error("cannot write " + name.toStdString());
-      }
-    }
-    if (isMovie) {
-      movie->End();
-      viz::commitTemporary(written.front(), path.toStdString());
-    } else {
-      for (int k = 0; k < static_cast<int>(written.size()); ++k)
-        viz::commitTemporary(written[static_cast<std::size_t>(k)],
-                             info.absoluteDir()
-                                 .absoluteFilePath(QString("%1_%2.png").arg(info.completeBaseName()).arg(k, 4, 10, QChar('0')))
-                                 .toStdString());
-    }
-  } catch (const std::exception& e) {
-    for (const std::string& t : written) QFile::remove(QString::fromStdString(t));
-    const QString message = QString("Cannot export the animation: %1").arg(e.what());
-    report("Export failed", message);
-    return message;
-  }
-  showMessage(QString("Animation saved to %1").arg(path), 5000);
-  return {};
+  if (!m_worker) return m_export->exportAnimation(path, 0.0, 0.0, fps);  // refused: nothing recorded
+  return m_export->exportAnimation(path, from, to, fps);
 }
 
 QString MainWindow::exportRun(const QString& pvdPath) {
-  if (!m_worker) return "no model loaded";
-  const QFileInfo info(pvdPath);
-  QEventLoop loop;
-  QString error = "the export did not finish";
-  auto done = connect(m_worker, &SimWorker::exportDone, &loop, [&](const QString& e) {
-    error = e;
-    loop.quit();
-  });
-  m_worker->requestExportRun(m_modelDir.toStdString(), info.absolutePath().toStdString(),
-                             info.completeBaseName().toStdString());
-  loop.exec();
-  disconnect(done);
-  if (!error.isEmpty()) {
-    const QString message = QString("Cannot export the run to '%1': %2").arg(pvdPath, error);
-    report("Export failed", message);
-    return message;
-  }
-  showMessage(QString("Run saved as %1").arg(pvdPath), 5000);
-  return {};
+  return m_export->exportRun(m_worker, m_document.modelDir(), pvdPath);
 }
 
 QImage MainWindow::grabView() {

@@ -7,6 +7,7 @@
 /// The simulation runs in a SimWorker on its own QThread; the window only queues edits and draws
 /// the snapshots the worker publishes (refreshed at 30 Hz).
 
+#include "gui/DocumentController.h"
 #include "gui/SimWorker.h"
 #include "viz/ModelScene.h"
 
@@ -15,6 +16,8 @@
 #include <QThread>
 
 #include <memory>
+#include <utility>
+#include <vector>
 
 class QAction;
 class QCheckBox;
@@ -27,6 +30,7 @@ class QVTKOpenGLNativeWidget;
 
 namespace pneuma::app {
 
+class ExportController;
 class LivePlots;
 class ParameterPanel;
 class PlotView;
@@ -84,7 +88,7 @@ class MainWindow : public QMainWindow {
   ParameterPanel* parameters() const { return m_params; }
   /// The snapshot on screen (null before the first one).
   const Snapshot* shown() const { return m_shown.get(); }
-  const sim::Model* model() const { return m_model.get(); }
+  const sim::Model* model() const { return m_document.model().get(); }
   /// Applies display options and redraws.
   void setDisplayOptions(const viz::DisplayOptions& options);
   /// Selects what is under view pixel (x, y) (Qt widget coordinates), as a click would.
@@ -116,7 +120,6 @@ class MainWindow : public QMainWindow {
   /// Shows `text` in the status bar for a while, then the model line again.
   void showMessage(const QString& text, int milliseconds);
   void select(const viz::Pick& pick);
-  QString modelDirFor(const std::string& scenarioModel) const;
   void exportPlotInteractive(const PlotView* plot);
   void updateTimeline();
 
@@ -125,8 +128,8 @@ class MainWindow : public QMainWindow {
   LivePlots* m_plots = nullptr;
   ParameterPanel* m_params = nullptr;
 
-  std::shared_ptr<const sim::Model> m_model;
-  QString m_modelDir;
+  DocumentController m_document;  // the open model and its directory; scenario files
+  ExportController* m_export = nullptr;  // plots, the 3D view, movies and ParaView series
   RunSettings m_settings;
   QThread m_thread;
   SimWorker* m_worker = nullptr;
@@ -142,7 +145,7 @@ class MainWindow : public QMainWindow {
   QComboBox* m_affectMode = nullptr;
   QComboBox* m_muscleColour = nullptr;
   QComboBox* m_gutColour = nullptr;
-  std::vector<QCheckBox*> m_structureChecks;  // bones, gut, translucent gut, cavity, lungs, landmarks, labels
+  std::vector<std::pair<QCheckBox*, bool viz::DisplayOptions::*>> m_structureChecks;  // each with its option
   std::vector<QCheckBox*> m_groupChecks;
   std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique
   QLabel* m_selection = nullptr;

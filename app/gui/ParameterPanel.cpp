@@ -12,8 +12,6 @@ namespace pneuma::app {
 
 namespace {
 
-constexpr std::size_t kKappaField = 6;  // index of the gut kappa field in m_fields
-
 // scales applied to every muscle group at once (cartilage keeps its own gains)
 double muscleScale(const std::array<double, sim::kElementGroupCount>& scales) { return scales[0]; }
 void setMuscleScale(std::array<double, sim::kElementGroupCount>& scales, double v) {
@@ -48,7 +46,7 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
            [](const RunSettings& s) { return muscleScale(s.options.step.passiveGainScale); },
            [](RunSettings& s, double v) { setMuscleScale(s.options.step.passiveGainScale, v); });
   addField("Gut \u03ba", "kPa", "Bulk modulus of the gut, P = \u03ba (V0/V - 1) (Eq. 4)",
-           [this](const RunSettings& s) { return 1e-3 * (s.options.step.kappa >= 0.0 ? s.options.step.kappa : m_modelKappa); },
+           [this](const RunSettings& s) { return m_model ? 1e-3 * sim::resolveOptions(*m_model, s.options).kappa : 0.0; },
            [](RunSettings& s, double v) { s.options.step.kappa = 1e3 * v; });
   addField("Joint friction \u03bc \u00d7", "-", "Scale of every joint's friction (Eq. 3)",
            [](const RunSettings& s) { return s.options.step.jointFrictionScale; },
@@ -92,9 +90,9 @@ void ParameterPanel::addField(const QString& label, const QString& unit, const Q
   connect(f.edit, &QLineEdit::editingFinished, this, [this, index] { edited(m_fields[index]); });
 }
 
-void ParameterPanel::setSettings(const RunSettings& settings, double modelKappa) {
+void ParameterPanel::setSettings(const RunSettings& settings, std::shared_ptr<const sim::Model> model) {
   m_settings = settings;
-  m_modelKappa = modelKappa;
+  m_model = std::move(model);
   for (const Field& f : m_fields) {
     f.edit->setText(QString::number(f.get(m_settings), 'g', 6));
     f.edit->setStyleSheet(QString());
@@ -120,10 +118,6 @@ void ParameterPanel::edited(const Field& field) {
     field.edit->setStyleSheet(QString());
     return;
   }
-
-  // kappa < 0 would mean "the model's own" to the sim: a typed value must be a real modulus
-  if (field.edit == m_fields[kKappaField].edit && !(value > 0.0))
-    return refuse(field.edit, QString("%1 = %2 refused: must be > 0").arg(name, field.edit->text()));
 
   // check the candidate with the sim's validators; apply nothing unless it passes
   RunSettings candidate = m_settings;

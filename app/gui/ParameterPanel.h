@@ -9,6 +9,7 @@
 #include <QWidget>
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 class QCheckBox;
@@ -23,8 +24,9 @@ class ParameterPanel : public QWidget {
  public:
   explicit ParameterPanel(QWidget* parent = nullptr);
 
-  /// Shows `settings`; `modelKappa` [Pa] is the model's own kappa (shown when the options do not override it).
-  void setSettings(const RunSettings& settings, double modelKappa);
+  /// Shows `settings` for `model` (may be null), whose own values show where the options leave them unset
+  /// (sim::resolveOptions()).
+  void setSettings(const RunSettings& settings, std::shared_ptr<const sim::Model> model);
   const RunSettings& settings() const { return m_settings; }
 
   /// The reason the last edit was refused, or empty.
@@ -49,7 +51,7 @@ class ParameterPanel : public QWidget {
   void refuse(QLineEdit* edit, const QString& reason);
 
   RunSettings m_settings;
-  double m_modelKappa = 0.0;  // [Pa]
+  std::shared_ptr<const sim::Model> m_model;
   std::vector<Field> m_fields;
   QCheckBox* m_gravity = nullptr;
   QLabel* m_reason = nullptr;

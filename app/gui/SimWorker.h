@@ -67,7 +67,6 @@ class SimWorker : public QObject {
   Q_OBJECT
 
  public:
-  /// @param simulation the run to drive (constructed and validated by the caller).
   /// @param model       the model `simulation` runs (kept alive by the snapshots)
   /// @param simulation  the run to drive, constructed and validated by the caller
   SimWorker(std::shared_ptr<const sim::Model> model, std::unique_ptr<sim::Simulation> simulation,
@@ -136,8 +135,8 @@ class SimWorker : public QObject {
   void collect(const sim::Simulation& simulation);
   void pushAffect(const std::string& name, sim::pattern::SwitchMode mode);
   void exportRun(const std::array<std::string, 3>& request);
-  /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces,
-  /// and the gut pressure of Eq. 4 recomputed from the volume error).
+  /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces and the
+  /// gut pressure, as measured then: sim::Recorder::restore()).
   void restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const;
   void publish(bool isScrubbed);
 

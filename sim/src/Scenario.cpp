@@ -85,9 +85,9 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("passive_gain_scale")) parseGroupScales(o.at("passive_gain_scale"), opt.step.passiveGainScale);
 }
 
-void parseOutputs(const Field& o, ScenarioOutputs& out) {
+void parseOutputs(const Field& o, ScenarioOutputs& out, SimulationOptions& opt) {
   o.allowKeys({"output_rate_hz", "csv", "plots", "vtk"});
-  if (o.has("output_rate_hz")) out.outputRate = o.at("output_rate_hz").numberIn(kOutputRateRange);
+  if (o.has("output_rate_hz")) opt.outputRate = o.at("output_rate_hz").numberIn(kOutputRateRange);
   if (o.has("csv")) out.csv = o.at("csv").boolean();
   if (o.has("plots")) out.plots = o.at("plots").boolean();
   if (o.has("vtk")) out.vtk = o.at("vtk").boolean();
@@ -135,8 +135,7 @@ Scenario parseScenario(const std::string& jsonText, const std::string& sourceNam
   if (root.has("seed")) s.seed = root.at("seed").unsignedInteger();
   parseController(root.at("controller"), baseDir, s);
   if (root.has("overrides")) parseOverrides(root.at("overrides"), s.options);
-  if (root.has("outputs")) parseOutputs(root.at("outputs"), s.outputs);
-  s.options.outputRate = s.outputs.outputRate;
+  if (root.has("outputs")) parseOutputs(root.at("outputs"), s.outputs, s.options);
 
   // cross-field checks the simulation would make later, reported against the file
   try {
@@ -167,15 +166,15 @@ std::string serializeScenario(const Scenario& s) {
   const StepOptions& st = s.options.step;
   json& o = j["overrides"];
   o["integrator"] = integratorName(st.integrator);
-  if (s.options.dt > 0.0) o["dt_s"] = s.options.dt;
+  if (s.options.dt) o["dt_s"] = *s.options.dt;
   o["settle_time_s"] = s.options.settleTime;
   o["gravity"] = st.gravity;
   o["joint_friction_scale"] = st.jointFrictionScale;
   o["gut_drag_scale"] = st.gutDragScale;
-  if (st.kappa > 0.0) o["kappa_pa"] = st.kappa;
+  if (st.kappa) o["kappa_pa"] = *st.kappa;
   o["active_gain_scale"] = groupScalesJson(st.activeGainScale);
   o["passive_gain_scale"] = groupScalesJson(st.passiveGainScale);
-  j["outputs"] = {{"output_rate_hz", s.outputs.outputRate}, {"csv", s.outputs.csv}, {"plots", s.outputs.plots},
+  j["outputs"] = {{"output_rate_hz", s.options.outputRate}, {"csv", s.outputs.csv}, {"plots", s.outputs.plots},
                   {"vtk", s.outputs.vtk}};
   return j.dump(2) + "\n";
 }

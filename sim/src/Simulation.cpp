@@ -1,5 +1,6 @@
 #include "pneuma/sim/Simulation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -13,7 +14,7 @@ namespace pneuma::sim {
 
 void validateSimulationOptions(const SimulationOptions& o) {
   validateStepOptions(o.step);
-  if (o.dt != 0.0) kTimeStepRange.check("dt", o.dt);  // 0: the integrator's default
+  if (o.dt) kTimeStepRange.check("dt", *o.dt);
   kSettleTimeRange.check("settleTime", o.settleTime);
   kOutputRateRange.check("outputRate", o.outputRate);
   if (!std::isfinite(o.recordSeconds) || o.recordSeconds < 0.0) {
@@ -21,6 +22,13 @@ void validateSimulationOptions(const SimulationOptions& o) {
     os << "recordSeconds: must be >= 0 s, got " << o.recordSeconds;
     throw Error(os.str());
   }
+}
+
+ResolvedOptions resolveOptions(const Model& model, const SimulationOptions& options, double maxTimeStep) {
+  ResolvedOptions r;
+  r.kappa = effectiveKappa(model, options.step);
+  r.dt = options.dt ? *options.dt : std::min(defaultTimeStep(options.step.integrator), maxTimeStep);
+  return r;
 }
 
 Simulation::Simulation(std::shared_ptr<const Model> model, std::unique_ptr<Controller> controller,
@@ -51,8 +59,7 @@ void Simulation::setController(std::unique_ptr<Controller> controller) {
 }
 
 void Simulation::updateTimeStep() {
-  m_dt = m_options.dt > 0.0 ? m_options.dt
-                            : std::min(defaultTimeStep(m_options.step.integrator), m_controller->maxTimeStep());
+  m_dt = resolveOptions(*m_model, m_options, m_controller->maxTimeStep()).dt;
 }
 
 void Simulation::reset() {

@@ -429,6 +429,38 @@ void applySystem(const Model& model, const StepOptions& o, const StepWork& w, co
 
 }  // namespace
 
+void updateTreeLevers(const Model& model, StepWork& w) {
+  for (int j : w.constants.treeJoints) {
+    w.scratch.treeLeverParent.col(j) =
+        w.scratch.rotation[at(model.joints.parent[at(j)])] * w.constants.jointLocalParent.col(j);
+    w.scratch.treeLeverChild.col(j) =
+        w.scratch.rotation[at(model.joints.child[at(j)])] * w.constants.jointLocalChild.col(j);
+  }
+}
+
+void stiffnessProduct(const Model& model, const StepOptions& o, StepWork& w, const Eigen::VectorXd& u,
+                      Eigen::VectorXd& out) {
+  linearizeElements(model, 1.0, 0.0, w);
+  out.resize(u.size());
+  applyStiffnessDamping(model, o, w, u, out);
+}
+
+Eigen::MatrixXd assembledSystem(const Model& model, const StepOptions& o, StepWork& w, double dt) {
+  updateTreeLevers(model, w);
+  assembleBodyBlocks(model, o, w.constants.treeJoints, w, dt);
+  const Eigen::Index n = w.scratch.cgX.size();
+  Eigen::MatrixXd full = Eigen::MatrixXd::Zero(n, n);
+  streamSystem(model, o, w, dt, [&](Eigen::Index row, Eigen::Index col, const auto& block) {
+    full.block<3, 3>(row, col) += block;
+    if (row != col) full.block<3, 3>(col, row) += block.transpose();
+  });
+  const Eigen::VectorXi& free = w.constants.freeCoordinates;
+  Eigen::MatrixXd a(free.size(), free.size());
+  for (Eigen::Index i = 0; i < free.size(); ++i)
+    for (Eigen::Index j = 0; j < free.size(); ++j) a(i, j) = full(free(i), free(j));
+  return a;
+}
+
 // the free coordinates of the implicit solve and the pattern of its matrix, from the model's topology (the
 // joint tree, the elements' endpoints): once per model, by makeStepWork(); the streamed values do not matter
 // here
@@ -521,12 +553,7 @@ void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepO
   Eigen::VectorXd &x = w.scratch.cgX, &r = w.scratch.cgR, &z = w.scratch.cgZ, &p = w.scratch.cgP,
                   &q = w.scratch.cgQ, &rhs = w.scratch.cgB, &t = w.scratch.cgT;
   const std::vector<int>& tree = w.constants.treeJoints;
-  for (int j : tree) {
-    w.scratch.treeLeverParent.col(j) =
-        w.scratch.rotation[at(model.joints.parent[at(j)])] * w.constants.jointLocalParent.col(j);
-    w.scratch.treeLeverChild.col(j) =
-        w.scratch.rotation[at(model.joints.child[at(j)])] * w.constants.jointLocalChild.col(j);
-  }
+  updateTreeLevers(model, w);
 
   // current generalized velocity and forces
   for (int b = 0; b < nb; ++b) {

@@ -23,10 +23,6 @@ inline Matrix3d skew(const Vector3d& v) {
   return m;
 }
 
-inline double effectiveKappa(const Model& model, const StepOptions& o) {
-  return o.kappa >= 0.0 ? o.kappa : model.gut.kappa;
-}
-
 // [1/s] beta of the visceral drag
 inline double effectiveDrag(const Model& model, const StepOptions& o) {
   return model.gut.drag * o.gutDragScale;
@@ -119,6 +115,19 @@ void updateBodyFrames(const Model& model, const State& s, StepWork& w);
 
 // the free coordinates of the implicit solve and the pattern of its matrix, once per model (StepImplicit.cpp)
 void analyzeSystem(const Model& model, StepWork& w);
+
+// the tree joints' anchor levers (world, from the body frames) that J and J^T use (StepImplicit.cpp)
+void updateTreeLevers(const Model& model, StepWork& w);
+
+// out = K u, the stiffness the implicit step linearises the forces with (elements with their geometric part,
+// the gut's rank-one pressure stiffness, the pleural one, joint springs), at the forces computeForces() left
+// in w, in full coordinates u = [dx_b, dtheta_b]_b ++ [dx_n]_n (StepImplicit.cpp; for the stiffness tests)
+void stiffnessProduct(const Model& model, const StepOptions& o, StepWork& w, const Eigen::VectorXd& u,
+                      Eigen::VectorXd& out);
+
+// the matrix the preconditioner factors, J^T (M + dt D + dt^2 K) J over the free coordinates without the gut's
+// and the pleural rank-one terms, dense (StepImplicit.cpp; for the stiffness tests)
+Eigen::MatrixXd assembledSystem(const Model& model, const StepOptions& o, StepWork& w, double dt);
 
 // linearly implicit Euler of the velocities in the joint tree's coordinates (StepImplicit.cpp)
 void implicitVelocityUpdate(const Model& model, State& s, double dt, const StepOptions& o, StepWork& w);

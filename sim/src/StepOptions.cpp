@@ -49,7 +49,8 @@ void validateStepOptions(const StepOptions& o) {
     fail("jointFrictionScale", o.jointFrictionScale, "must be finite and >= 0");
   if (!std::isfinite(o.gutDragScale) || o.gutDragScale < 0.0)
     fail("gutDragScale", o.gutDragScale, "must be finite and >= 0");
-  if (!std::isfinite(o.kappa)) fail("kappa", o.kappa, "must be finite (< 0 selects the model's value)");
+  if (o.kappa && !(std::isfinite(*o.kappa) && *o.kappa > 0.0))
+    fail("kappa", *o.kappa, "must be finite and > 0 (unset selects the model's value)");
   for (int g = 0; g < kElementGroupCount; ++g) {
     const std::string name = groupName(static_cast<ElementGroup>(g));
     if (!std::isfinite(o.activeGainScale[at(g)]) || o.activeGainScale[at(g)] < 0.0)

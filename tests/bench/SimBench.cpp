@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,12 +20,12 @@ namespace {
 
 using test::defaultModel;
 
-// real-time factor of a breath style on the default model at time step dt [s] (0: the integrator's default),
+// real-time factor of a breath style on the default model at time step dt [s] (unset: the integrator's default),
 // after 100 settling steps (rtf is a rate over the CPU time of the loop, i.e. wall time on an idle core;
 // stepping, metrics and recording at 60 Hz are all included); one iteration is 25 steps. The recorder keeps 1 s,
 // as in `pneuma-cli bench`: its memory is then reused, the steady state of any run. While a fresh 300 s timeline
 // fills, each frame also touches new memory (14 KB; about 50 us per frame in page faults on the build machine).
-void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator, double dt) {
+void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator, std::optional<double> dt) {
   const auto model = defaultModel();
   if (!model) {
     state.SkipWithError("default model missing: build it with 'pneuma-cli model build'");
@@ -33,9 +34,10 @@ void realTimeFactor(benchmark::State& state, const std::string& style, Integrato
   SimulationOptions o;
   o.step.integrator = integrator;
   o.dt = dt;
-  o.settleTime = 100.0 * (dt > 0.0 ? dt : defaultTimeStep(integrator));
   o.recordSeconds = kTraceOnlyRecordSeconds;
-  Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle(style)), o);
+  auto controller = std::make_unique<BreathStyleController>(loadBreathStyle(style));
+  o.settleTime = 100.0 * resolveOptions(*model, o, controller->maxTimeStep()).dt;
+  Simulation sim(model, std::move(controller), o);
   const double chunk = 25.0 * sim.dt();     // [s] simulated per iteration
   double cgIterations = 0.0, frames = 0.0;  // CG iterations of the step before each output frame
   const auto sample = [&](const Simulation& s) {
@@ -82,18 +84,18 @@ const bool kRegistered = [] {
   // Euler
   struct Run {
     IntegratorKind integrator;
-    double dt;  // [s], 0 = the integrator's default
+    std::optional<double> dt;  // [s], unset: the integrator's default
     const char* style;
   };
   std::vector<Run> runs;
   for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) {
-    runs.push_back({IntegratorKind::ImplicitEulerJoints, 0.0, style});
+    runs.push_back({IntegratorKind::ImplicitEulerJoints, std::nullopt, style});
     runs.push_back({IntegratorKind::ImplicitEulerJoints, 0.01, style});
   }
-  runs.push_back({IntegratorKind::SymplecticEuler, 0.0, "calm"});
+  runs.push_back({IntegratorKind::SymplecticEuler, std::nullopt, "calm"});
   for (const Run& run : runs) {
     const std::string dtName =
-        run.dt > 0.0 ? "/dt_ms:" + std::to_string(static_cast<int>(run.dt * 1e3 + 0.5)) : "";
+        run.dt ? "/dt_ms:" + std::to_string(static_cast<int>(*run.dt * 1e3 + 0.5)) : "";
     benchmark::RegisterBenchmark(
         (std::string("RealTimeFactor/") + integratorName(run.integrator) + dtName + "/" + run.style).c_str(),
         [run](benchmark::State& st) { realTimeFactor(st, run.style, run.integrator, run.dt); })

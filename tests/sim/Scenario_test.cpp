@@ -41,7 +41,7 @@ TEST(Scenario, MinimalFileGetsDocumentedDefaults) {
   EXPECT_EQ(s.duration, 5.0);
   EXPECT_EQ(s.model, "default");
   EXPECT_EQ(s.seed, 0u);
-  EXPECT_EQ(s.outputs.outputRate, 60.0);
+  EXPECT_EQ(s.options.outputRate, 60.0);
   EXPECT_TRUE(s.outputs.csv);
   EXPECT_FALSE(s.outputs.vtk);
   EXPECT_EQ(s.options.settleTime, SimulationOptions{}.settleTime);
@@ -74,7 +74,6 @@ TEST(Scenario, OverridesReachTheSimulationOptions) {
   EXPECT_EQ(s.options.step.activeGainScale[static_cast<int>(ElementGroup::Rectus)], 1.5);
   EXPECT_EQ(s.options.step.activeGainScale[static_cast<int>(ElementGroup::Diaphragm)], 1.0);
   EXPECT_EQ(s.options.step.passiveGainScale[static_cast<int>(ElementGroup::Cartilage)], 2.0);
-  EXPECT_EQ(s.outputs.outputRate, 25.0);
   EXPECT_EQ(s.options.outputRate, 25.0);
   EXPECT_TRUE(s.outputs.vtk);
 }

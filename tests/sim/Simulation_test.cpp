@@ -74,6 +74,31 @@ TEST(Simulation, TimeStepFollowsTheControllersCapUnlessDtIsGiven) {
   EXPECT_DOUBLE_EQ(given.dt(), 0.002);
 }
 
+// unset options take the model's kappa and the integrator's dt under the controller's cap, set ones win; the
+// step measures its gut pressure with the kappa resolveOptions() reports: P = kappa (V0/V - 1), Eq. 4
+TEST(Simulation, ResolveOptionsIsTheRuleTheRunFollows) {
+  const auto model = toy();
+  SimulationOptions o;
+  EXPECT_EQ(resolveOptions(*model, o).kappa, model->gut.kappa);
+  EXPECT_EQ(resolveOptions(*model, o).dt, defaultTimeStep(o.step.integrator));
+  EXPECT_EQ(resolveOptions(*model, o, 0.004).dt, 0.004);
+  o.dt = 0.01;
+  EXPECT_EQ(resolveOptions(*model, o, 0.004).dt, 0.01);
+  o.step.kappa = 3.0 * model->gut.kappa;
+  EXPECT_EQ(resolveOptions(*model, o).kappa, 3.0 * model->gut.kappa);
+  o.step.kappa = 0.0;
+  expectError([&] { Simulation(model, calm(), o); }, "kappa");
+  for (const std::optional<double> kappa : {std::optional<double>{}, std::optional<double>{4.0 * model->gut.kappa}}) {
+    o.step.kappa = kappa;
+    Simulation sim(model, calm(), o);
+    sim.advance(0.2);
+    const Metrics& m = sim.latestMetrics();
+    ASSERT_NE(m.gutVolumeError, 0.0);
+    EXPECT_NEAR(m.gutPressure, resolveOptions(*model, o).kappa * (1.0 / (1.0 + m.gutVolumeError) - 1.0),
+                1e-9 * std::abs(m.gutPressure));
+  }
+}
+
 TEST(SimulationInput, RejectsNegativeGainsAndMasses) {
   Model bad = *toy();
   bad.elements.kac(3) = -5.0;

@@ -218,15 +218,21 @@ TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
   EXPECT_TRUE(panel->refusal().contains("not a number"));
   EXPECT_EQ(panel->settings().style.breathsPerMinute, before);
 
-  // a non-positive gut kappa is refused too (the sim would read it as "use the model's")
-  const double kappaBefore = panel->settings().options.step.kappa;
+  // the gut kappa field shows the model's own kappa while the options leave it unset (sim::resolveOptions());
+  // a non-positive one is refused, by the sim's own check
+  QLineEdit* kappa = nullptr;
   for (QLineEdit* f : panel->findChildren<QLineEdit*>())
-    if (f->property("label").toString().contains("kPa")) {
-      f->setText("-1");
-      emit f->editingFinished();
-    }
-  EXPECT_TRUE(panel->refusal().contains("must be > 0")) << panel->refusal().toStdString();
-  EXPECT_EQ(panel->settings().options.step.kappa, kappaBefore);
+    if (f->property("label").toString().contains("kPa")) kappa = f;
+  ASSERT_NE(kappa, nullptr);
+  ASSERT_FALSE(panel->settings().options.step.kappa.has_value());
+  EXPECT_EQ(kappa->text().toDouble(), 1e-3 * w.window.model()->gut.kappa);
+  kappa->setText("-1");
+  emit kappa->editingFinished();
+  EXPECT_TRUE(panel->refusal().contains("kappa: must be finite and > 0")) << panel->refusal().toStdString();
+  EXPECT_FALSE(panel->settings().options.step.kappa.has_value());
+  kappa->setText("150");
+  emit kappa->editingFinished();
+  EXPECT_EQ(panel->settings().options.step.kappa, 150e3);
 }
 
 // the toy torso is not calibrated to breathe cleanly, so the rate is measured on the default model

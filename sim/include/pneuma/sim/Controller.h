@@ -29,8 +29,8 @@ class Controller {
   virtual std::string describe() const = 0;
   /// A deep copy with the same parameters and internal state.
   virtual std::unique_ptr<Controller> clone() const = 0;
-  /// [s] The largest time step this controller is made for; a run whose dt is left to the default
-  /// (SimulationOptions::dt = 0) steps at min(defaultTimeStep(integrator), maxTimeStep()). Infinity (the
+  /// [s] The largest time step this controller is made for; a run whose dt is left unset steps at
+  /// min(defaultTimeStep(integrator), maxTimeStep()) (resolveOptions(), Simulation.h). Infinity (the
   /// default) when any step will do; a feedback controller tuned against the plant at a given step says so.
   virtual double maxTimeStep() const { return std::numeric_limits<double>::infinity(); }
 

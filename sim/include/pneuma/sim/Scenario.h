@@ -35,9 +35,8 @@ enum class ControllerKind { Style, Affect, Pattern };
 /// Stable names "style", "affect", "pattern".
 const char* controllerKindName(ControllerKind k);
 
-/// Which files a run writes.
+/// Which files a run writes (at SimulationOptions::outputRate, the file's outputs.output_rate_hz).
 struct ScenarioOutputs {
-  double outputRate = 60.0;  ///< [Hz] frames per simulated second in CSV/plots/VTK, > 0
   bool csv = true;           ///< timeseries.csv
   bool plots = true;         ///< PNG + SVG plots
   bool vtk = false;          ///< .pvd series of .vtp frames
@@ -53,7 +52,7 @@ struct Scenario {
   ControllerKind controller = ControllerKind::Style;
   std::string controllerName;       ///< Style: preset name; Affect: affect name; Pattern: pattern file path ("" when inline)
   std::string patternText;          ///< Pattern given inline: the pattern file's JSON text ("" otherwise)
-  SimulationOptions options;        ///< overrides: step options, dt, settle time (outputRate mirrors outputs.outputRate)
+  SimulationOptions options;        ///< overrides: step options, dt, settle time; outputs.output_rate_hz
   ScenarioOutputs outputs;
 };
 

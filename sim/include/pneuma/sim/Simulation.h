@@ -12,7 +12,9 @@
 #include <atomic>
 #include <functional>
 #include <istream>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -28,12 +30,23 @@ namespace pneuma::sim {
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
   StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
-  double dt = 0.0;          ///< [s] time step in kTimeStepRange; 0 = defaultTimeStep(step.integrator), or the
-                            ///< controller's maxTimeStep() when smaller
+  std::optional<double> dt;     ///< [s] time step in kTimeStepRange; unset: resolveOptions() picks it
   double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange
   double outputRate = 60.0;     ///< [Hz] metrics and recording rate, in kOutputRateRange
   double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
 };
+
+/// What a run takes where its options leave the choice to the model, the integrator or the controller.
+struct ResolvedOptions {
+  double kappa = 0.0;  ///< [Pa] gut bulk modulus of Eq. 4: effectiveKappa(), StepOptions::kappa else Model::gut.kappa
+  double dt = 0.0;     ///< [s] SimulationOptions::dt, else min(defaultTimeStep(integrator), maxTimeStep)
+};
+
+/// The one place where unset options get their values: the Simulation, the CLI (simulate, bench) and the app's
+/// parameter panel all call it. `maxTimeStep` [s] is the controller's Controller::maxTimeStep() (infinity for
+/// an open-loop controller): a feedback controller tuned at a step caps the default one, never a given dt.
+ResolvedOptions resolveOptions(const Model& model, const SimulationOptions& options,
+                               double maxTimeStep = std::numeric_limits<double>::infinity());
 
 /// [-] most frames Simulation::trace() holds (9.1 min at 60 Hz, about 10 MB): beyond it the trace keeps every
 /// other frame and from then on records every 2nd (4th, ...) one, so a long run's memory stays bounded and
@@ -45,7 +58,7 @@ inline constexpr std::size_t kMaxTraceFrames = std::size_t{1} << 15;
 /// "Performance").
 inline constexpr double kTraceOnlyRecordSeconds = 1.0;
 
-/// @throws Error naming the field and value: dt neither 0 nor in kTimeStepRange, settleTime outside
+/// @throws Error naming the field and value: dt set and outside kTimeStepRange, settleTime outside
 ///         kSettleTimeRange, outputRate outside kOutputRateRange (Limits.h), recordSeconds < 0, bad step
 ///         options.
 void validateSimulationOptions(const SimulationOptions& o);

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,7 +50,7 @@ struct StepOptions {
   bool gravity = true;                ///< apply Model::gravity to bodies and nodes
   double jointFrictionScale = 1.0;    ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
   double gutDragScale = 1.0;          ///< [-] multiplies the visceral drag Model::gut.drag; 0 = none
-  double kappa = -1.0;                ///< [Pa] gut bulk modulus of Eq. 4; < 0 uses Model::gut.kappa
+  std::optional<double> kappa;        ///< [Pa] gut bulk modulus of Eq. 4, > 0; unset: Model::gut.kappa
   std::array<double, kElementGroupCount> activeGainScale{1, 1, 1, 1, 1, 1};   ///< [-] multiplies kac per group
   std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kpe and b per group
   int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
@@ -63,6 +64,10 @@ struct StepOptions {
   double cgTolerance = 1e-2;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm);
                                       ///< 1e-2 changes validate figures by at most 0.3 % against 1e-4 (docs/cli.md)
 };
+
+/// [Pa] The gut's bulk modulus kappa of Eq. 4 a step uses: StepOptions::kappa when set, else Model::gut.kappa.
+/// The one rule for it; resolveOptions() (Simulation.h) reports it with the time step to the CLI and the app.
+inline double effectiveKappa(const Model& model, const StepOptions& o) { return o.kappa.value_or(model.gut.kappa); }
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
 /// @throws Error naming the field and value.

@@ -114,7 +114,7 @@ struct TrackingStats {
 /// settles within the level.
 /// The first group's baseline is V_rest. 5 x 9 s of simulated time, about 8 s of wall time on the
 /// default model.
-/// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run; a dt of 0
+/// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run; an unset dt
 ///                 steps at kDriveTimeStep, as the drive itself
 /// @param stop     checked before every step (Simulation::setStopFlag()); may be null
 /// @throws Interrupted when `*stop` became true before the calibration finished.

@@ -1,0 +1,57 @@
+#pragma once
+/// @file DocumentController.h
+/// What the window shows, as files: the open model (its directory) and the run settings' scenario files. Reading
+/// checks everything before anything changes: a model is loaded and a simulation of it made with the settings, a
+/// scenario's style and options are read, and only then does the caller adopt them. Saving writes a scenario that
+/// names an unedited style preset, or an edited style as its own preset file beside the scenario.
+
+#include "gui/SimWorker.h"
+
+#include <QString>
+
+#include <memory>
+
+namespace pneuma::app {
+
+class DocumentController {
+ public:
+  /// A model read from disk with a simulation of it, not adopted yet.
+  struct OpenedModel {
+    std::shared_ptr<const sim::Model> model;
+    std::unique_ptr<sim::Simulation> simulation;  ///< a breath-style run of the settings it was opened with
+    QString dir;                                  ///< absolute
+  };
+  /// A scenario read from disk: the settings it asks for and its model's directory.
+  struct OpenedScenario {
+    QString name;
+    RunSettings settings;
+    QString modelDir;
+  };
+
+  /// The directory of the default model: sim::defaultModelDir() ($PNEUMA_MODEL_DIR, else
+  /// <bindir>/../share/pneuma/models/default).
+  static QString defaultModelDir();
+
+  /// Loads the model in `dir` and makes a simulation of it under `settings`.
+  /// @throws std::exception naming the problem ("Cannot open model '<dir>': ...").
+  static OpenedModel readModel(const QString& dir, const RunSettings& settings);
+  /// Reads the scenario at `path`: its breath style and options (recordSeconds kept from `current`), its model.
+  /// @throws std::exception naming the problem; the app plays breath-style scenarios only.
+  static OpenedScenario readScenario(const QString& path, const RunSettings& current);
+
+  /// The adopted model and its directory (null and empty before the first one).
+  const std::shared_ptr<const sim::Model>& model() const { return m_model; }
+  const QString& modelDir() const { return m_modelDir; }
+  /// Makes `opened` the document's model (its simulation is left to the caller).
+  void adopt(const OpenedModel& opened);
+
+  /// Writes `settings` and the model as the scenario `path` (60 s, a breath style); an edited style goes beside
+  /// it as "<stem>.style.json". @throws std::exception naming the file.
+  void saveScenario(const QString& path, const RunSettings& settings) const;
+
+ private:
+  std::shared_ptr<const sim::Model> m_model;
+  QString m_modelDir;
+};
+
+}  // namespace pneuma::app

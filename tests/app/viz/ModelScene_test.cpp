@@ -1,0 +1,92 @@
+// The 3D scene (viz::ModelScene) draws the posed model: after update(), each bone's actor carries its body's pose
+// [R x], and the drawn points (every actor's data through its matrix) hold every gut node, both ends of every
+// element and every cavity vertex where the state puts them, none left at rest.
+#include "VizTestSupport.h"
+#include "viz/ModelScene.h"
+
+#include <gtest/gtest.h>
+#include <vtkActor.h>
+#include <vtkActorCollection.h>
+#include <vtkDataSet.h>
+#include <vtkMapper.h>
+#include <vtkMatrix4x4.h>
+#include <vtkRenderer.h>
+
+#include <limits>
+#include <vector>
+
+namespace pneuma {
+namespace {
+
+using Eigen::Vector3d;
+
+// the points of every actor's data in world coordinates, and the actors' matrices
+void drawn(vtkRenderer* renderer, std::vector<Vector3d>& points, std::vector<Eigen::Matrix4d>& matrices) {
+  vtkActorCollection* actors = renderer->GetActors();
+  actors->InitTraversal();
+  while (vtkActor* actor = actors->GetNextActor()) {
+    vtkMapper* mapper = actor->GetMapper();
+    if (!mapper) continue;
+    mapper->Update();
+    vtkDataSet* data = mapper->GetInput();
+    Eigen::Matrix4d m;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) m(i, j) = actor->GetMatrix()->GetElement(i, j);
+    matrices.push_back(m);
+    for (vtkIdType k = 0; data && k < data->GetNumberOfPoints(); ++k) {
+      double p[3];
+      data->GetPoint(k, p);
+      points.push_back((m * Eigen::Vector4d(p[0], p[1], p[2], 1.0)).head<3>());
+    }
+  }
+}
+
+double nearest(const std::vector<Vector3d>& points, const Vector3d& x) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vector3d& p : points) best = std::min(best, (p - x).squaredNorm());
+  return std::sqrt(best);
+}
+
+TEST(ModelScene, ActorsAreAtThePosedPositions) {
+  const sim::Model model = sim::test::makeToyTorso(2);
+  viz::ModelScene scene;
+  scene.setModel(model, "");
+  viz::DisplayOptions all = scene.options();
+  all.showCavity = true;
+  scene.setOptions(all);
+  const sim::State s = test::posedState(model, 3);
+  scene.update(s, test::someMetrics(model, s, 3));
+
+  std::vector<Vector3d> points;
+  std::vector<Eigen::Matrix4d> matrices;
+  drawn(scene.renderer(), points, matrices);
+  const double tol = 1e-6;  // [m] VTK keeps points in single precision
+
+  // each bone is drawn with its body's pose
+  for (int b = 0; b < model.bodies.size(); ++b) {
+    Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+    pose.topLeftCorner<3, 3>() = s.bodyOrientation[static_cast<std::size_t>(b)].toRotationMatrix();
+    pose.topRightCorner<3, 1>() = s.bodyPosition.col(b);
+    double best = std::numeric_limits<double>::infinity();
+    for (const Eigen::Matrix4d& m : matrices) best = std::min(best, (m - pose).norm());
+    EXPECT_LT(best, 1e-12) << "body " << b;
+  }
+  // gut nodes, element ends and cavity vertices where the state puts them
+  for (int i = 0; i < model.nodes.size(); ++i) EXPECT_LT(nearest(points, s.nodePosition.col(i)), tol) << "node " << i;
+  Eigen::Matrix3Xd a, b, cavity;
+  sim::anchorPositions(model.elements.endA, s, a);
+  sim::anchorPositions(model.elements.endB, s, b);
+  for (int e = 0; e < model.elements.size(); ++e) {
+    EXPECT_LT(nearest(points, a.col(e)), tol) << "element " << e << " end A";
+    EXPECT_LT(nearest(points, b.col(e)), tol) << "element " << e << " end B";
+  }
+  sim::anchorPositions(model.cavity.vertices, s, cavity);
+  for (Eigen::Index i = 0; i < cavity.cols(); ++i) EXPECT_LT(nearest(points, cavity.col(i)), tol) << "cavity " << i;
+  // and nothing of the moved nodes is left at its rest position
+  int atRest = 0;
+  for (int i = 0; i < model.nodes.size(); ++i) atRest += nearest(points, model.nodes.rest.col(i)) < tol;
+  EXPECT_EQ(atRest, 0);
+}
+
+}  // namespace
+}  // namespace pneuma
