@@ -73,6 +73,17 @@ void applyIntegrator(const std::string& name, sim::IntegratorKind& kind) {
     fail(kExitBadInput, "--integrator: unknown integrator '" + name + "' (valid: " + sim::integratorNames() + ")");
 }
 
+void addPostureOption(CLI::App& cmd, std::string& name) {
+  cmd.add_option("--posture", name,
+                 "Gravity relative to the body: one of " + sim::postureNames() + " (default " +
+                     sim::postureName(sim::StepOptions{}.posture) + ")");
+}
+
+void applyPosture(const std::string& name, sim::Posture& posture) {
+  if (!name.empty() && !sim::postureFromName(name, posture))
+    fail(kExitBadInput, "--posture: unknown posture '" + name.substr(0, 60) + "' (valid: " + sim::postureNames() + ")");
+}
+
 }  // namespace pneuma::app
 
 namespace pneuma::app {

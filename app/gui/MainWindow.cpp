@@ -579,6 +579,18 @@ QString MainWindow::setBreathStyle(const QString& name) {
   return {};
 }
 
+QString MainWindow::setPosture(const QString& name) {
+  if (!sim::postureFromName(name.toStdString(), m_settings.options.step.posture)) {
+    const QString error =
+        QString("unknown posture '%1' (valid: %2)").arg(name.left(60), QString::fromStdString(sim::postureNames()));
+    report("Unknown posture", error);
+    return error;
+  }
+  m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
+  if (m_worker) m_worker->requestSettings(m_settings);
+  return {};
+}
+
 QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
   if (m_affectCombo->findText(name) < 0) {
     QStringList valid;

@@ -51,6 +51,9 @@ class MainWindow : public QMainWindow {
   QString saveScenario(const QString& path);
   /// Selects a breath style preset by name ("calm", "deep", "panting", "forced-exhale").
   QString setBreathStyle(const QString& name);
+  /// Selects the posture by name (sim::postureNames()); a new posture restarts the run, which settles in it.
+  /// @return empty, or the error (an unknown name lists the valid ones).
+  QString setPosture(const QString& name);
 
   void play();
   void pause();

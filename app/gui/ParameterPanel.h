@@ -1,7 +1,7 @@
 #pragma once
 /// @file ParameterPanel.h
 /// The parameter panel: breathing frequency, contraction ratios r, gain scales, gut kappa, joint
-/// friction and gravity. Each edit is checked with the sim's own validators before anything is applied;
+/// friction, gravity and the posture (a combo box of sim::postureNames()). Each edit is checked with the sim's own validators before anything is applied;
 /// an invalid value stays in its field, marked red, with the validator's reason shown under the panel.
 
 #include "gui/SimWorker.h"
@@ -12,6 +12,7 @@
 #include <vector>
 
 class QCheckBox;
+class QComboBox;
 class QLabel;
 class QLineEdit;
 
@@ -31,6 +32,8 @@ class ParameterPanel : public QWidget {
   QString refusal() const;
   /// The field editing the breathing frequency [breaths/min] (for tests and shortcuts).
   QLineEdit* frequencyField() const { return m_fields.front().edit; }
+  /// The posture combo box (for tests).
+  QComboBox* postureBox() const { return m_posture; }
 
  signals:
   /// A valid edit: apply at the next sync point.
@@ -52,6 +55,7 @@ class ParameterPanel : public QWidget {
   double m_modelKappa = 0.0;  // [Pa]
   std::vector<Field> m_fields;
   QCheckBox* m_gravity = nullptr;
+  QComboBox* m_posture = nullptr;
   QLabel* m_reason = nullptr;
 };
 

@@ -27,7 +27,7 @@ namespace pneuma::sim {
 
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
-  StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
+  StepOptions step;             ///< integrator, gravity and posture, friction scale, kappa override, gain scales
   double dt = 0.0;          ///< [s] time step in kTimeStepRange; 0 = defaultTimeStep(step.integrator), or the
                             ///< controller's maxTimeStep() when smaller
   double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange
@@ -103,7 +103,7 @@ class Simulation {
   void save(std::ostream& out) const;
   /// Reads what save() wrote and restore()s it; the controller state is read into a copy of the current
   /// controller. @throws Error naming `source` and the field when the data is not a checkpoint of this model,
-  /// dt or controller.
+  /// dt, posture or controller.
   void load(std::istream& in, const std::string& source = "checkpoint");
 
   const Model& model() const { return *m_model; }
