@@ -116,7 +116,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
 
   m_messageTimer = new QTimer(this);
   m_messageTimer->setSingleShot(true);
-  connect(m_messageTimer, &QTimer::timeout, this, [this] { m_statusModel->setText(m_modelText); });
+  connect(m_messageTimer, &QTimer::timeout, this, [this] { m_statusModel->setText(modelStatus()); });
 
   m_refresh = new QTimer(this);
   m_refresh->setInterval(kRefreshMs);
@@ -388,6 +388,7 @@ void MainWindow::buildDocks() {
     m_settings = s;
     m_plots->setBreathPeriod(60.0 / s.style.breathsPerMinute);
     if (m_worker) m_worker->requestSettings(s);
+    showPosture();
   });
 
   auto* tabs = new QTabWidget(this);
@@ -430,6 +431,15 @@ void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
   m_view->renderWindow()->Render();
 }
 
+QString MainWindow::modelStatus() const {
+  if (!m_model) return m_modelText;
+  return m_modelText + QString(", posture %1").arg(sim::postureName(m_settings.options.step.posture));
+}
+
+void MainWindow::showPosture() {
+  if (!m_messageTimer->isActive()) m_statusModel->setText(modelStatus());
+}
+
 void MainWindow::showMessage(const QString& text, int milliseconds) {
   m_statusModel->setText(text);
   m_messageTimer->start(milliseconds);
@@ -470,7 +480,7 @@ QString MainWindow::openModel(const QString& dir) {
                     .arg(model->bodies.size())
                     .arg(model->elements.size())
                     .arg(model->nodes.size());
-  m_statusModel->setText(m_modelText);
+  m_statusModel->setText(modelStatus());
   setWindowTitle(QString("Pneuma \u2014 %1").arg(QString::fromStdString(model->name)));
 
   if (!m_worker) {
@@ -588,6 +598,7 @@ QString MainWindow::setPosture(const QString& name) {
   }
   m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
   if (m_worker) m_worker->requestSettings(m_settings);
+  showPosture();
   return {};
 }
 

@@ -118,6 +118,10 @@ class MainWindow : public QMainWindow {
   void report(const QString& title, const QString& message);
   /// Shows `text` in the status bar for a while, then the model line again.
   void showMessage(const QString& text, int milliseconds);
+  /// The status bar's model text with the run's posture ("Model: ... , posture supine").
+  QString modelStatus() const;
+  /// Shows modelStatus() now unless a message is on show (it comes back when the message ends).
+  void showPosture();
   void select(const viz::Pick& pick);
   QString modelDirFor(const std::string& scenarioModel) const;
   void exportPlotInteractive(const PlotView* plot);

@@ -11,7 +11,9 @@
 
 #include <QComboBox>
 #include <QFile>
+#include <QLabel>
 #include <QLineEdit>
+#include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
 #include <gtest/gtest.h>
@@ -321,6 +323,10 @@ TEST(MainWindow, PostureBoxRestartsTheRunWithGravityTurned) {
   const Eigen::Vector3d supine = shownGutSag(w.window);
   EXPECT_LT(supine.y(), 0.0);
   EXPECT_GT(-supine.y(), 3.0 * std::abs(supine.z()));
+  bool isStated = false;  // the status bar says which posture runs
+  for (const QLabel* label : w.window.statusBar()->findChildren<QLabel*>())
+    isStated = isStated || label->text().endsWith(", posture supine");
+  EXPECT_TRUE(isStated);
 
   const QString error = w.window.setPosture("sitting");
   EXPECT_EQ(error.toStdString(),
