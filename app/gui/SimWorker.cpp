@@ -123,6 +123,11 @@ void SimWorker::sync() {
   // a new posture turns gravity: the run starts over from the rest pose and settles in it
   const bool isNewPosture = p.settings && p.settings->options.step.posture != m_settings.options.step.posture;
   if (p.settings) applySettings(*p.settings);
+  if (isNewPosture && m_pattern) {
+    // an affect's drive was calibrated in the old posture: back to the breath style until one is pushed again
+    m_sim->setController(std::make_unique<sim::BreathStyleController>(m_settings.style));
+    m_pattern = nullptr;
+  }
   if (p.doReset || isNewPosture) {
     m_sim->reset();
     m_runUntil = -1.0;

@@ -446,6 +446,12 @@ TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   // the target is defined once control starts after settling
   EXPECT_TRUE(std::isfinite(volume->series()[1].y.back()));
   EXPECT_GT(volume->series()[1].y.back(), 0.0);
+  // a new posture restarts the run with the breath style: the affect's drive was calibrated upright
+  ASSERT_EQ(window.setPosture("supine"), QString());
+  ASSERT_TRUE(window.runUntil(3.0)) << window.lastError().toStdString();
+  EXPECT_NEAR(window.shown()->state.time, 3.0, 0.05);
+  const auto& series = window.plots()->volumePlot()->series();
+  EXPECT_TRUE(series.size() < 2 || series[1].y.empty() || !std::isfinite(series[1].y.back()));
 }
 
 TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
