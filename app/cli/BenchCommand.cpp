@@ -115,7 +115,8 @@ void runBench(const BenchArgs& args) {
   j["simulated_seconds"] = args.seconds;
   std::printf("model %s: %d bodies, %d nodes, %d elements; %s, %s, dt = %g s, %g s simulated per row\n\n",
               model->name.c_str(), model->bodies.size(), model->nodes.size(), model->elements.size(),
-              sim::integratorName(options.step.integrator), sim::postureName(options.step.posture), dt, args.seconds);
+              sim::integratorName(options.step.integrator), sim::postureName(options.step.posture), dt,
+              args.seconds);
 
   // real-time factor per breath style
   std::printf("%-16s %18s %16s\n", "breath style", "real-time factor", "step time [ms]");

@@ -70,15 +70,18 @@ std::string choiceHelp(const std::string& what, const std::string& names, const 
 }
 
 // "<flag>: unknown <kind> 'value' (valid: a, b)", exit 2
-[[noreturn]] void failUnknown(const char* flag, const char* kind, const std::string& value, const std::string& names) {
-  fail(kExitBadInput, std::string(flag) + ": unknown " + kind + " '" + value.substr(0, 60) + "' (valid: " + names + ")");
+[[noreturn]] void failUnknown(const char* flag, const char* kind, const std::string& value,
+                              const std::string& names) {
+  fail(kExitBadInput,
+       std::string(flag) + ": unknown " + kind + " '" + value.substr(0, 60) + "' (valid: " + names + ")");
 }
 
 }  // namespace
 
 void addIntegratorOption(CLI::App& cmd, std::string& name) {
   cmd.add_option("--integrator", name,
-                 choiceHelp("Time integration scheme", sim::integratorNames(), sim::integratorName(sim::StepOptions{}.integrator)));
+                 choiceHelp("Time integration scheme", sim::integratorNames(),
+                            sim::integratorName(sim::StepOptions{}.integrator)));
 }
 
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind) {
@@ -93,7 +96,8 @@ void addPostureOption(CLI::App& cmd, std::string& name) {
 }
 
 void applyPosture(const std::string& name, sim::Posture& posture) {
-  if (!name.empty() && !sim::postureFromName(name, posture)) failUnknown("--posture", "posture", name, sim::postureNames());
+  if (!name.empty() && !sim::postureFromName(name, posture))
+    failUnknown("--posture", "posture", name, sim::postureNames());
 }
 
 }  // namespace pneuma::app

@@ -591,8 +591,8 @@ QString MainWindow::setBreathStyle(const QString& name) {
 
 QString MainWindow::setPosture(const QString& name) {
   if (!sim::postureFromName(name.toStdString(), m_settings.options.step.posture)) {
-    const QString error =
-        QString("unknown posture '%1' (valid: %2)").arg(name.left(60), QString::fromStdString(sim::postureNames()));
+    const QString error = QString("unknown posture '%1' (valid: %2)")
+                              .arg(name.left(60), QString::fromStdString(sim::postureNames()));
     report("Unknown posture", error);
     return error;
   }

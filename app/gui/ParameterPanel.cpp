@@ -75,8 +75,9 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
   // the names in sim's order; a new posture restarts the run (SimWorker), which settles in it
   m_posture = new QComboBox;
   m_posture->addItems(QString::fromStdString(sim::postureNames()).split(", "));
-  m_posture->setToolTip("Direction of gravity relative to the body: upright (seated, the paper's subject), supine "
-                        "(lying on the back), prone, left- or right-lateral. A change restarts the run.");
+  m_posture->setToolTip(
+      "Direction of gravity relative to the body: upright (seated, the paper's subject), supine "
+      "(lying on the back), prone, left- or right-lateral. A change restarts the run.");
   connect(m_posture, &QComboBox::textActivated, this, [this](const QString& name) {
     if (!sim::postureFromName(name.toStdString(), m_settings.options.step.posture)) return;
     emit settingsEdited(m_settings);

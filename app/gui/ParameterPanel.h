@@ -1,8 +1,9 @@
 #pragma once
 /// @file ParameterPanel.h
 /// The parameter panel: breathing frequency, contraction ratios r, gain scales, gut kappa, joint
-/// friction, gravity and the posture (a combo box of sim::postureNames()). Each edit is checked with the sim's own validators before anything is applied;
-/// an invalid value stays in its field, marked red, with the validator's reason shown under the panel.
+/// friction, gravity and the posture (a combo box of sim::postureNames()). Each edit is checked with the
+/// sim's own validators before anything is applied; an invalid value stays in its field, marked red, with the
+/// validator's reason shown under the panel.
 
 #include "gui/SimWorker.h"
 

@@ -74,8 +74,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption affect("affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).",
                                   "NAME");
   const QCommandLineOption posture(
-      "posture", QString::fromStdString("Gravity relative to the body: " + pneuma::sim::postureNames() + " (default " +
-                                        pneuma::sim::postureName(pneuma::sim::StepOptions{}.posture) + ")."),
+      "posture",
+      QString::fromStdString("Gravity relative to the body: " + pneuma::sim::postureNames() + " (default " +
+                             pneuma::sim::postureName(pneuma::sim::StepOptions{}.posture) + ")."),
       "NAME");
   const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.", "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",

@@ -68,8 +68,8 @@ void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
 }
 
 void parseOverrides(const Field& o, SimulationOptions& opt) {
-  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "posture", "joint_friction_scale", "gut_drag_scale",
-               "kappa_pa", "active_gain_scale", "passive_gain_scale"});
+  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "posture", "joint_friction_scale",
+               "gut_drag_scale", "kappa_pa", "active_gain_scale", "passive_gain_scale"});
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
     if (!integratorFromName(name, opt.step.integrator))

@@ -198,8 +198,7 @@ void accumulateGravityAndGyroscopic(const Model& model, const State& s, const St
     w.scratch.bodyTorque.col(b) -= om.cross(r * (model.bodies.inertia[at(b)] * (r.transpose() * om)));
   }
   if (o.gravity) {
-    for (int n = 0; n < model.nodes.size(); ++n)
-      w.scratch.nodeForce.col(n) += model.nodes.mass(n) * g;
+    for (int n = 0; n < model.nodes.size(); ++n) w.scratch.nodeForce.col(n) += model.nodes.mass(n) * g;
   }
 }
 

@@ -50,7 +50,9 @@ bool valueIn(const std::pair<E, const char*> (&table)[N], const std::string& nam
 
 const char* integratorName(IntegratorKind k) { return nameIn(kIntegratorNames, k); }
 std::string integratorNames() { return namesIn(kIntegratorNames); }
-bool integratorFromName(const std::string& name, IntegratorKind& out) { return valueIn(kIntegratorNames, name, out); }
+bool integratorFromName(const std::string& name, IntegratorKind& out) {
+  return valueIn(kIntegratorNames, name, out);
+}
 
 const char* postureName(Posture p) { return nameIn(kPostureNames, p); }
 std::string postureNames() { return namesIn(kPostureNames); }

@@ -158,8 +158,8 @@ INSTANTIATE_TEST_SUITE_P(EveryStyle, BreathStyleRestart,
                            return n;
                          });
 
-// lying on the back (gravity posterior, StepOptions::posture): the file carries the posture and the run goes on
-// bit-identically
+// lying on the back (gravity posterior, StepOptions::posture): the file carries the posture and the run goes
+// on bit-identically
 TEST(ExactRestart, SupineCalmContinuesBitIdentically) {
   REQUIRE_DEFAULT_MODEL();
   SimulationOptions supine = runOptions();
@@ -225,13 +225,15 @@ TEST(ExactRestart, LoadRefusesAnotherTimeStep) {
   expectLoadError(other, savedCalmRun(0.1), "run.ckpt: checkpoint field 'simulation.dt'");
 }
 
-// a run saved upright does not continue lying down (gravity would turn at the restart), and the message names both
+// a run saved upright does not continue lying down (gravity would turn at the restart), and the message names
+// both
 TEST(ExactRestart, LoadRefusesAnotherPosture) {
   REQUIRE_DEFAULT_MODEL();
   SimulationOptions supine = runOptions();
   supine.step.posture = Posture::Supine;
-  expectLoadError(supine, savedCalmRun(0.1),
-                  "run.ckpt: checkpoint field 'simulation.posture': saved in posture 'upright', this run is supine");
+  expectLoadError(
+      supine, savedCalmRun(0.1),
+      "run.ckpt: checkpoint field 'simulation.posture': saved in posture 'upright', this run is supine");
 }
 
 // a damaged file fails with an Error naming the field, before anything is changed

@@ -204,9 +204,9 @@ TEST(PleuralPressure, ForceIsMinusTheGradientOfTheRecoilEnergy) {
 namespace pneuma::sim {
 namespace {
 
-// the posture turns gravity into the body frame (postureGravity()): each posture pulls every free node and body
-// with m g along its own axis (supine posteriorly, -y), and the gravity energy of computeMetrics() is the
-// potential of that force (its finite-difference gradient on a displaced node equals minus the force)
+// the posture turns gravity into the body frame (postureGravity()): each posture pulls every free node and
+// body with m g along its own axis (supine posteriorly, -y), and the gravity energy of computeMetrics() is
+// the potential of that force (its finite-difference gradient on a displaced node equals minus the force)
 TEST(Posture, GravityPointsAlongThePostureAxisAndIsTheGradientOfItsEnergy) {
   const Model toy = test::makeToyTorso();
   const double g = toy.gravity.norm();

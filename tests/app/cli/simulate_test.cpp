@@ -217,7 +217,8 @@ TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
   EXPECT_NEAR(s["simulated_time_s"].get<double>(), 2.5, 1e-6);
   EXPECT_EQ(s["frames"].get<int>(), 25);
   EXPECT_FALSE(fs::exists(out + "/lung_volume.png"));  // plots off in the scenario
-  r = runCli({"simulate", "--scenario", file, "--duration", "0.5", "--posture", "upright", "--force", "--out", out});
+  r = runCli(
+      {"simulate", "--scenario", file, "--duration", "0.5", "--posture", "upright", "--force", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   s = nlohmann::json::parse(slurp(out + "/summary.json"));
   EXPECT_EQ(s["posture"], "upright");  // the command line wins

@@ -27,7 +27,7 @@ namespace pneuma::sim {
 
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
-  StepOptions step;             ///< integrator, gravity and posture, friction scale, kappa override, gain scales
+  StepOptions step;         ///< integrator, gravity and posture, friction scale, kappa override, gain scales
   double dt = 0.0;          ///< [s] time step in kTimeStepRange; 0 = defaultTimeStep(step.integrator), or the
                             ///< controller's maxTimeStep() when smaller
   double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange

@@ -45,7 +45,8 @@ double defaultTimeStep(IntegratorKind k);
 
 /// The body's posture: which way gravity points in the body (model) frame, RAS (+x right, +y anterior,
 /// +z superior). The model's rest pose is built upright and Model::gravity is the upright gravity; another
-/// posture turns it (postureGravity()), and the settling phase lets the viscera and the dome find their new rest.
+/// posture turns it (postureGravity()), and the settling phase lets the viscera and the dome find their new
+/// rest.
 ///   upright        gravity -z (caudal): the paper's seated subject (the default)
 ///   supine         gravity -y (posterior): lying on the back
 ///   prone          gravity +y (anterior): lying on the front
@@ -82,10 +83,10 @@ struct StepOptions {
                                       ///< 1e-2 changes validate figures by at most 0.3 % against 1e-4 (docs/cli.md)
 };
 
-/// [m/s^2] The gravity a run applies, in the body frame: zero when `o.gravity` is off, else Model::gravity (the
-/// upright gravity) turned by a quarter turn for the lying postures, g = R(o.posture) Model::gravity: supine
-/// R_x(-90 deg), prone R_x(+90 deg), left-lateral R_y(+90 deg), right-lateral R_y(-90 deg). The one rule every
-/// reader of gravity uses (the step's forces, the gravity energy of computeMetrics()).
+/// [m/s^2] The gravity a run applies, in the body frame: zero when `o.gravity` is off, else Model::gravity
+/// (the upright gravity) turned by a quarter turn for the lying postures, g = R(o.posture) Model::gravity:
+/// supine R_x(-90 deg), prone R_x(+90 deg), left-lateral R_y(+90 deg), right-lateral R_y(-90 deg). The one
+/// rule every reader of gravity uses (the step's forces, the gravity energy of computeMetrics()).
 Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o);
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
