@@ -116,6 +116,7 @@ void writeMotion(const sim::Motion& m, nlohmann::json& j) {
   j["xiphoid_cranial_mm"] = jsonNumber(m.xiphoidCranial * kMm);
   j["lower_rib_expansion_mm"] = jsonNumber(m.lowerRibExpansion * kMm);
   j["umbilicus_anterior_mm"] = jsonNumber(m.umbilicusAnterior * kMm);
+  j["umbilicus_anterior_min_mm"] = jsonNumber(m.umbilicusAnteriorMin * kMm);
   j["rib_cage_tidal_ml"] = jsonNumber(m.ribCageTidal * kMl);
   j["abdomen_tidal_ml"] = jsonNumber(m.abdomenTidal * kMl);
   j["rib_cage_fraction"] = jsonNumber(m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal));

@@ -39,7 +39,8 @@ RunRecord::RunRecord(const sim::Model& model, bool hasVolumeTarget, const std::s
 
 void RunRecord::writeCsvHeader() {
   std::ostringstream csv;
-  csv << "time [s],lung_volume [mL],gut_volume_error [%],rib_cage_volume [mL],abdomen_volume [mL]";
+  csv << "time [s],lung_volume [mL],gut_volume_error [%],rib_cage_volume [mL],abdomen_volume [mL],"
+         "right_lung_volume [mL],left_lung_volume [mL],thoracic_cavity_volume [mL]";
   for (int g = 0; g < sim::kElementGroupCount; ++g)
     if (sim::isMuscleGroup(group(g))) csv << "," << sim::groupName(group(g)) << ".r [-]," << sim::groupName(group(g)) << ".alpha [-]";
   for (int g = 0; g < sim::kElementGroupCount; ++g) csv << "," << sim::groupName(group(g)) << ".mean_tension [N]";
@@ -66,7 +67,8 @@ void RunRecord::append(const sim::Metrics& m, double targetFraction, double meas
   std::ostringstream csv;
   csv << formatNumber(t) << "," << formatNumber(m.lungVolume * kMl) << ","
       << formatNumber(m.gutVolumeError * kPct) << "," << formatNumber((m.lungVolume - m.abdomenVolume) * kMl)
-      << "," << formatNumber(m.abdomenVolume * kMl);
+      << "," << formatNumber(m.abdomenVolume * kMl) << "," << formatNumber(m.rightLungVolume * kMl) << ","
+      << formatNumber(m.leftLungVolume * kMl) << "," << formatNumber(m.thoracicCavityVolume * kMl);
   for (int g = 0; g < sim::kElementGroupCount; ++g)
     if (sim::isMuscleGroup(group(g)))
       csv << "," << formatNumber(m.activations[static_cast<std::size_t>(g)].r) << ","
@@ -100,9 +102,9 @@ std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std
   };
   std::vector<double> t, v;
 
-  viz::Plot lung("Lung-cavity volume (" + runLabel + ")", "time [s]", "lung-cavity volume [mL]");
+  viz::Plot lung("Lung volume (" + runLabel + ")", "time [s]", "lung volume [mL]");
   curve(m_lungVolume, kMl, t, v);
-  lung.addSeries("lung-cavity volume", t, v);
+  lung.addSeries("lung volume", t, v);
   save(lung, "lung_volume");
 
   viz::Plot gut("Gut volume error (" + runLabel + ")", "time [s]", "gut volume error (V - V0)/V0 [%]");

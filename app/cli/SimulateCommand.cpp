@@ -233,6 +233,13 @@ void runSimulate(const SimulateArgs& args) {
   j["cycles"] = sum.cycles;
   j["end_expiratory_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * 1e6) : none;
   j["end_inspiratory_volume_ml"] = ran ? jsonNumber(sum.endInspiratoryVolume * 1e6) : none;
+  // the lungs' parts at end-expiration: the right/left split of the latest frame, the constant mediastinum
+  const sim::Metrics* latest = ran ? &simulation->latestMetrics() : nullptr;
+  const double rightShare = latest != nullptr ? latest->rightLungVolume / latest->lungVolume : sim::kNaN;
+  j["end_expiratory_right_lung_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * rightShare * 1e6) : none;
+  j["end_expiratory_left_lung_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * (1.0 - rightShare) * 1e6) : none;
+  j["end_expiratory_thoracic_cavity_volume_ml"] =
+      ran ? jsonNumber((sum.endExpiratoryVolume + model->lungs.mediastinumVolume) * 1e6) : none;
   j["max_gut_volume_error_pct"] = ran ? jsonNumber(sum.maxGutVolumeError * 100.0) : none;
   j["mean_gut_volume_error_pct"] = ran ? jsonNumber(sum.meanGutVolumeError * 100.0) : none;
   writeMotion(sum.motion, j);

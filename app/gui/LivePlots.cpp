@@ -41,7 +41,7 @@ const std::array<QColor, 4> kTraceColours{QColor(20, 20, 20), QColor(200, 0, 160
 
 LivePlots::LivePlots(QWidget* parent) : QWidget(parent), m_cursor(kNaN) {
   auto* splitter = new QSplitter(Qt::Vertical, this);
-  m_plots = {new PlotView("Lung-cavity volume", "volume [mL]"), new PlotView("Gut volume error", "error [%]"),
+  m_plots = {new PlotView("Lung volume", "volume [mL]"), new PlotView("Gut volume error", "error [%]"),
              new PlotView("Activations (r solid, \u03b1 dashed)", "r, \u03b1 [-]"),
              new PlotView("Muscle tension (mean per element)", "tension [N]")};
   m_plots[1]->setReferences({{"+0.5 %", 0.5, QColor(40, 160, 60)},
@@ -128,10 +128,16 @@ bool LivePlots::refresh() {
                       column([](const PlotSample& s) { return 1e6 * s.targetVolume; }), "target"});
   }
   m_plots[0]->setData(time, std::move(volume));
-  m_plots[0]->setNote(n == 0 ? QString()
-                             : QString("V = %1 mL    tidal volume %2 mL")
-                                   .arg(1e6 * m_history.back().lungVolume, 0, 'f', 0)
-                                   .arg(1e6 * tidalVolume(), 0, 'f', 0));
+  // read-out: the two lungs, their split and the tidal volume
+  QString note;
+  if (n > 0) {
+    const PlotSample& last = m_history.back();
+    note = QString("lungs %1 mL").arg(1e6 * last.lungVolume, 0, 'f', 0);
+    if (std::isfinite(last.rightLungVolume))
+      note += QString(" (R %1 L %2)").arg(1e6 * last.rightLungVolume, 0, 'f', 0).arg(1e6 * last.leftLungVolume, 0, 'f', 0);
+    note += QString("  VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
+  }
+  m_plots[0]->setNote(note);
 
   // gut volume error [%]
   m_plots[1]->setData(time, {{"gut volume error", QColor(120, 40, 160), false,

@@ -329,7 +329,7 @@ void MainWindow::buildDocks() {
 
   auto* structures = new QGroupBox("Structures", display);
   auto* structLayout = new QVBoxLayout(structures);
-  for (const char* name : {"Bones", "Gut", "Translucent gut", "Lung cavity", "Landmarks", "Anatomical labels"}) {
+  for (const char* name : {"Bones", "Gut", "Translucent gut", "Lung cavity", "Lungs", "Landmarks", "Anatomical labels"}) {
     auto* check = new QCheckBox(name, structures);
     structLayout->addWidget(check);
     m_structureChecks.push_back(check);
@@ -373,8 +373,9 @@ void MainWindow::buildDocks() {
     o.showGut = m_structureChecks[1]->isChecked();
     o.isGutTranslucent = m_structureChecks[2]->isChecked();
     o.showCavity = m_structureChecks[3]->isChecked();
-    o.showLandmarks = m_structureChecks[4]->isChecked();
-    o.showLabels = m_structureChecks[5]->isChecked();
+    o.showLungs = m_structureChecks[4]->isChecked();
+    o.showLandmarks = m_structureChecks[5]->isChecked();
+    o.showLabels = m_structureChecks[6]->isChecked();
     for (std::size_t g = 0; g < m_groupChecks.size(); ++g) o.showGroup[g] = m_groupChecks[g]->isChecked();
     setDisplayOptions(o);
   };
@@ -419,7 +420,7 @@ void MainWindow::syncDisplayWidgets() {
   }();
   m_muscleColour->setCurrentIndex(o.muscleColouring == viz::MuscleColouring::Force ? 0 : 1);
   m_gutColour->setCurrentIndex(static_cast<int>(o.gutColouring));
-  const bool flags[] = {o.showBones, o.showGut, o.isGutTranslucent, o.showCavity, o.showLandmarks, o.showLabels};
+  const bool flags[] = {o.showBones, o.showGut, o.isGutTranslucent, o.showCavity, o.showLungs, o.showLandmarks, o.showLabels};
   for (std::size_t i = 0; i < m_structureChecks.size(); ++i) m_structureChecks[i]->setChecked(flags[i]);
   for (std::size_t g = 0; g < m_groupChecks.size(); ++g) m_groupChecks[g]->setChecked(o.showGroup[g]);
 }

@@ -149,7 +149,7 @@ class MainWindow : public QMainWindow {
   QComboBox* m_affectMode = nullptr;
   QComboBox* m_muscleColour = nullptr;
   QComboBox* m_gutColour = nullptr;
-  std::vector<QCheckBox*> m_structureChecks;  // bones, gut, translucent gut, cavity, landmarks, labels
+  std::vector<QCheckBox*> m_structureChecks;  // bones, gut, translucent gut, cavity, lungs, landmarks, labels
   std::vector<QCheckBox*> m_groupChecks;
   std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique
   QLabel* m_selection = nullptr;

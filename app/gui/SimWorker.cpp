@@ -172,6 +172,8 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   PlotSample s;
   s.time = m.time;
   s.lungVolume = m.lungVolume;
+  s.rightLungVolume = m.rightLungVolume;
+  s.leftLungVolume = m.leftLungVolume;
   s.gutVolumeError = m.gutVolumeError;
   s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
                              : std::numeric_limits<double>::quiet_NaN();

@@ -34,7 +34,9 @@ struct RunSettings {
 /// One output frame for the live plots (a slim copy of sim::Metrics).
 struct PlotSample {
   double time = 0.0;                      ///< [s]
-  double lungVolume = 0.0;                ///< [m^3]
+  double lungVolume = 0.0;                ///< [m^3] the two lungs (sim::Metrics::lungVolume)
+  double rightLungVolume = 0.0;           ///< [m^3] NaN for a model without lung surfaces
+  double leftLungVolume = 0.0;            ///< [m^3] NaN for a model without lung surfaces
   double gutVolumeError = 0.0;            ///< [-] signed (V - V0) / V0
   double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung volume; NaN without one
   sim::Activations activations{};         ///< r and alpha per group

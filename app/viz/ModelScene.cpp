@@ -204,6 +204,9 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkActor> cavityActor;
   Eigen::Matrix3Xd cavityPoints;  // [m]
 
+  std::array<vtkSmartPointer<vtkPolyData>, 2> lungs;  // right, left
+  std::array<vtkSmartPointer<vtkActor>, 2> lungActors;
+
   vtkSmartPointer<vtkPolyData> landmarks;
   vtkSmartPointer<vtkActor> landmarkActor;
 
@@ -225,6 +228,8 @@ struct ModelScene::Impl {
     bodyPose.clear();
     labels.clear();
     gutActor = cavityActor = landmarkActor = highlightActor = nullptr;
+    lungs = {};
+    lungActors = {};
     highlight = Pick{};
     maxForceSeen = maxDisplacementSeen = maxPressureSeen = 0.0;
   }
@@ -236,6 +241,7 @@ struct ModelScene::Impl {
     for (const auto& b : bodies) props.push_back(b);
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
+                       static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
                        static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
       if (p) props.push_back(p);
     return props;
@@ -354,6 +360,17 @@ struct ModelScene::Impl {
     cavityActor->GetProperty()->SetOpacity(0.28);
     cavityActor->PickableOff();
 
+    // the lungs: translucent pink, a model without lung surfaces shows none
+    const std::array<const sim::LungSurface*, 2> lungSurfaces{&model.lungs.right, &model.lungs.left};
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (lungSurfaces[i]->vertexCount() == 0) continue;
+      lungs[i] = surface(lungSurfaces[i]->vertexCount(), lungSurfaces[i]->triangles);
+      lungActors[i] = actorFor(lungs[i]);
+      lungActors[i]->GetProperty()->SetColor(0.96, 0.62, 0.66);
+      lungActors[i]->GetProperty()->SetOpacity(0.3);
+      lungActors[i]->PickableOff();
+    }
+
     landmarks = vtkSmartPointer<vtkPolyData>::New();
     vtkNew<vtkPoints> lmPoints;
     lmPoints->SetNumberOfPoints(static_cast<vtkIdType>(model.landmarks.name.size()));
@@ -439,6 +456,8 @@ struct ModelScene::Impl {
       gutBar->SetVisibility(options.showGut && coloured);
     }
     if (cavityActor) cavityActor->SetVisibility(options.showCavity);
+    for (const auto& a : lungActors)
+      if (a) a->SetVisibility(options.showLungs);
     if (landmarkActor) landmarkActor->SetVisibility(options.showLandmarks);
     for (const Label& l : labels) {
       const bool relevant = l.group >= 0 ? options.showGroup[static_cast<std::size_t>(l.group)]
@@ -572,6 +591,13 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
   if (s.cavity) {
     sim::anchorPositions(model.cavity.vertices, state, s.cavityPoints);
     Impl::setPoints(s.cavity, s.cavityPoints);
+    const std::array<const sim::LungSurface*, 2> lungSurfaces{&model.lungs.right, &model.lungs.left};
+    Eigen::Matrix3Xd x;
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (!s.lungs[i]) continue;
+      sim::lungPositions(*lungSurfaces[i], s.cavityPoints, x);
+      Impl::setPoints(s.lungs[i], x);
+    }
   }
   Eigen::Matrix3Xd lm;
   sim::anchorPositions(model.landmarks.points, state, lm);

@@ -46,6 +46,7 @@ struct DisplayOptions {
   bool showBones = true;
   bool showGut = true;
   bool showCavity = false;
+  bool showLungs = true;   ///< the right and left lungs, translucent (Model::lungs)
   bool showLandmarks = true;
   bool showLabels = false;
   std::array<bool, sim::kElementGroupCount> showGroup{true, true, true, true, true, true};

@@ -31,7 +31,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity"};
+constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity", "lungs"};
+constexpr int kPartCount = 5;
 
 vtkSmartPointer<vtkDoubleArray> scalarArray(const char* name, int components, vtkIdType tuples) {
   auto a = vtkSmartPointer<vtkDoubleArray>::New();
@@ -211,6 +212,32 @@ struct VtkSeriesWriter::Impl {
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     setPoints(pd, x);
     pd->SetPolys(triangles(model.cavity.triangles));
+    fieldValue(pd, "thoracic_cavity_volume_m3", metrics.thoracicCavityVolume);
+    fieldValue(pd, "lung_volume_m3", metrics.lungVolume);
+    return pd;
+  }
+
+  // both lungs in one polydata, the right lung's vertices and triangles first; cell data side: 0 right, 1 left
+  vtkSmartPointer<vtkPolyData> lungs(const sim::State& state, const sim::Metrics& metrics) const {
+    const sim::LungSurface& right = model.lungs.right;
+    const sim::LungSurface& left = model.lungs.left;
+    Eigen::Matrix3Xd cavity, xr, xl;
+    sim::anchorPositions(model.cavity.vertices, state, cavity);
+    sim::lungPositions(right, cavity, xr);
+    sim::lungPositions(left, cavity, xl);
+    Eigen::Matrix3Xd x(3, xr.cols() + xl.cols());
+    x << xr, xl;
+    Eigen::Matrix3Xi t(3, right.triangles.cols() + left.triangles.cols());
+    t << right.triangles, (left.triangles.array() + right.vertexCount()).matrix();
+    auto side = vtkSmartPointer<vtkIntArray>::New();
+    side->SetName("side");
+    for (Eigen::Index i = 0; i < t.cols(); ++i) side->InsertNextValue(i < right.triangles.cols() ? 0 : 1);
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, x);
+    pd->SetPolys(triangles(t));
+    pd->GetCellData()->AddArray(side);
+    fieldValue(pd, "right_lung_volume_m3", metrics.rightLungVolume);
+    fieldValue(pd, "left_lung_volume_m3", metrics.leftLungVolume);
     fieldValue(pd, "lung_volume_m3", metrics.lungVolume);
     return pd;
   }
@@ -228,6 +255,7 @@ void VtkSeriesWriter::writeFrame(const sim::State& state, const sim::Metrics& me
   m_impl->write(m_impl->muscles(state, metrics), m_impl->partPath(1, frame));
   m_impl->write(m_impl->gut(state, metrics), m_impl->partPath(2, frame));
   m_impl->write(m_impl->cavity(state, metrics), m_impl->partPath(3, frame));
+  m_impl->write(m_impl->lungs(state, metrics), m_impl->partPath(4, frame));
   m_impl->frameTimes.push_back(state.time);
 }
 
@@ -237,7 +265,7 @@ std::string VtkSeriesWriter::finish() {
   pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "  <Collection>\n";
   for (std::size_t f = 0; f < m_impl->frameTimes.size(); ++f)
-    for (int part = 0; part < 4; ++part)
+    for (int part = 0; part < kPartCount; ++part)
       pvd << "    <DataSet timestep=\"" << m_impl->frameTimes[f] << "\" group=\"\" part=\"" << part << "\" name=\""
           << kPartNames[part] << "\" file=\"" << m_impl->partPath(part, static_cast<int>(f)) << "\"/>\n";
   pvd << "  </Collection>\n</VTKFile>\n";

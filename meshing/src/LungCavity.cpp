@@ -3,13 +3,18 @@
 #include "Anchors.h"
 
 #include "pneuma/meshing/MeshTools.h"
+#include "pneuma/meshing/Sweep.h"
+#include "pneuma/sim/Error.h"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <numeric>
+#include <string>
 
 namespace pneuma::meshing {
 
@@ -55,7 +60,219 @@ Eigen::Vector3d closestBarycentric(const Eigen::Vector3d& p, const Eigen::Vector
   return w;
 }
 
+
+// ---- the two lungs: the cavity minus the mediastinum, split at the midline
+
+/// Proportions of the mediastinum, as fractions of the cavity's rest extent (W lateral, D anteroposterior,
+/// H craniocaudal). The central block (trachea, oesophagus, great vessels, the vertebral bodies' bulge) runs the
+/// cavity's full depth and height; the heart is an ellipsoid that sits on the diaphragm's central tendon, left of
+/// the block's centre and anterior (adult heart about 12 x 8.5 x 6 cm). The whole mediastinum's lateral offset
+/// from the cavity's midline is solved for the right/left split.
+constexpr double kBlockHalfWidth = 0.075;   // [-] of W: a 3.5-4.5 cm wide central mediastinum
+constexpr double kHeartHalfWidth = 0.23;    // [-] of W (lateral semi-axis, about 6 cm)
+constexpr double kHeartHalfDepth = 0.24;    // [-] of D (anteroposterior semi-axis, about 4.5 cm)
+constexpr double kHeartHalfHeight = 0.24;   // [-] of H (craniocaudal semi-axis, about 5.5 cm)
+constexpr double kHeartCentreX = -0.08;     // [-] of W from the block's centre: to the left
+constexpr double kHeartCentreY = 0.58;      // [-] of D from the back: anterior of the middle
+constexpr double kHeartSink = 0.05;         // [-] of the vertical semi-axis below the floor under its centre
+/// Right lung's share of the two lungs' volume: 53.5 % (upright and supine CT, Yamada et al. 2020, Respiration
+/// 99:598, Table 3: standing 53.3 +/- 1.3 %, supine 53.6 +/- 1.5 %).
+constexpr double kRightShare = 0.535;
+constexpr double kOnSurface = 1e-7;         // [m] a lung vertex this close to a cavity triangle lies on it
+
+TriangleMesh box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  TriangleMesh m;
+  m.vertices.resize(3, 8);
+  for (int i = 0; i < 8; ++i)
+    m.vertices.col(i) = Eigen::Vector3d((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(), (i & 4) ? hi.z() : lo.z());
+  m.triangles.resize(3, 12);
+  m.triangles << 0, 0, 4, 4, 0, 0, 2, 2, 0, 0, 1, 1,  //
+      2, 3, 5, 7, 1, 5, 6, 7, 4, 6, 3, 7,              //
+      3, 1, 7, 6, 5, 4, 7, 3, 6, 2, 7, 5;
+  return m;
+}
+
+/// Ellipsoid of semi-axes `r` [m] about `c` (axes along x, y, z), as a capped sweep along z.
+TriangleMesh ellipsoid(const Eigen::Vector3d& c, const Eigen::Vector3d& r) {
+  std::vector<SweepStation> st;
+  constexpr int kStations = 15;
+  for (int i = 0; i < kStations; ++i) {
+    const double u = -0.97 + 1.94 * i / (kStations - 1);
+    const double f = std::sqrt(1.0 - u * u);
+    st.push_back({c + Eigen::Vector3d(0, 0, u * r.z()), Eigen::Vector3d::UnitY(), f * r.y(), f * r.x()});
+  }
+  return sweepTube(st, 24, false);
+}
+
+/// z [m] of the first cavity surface point straight above (`up`) or below `p`, with its triangle and barycentric
+/// weights; false when the vertical line misses.
+bool verticalHit(const TriangleMesh& cavity, const Eigen::Vector3d& p, bool up, int& face, Eigen::Vector3d& w,
+                 double& z) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < cavity.triangleCount(); ++f) {
+    const Eigen::Vector3d a = cavity.vertices.col(cavity.triangles(0, f));
+    const Eigen::Vector3d b = cavity.vertices.col(cavity.triangles(1, f));
+    const Eigen::Vector3d c = cavity.vertices.col(cavity.triangles(2, f));
+    // barycentric coordinates of p's projection in the xy plane
+    const double det = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
+    if (std::abs(det) < 1e-14) continue;
+    const double wb = ((p.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (p.y() - a.y())) / det;
+    const double wc = ((b.x() - a.x()) * (p.y() - a.y()) - (p.x() - a.x()) * (b.y() - a.y())) / det;
+    const double wa = 1.0 - wb - wc;
+    if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
+    const double zh = wa * a.z() + wb * b.z() + wc * c.z();
+    const double d = up ? zh - p.z() : p.z() - zh;
+    if (d < 0.0 || d >= best) continue;
+    best = d;
+    face = f;
+    w = {wa, wb, wc};
+    z = zh;
+  }
+  return std::isfinite(best);
+}
+
+/// Binds each vertex of `lung` to the cavity (sim::LungSurface): a cavity vertex itself, the cavity triangle it
+/// lies on, or the cavity points straight above and below it.
+sim::LungSurface embed(const TriangleMesh& lung, const TriangleMesh& cavity, const std::string& part) {
+  std::map<std::array<long long, 3>, int> cavityVertex;
+  for (int v = 0; v < cavity.vertexCount(); ++v) cavityVertex.emplace(gridKey(cavity.vertices.col(v)), v);
+  sim::LungSurface s;
+  s.cavityVertex.setConstant(sim::kLungVertexSlots, lung.vertexCount(), -1);
+  s.weights.setZero(sim::kLungVertexSlots, lung.vertexCount());
+  s.triangles = lung.triangles;
+  for (int v = 0; v < lung.vertexCount(); ++v) {
+    const Eigen::Vector3d p = lung.vertices.col(v);
+    if (auto it = cavityVertex.find(gridKey(p)); it != cavityVertex.end()) {
+      s.cavityVertex(0, v) = it->second;
+      s.weights(0, v) = 1.0;
+      continue;
+    }
+    // on a cavity wall: the triangle it lies on
+    double best = 1e9;
+    int face = -1;
+    Eigen::Vector3d w;
+    for (int f = 0; f < cavity.triangleCount(); ++f) {
+      double d = 0.0;
+      const Eigen::Vector3i t = cavity.triangles.col(f);
+      const Eigen::Vector3d wf = closestBarycentric(p, cavity.vertices.col(t(0)), cavity.vertices.col(t(1)),
+                                                    cavity.vertices.col(t(2)), d);
+      if (d < best) best = d, face = f, w = wf;
+    }
+    if (best < kOnSurface) {
+      for (int k = 0; k < 3; ++k) s.cavityVertex(k, v) = cavity.triangles(k, face), s.weights(k, v) = w(k);
+      continue;
+    }
+    // on the mediastinal face: between the cavity points above and below
+    int fa = -1, fb = -1;
+    Eigen::Vector3d wa, wb;
+    double za = 0.0, zb = 0.0;
+    if (!verticalHit(cavity, p, true, fa, wa, za) || !verticalHit(cavity, p, false, fb, wb, zb) || !(za > zb))
+      throw sim::Error(part + ": vertex " + std::to_string(v) + " is not inside the lung cavity");
+    const double t = (za - p.z()) / (za - zb);  // 0 at the point above, 1 below
+    for (int k = 0; k < 3; ++k) {
+      s.cavityVertex(k, v) = cavity.triangles(k, fa), s.weights(k, v) = (1.0 - t) * wa(k);
+      s.cavityVertex(3 + k, v) = cavity.triangles(k, fb), s.weights(3 + k, v) = t * wb(k);
+    }
+  }
+  return s;
+}
+
+/// The connected components of `m` (triangles sharing a vertex), each as its own mesh.
+std::vector<TriangleMesh> components(const TriangleMesh& m) {
+  std::vector<int> parent(static_cast<std::size_t>(m.vertexCount()));
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int v) {
+    while (parent[static_cast<std::size_t>(v)] != v) v = parent[static_cast<std::size_t>(v)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
+    return v;
+  };
+  for (int f = 0; f < m.triangleCount(); ++f)
+    for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(root(m.triangles(k, f)))] = root(m.triangles(0, f));
+  std::map<int, int> index;  // root -> component
+  std::vector<TriangleMesh> out;
+  std::vector<std::map<int, int>> local;
+  for (int f = 0; f < m.triangleCount(); ++f) {
+    const int r = root(m.triangles(0, f));
+    auto [it, isNew] = index.emplace(r, static_cast<int>(out.size()));
+    if (isNew) out.emplace_back(), local.emplace_back();
+    TriangleMesh& c = out[static_cast<std::size_t>(it->second)];
+    std::map<int, int>& map = local[static_cast<std::size_t>(it->second)];
+    Eigen::Vector3i t;
+    for (int k = 0; k < 3; ++k) {
+      const int v = m.triangles(k, f);
+      auto [vi, added] = map.emplace(v, static_cast<int>(map.size()));
+      if (added) {
+        c.vertices.conservativeResize(3, c.vertices.cols() + 1);
+        c.vertices.col(c.vertices.cols() - 1) = m.vertices.col(v);
+      }
+      t(k) = vi->second;
+    }
+    c.triangles.conservativeResize(3, c.triangles.cols() + 1);
+    c.triangles.col(c.triangles.cols() - 1) = t;
+  }
+  return out;
+}
+
+struct LungMeshes {
+  TriangleMesh right, left;
+};
+
+/// The cavity minus the mediastinum shifted `shift` [m] from the cavity's midline (x > 0: right).
+LungMeshes carveLungs(const TriangleMesh& cavity, double shift) {
+  const Eigen::Vector3d lo = cavity.vertices.rowwise().minCoeff(), hi = cavity.vertices.rowwise().maxCoeff();
+  const Eigen::Vector3d size = hi - lo, pad(0.0, 0.02, 0.02);  // [m] the block overhangs front, back, top, bottom
+  const double midX = 0.5 * (lo.x() + hi.x()) + shift;
+  const TriangleMesh block = box(Eigen::Vector3d(midX - kBlockHalfWidth * size.x(), lo.y(), lo.z()) - pad,
+                                 Eigen::Vector3d(midX + kBlockHalfWidth * size.x(), hi.y(), hi.z()) + pad);
+  // the heart rests on the floor under its centre
+  const Eigen::Vector3d r(kHeartHalfWidth * size.x(), kHeartHalfDepth * size.y(), kHeartHalfHeight * size.z());
+  Eigen::Vector3d c(midX + kHeartCentreX * size.x(), lo.y() + kHeartCentreY * size.y(), hi.z());
+  int face = -1;
+  Eigen::Vector3d w;
+  double floorZ = lo.z();
+  if (!verticalHit(cavity, c, false, face, w, floorZ)) throw sim::Error("lungs: no cavity floor under the heart");
+  c.z() = floorZ + (1.0 - kHeartSink) * r.z();
+  const TriangleMesh carved = subtract(subtract(cavity, block, kGrid, "lungs (central mediastinum)"), ellipsoid(c, r),
+                                       kGrid, "lungs (heart)");
+  // each component to the side of its centroid; the right lung lies at x > 0 (world RAS)
+  LungMeshes out;
+  for (const TriangleMesh& part : components(carved)) {
+    const double v = enclosedVolume(part.vertices, part.triangles);
+    if (v < 1e-6) continue;  // slivers below 1 mL the cut leaves at the block's edges
+    TriangleMesh& side = part.vertices.row(0).mean() > midX ? out.right : out.left;  // the block splits them
+    side.append(part);
+  }
+  return out;
+}
+
 }  // namespace
+
+void buildLungs(const TriangleMesh& cavity, sim::Model& model) {
+  // solve the mediastinum's lateral offset for the right lung's share (secant; the share falls as it moves right)
+  const double width = cavity.vertices.row(0).maxCoeff() - cavity.vertices.row(0).minCoeff();
+  auto share = [&](const LungMeshes& l) {
+    const double r = enclosedVolume(l.right.vertices, l.right.triangles);
+    return r / (r + enclosedVolume(l.left.vertices, l.left.triangles));
+  };
+  double x0 = 0.0, x1 = -0.04 * width;
+  LungMeshes l0 = carveLungs(cavity, x0), l1 = carveLungs(cavity, x1);
+  double s0 = share(l0), s1 = share(l1);
+  for (int i = 0; i < 6 && std::abs(s1 - kRightShare) > 1e-3 && std::abs(s1 - s0) > 1e-9; ++i) {
+    const double x2 = x1 + (kRightShare - s1) * (x1 - x0) / (s1 - s0);
+    x0 = x1, s0 = s1, l0 = std::move(l1);
+    x1 = std::clamp(x2, -0.15 * width, 0.15 * width);
+    l1 = carveLungs(cavity, x1);
+    s1 = share(l1);
+  }
+  if (l1.right.triangleCount() == 0 || l1.left.triangleCount() == 0)
+    throw sim::Error("lungs: the mediastinum does not leave a right and a left lung");
+
+  sim::Lungs& lungs = model.lungs;
+  lungs.right = embed(l1.right, cavity, "lungs.right");
+  lungs.left = embed(l1.left, cavity, "lungs.left");
+  lungs.mediastinumVolume = enclosedVolume(cavity.vertices, cavity.triangles) -
+                            enclosedVolume(l1.right.vertices, l1.right.triangles) -
+                            enclosedVolume(l1.left.vertices, l1.left.triangles);
+}
 
 double buildCavity(const Skeleton& sk, const GutSurface& gut, sim::Model& model) {
   // hull points on the inner faces of the moving ribs and on the back of the sternum
@@ -108,6 +325,7 @@ double buildCavity(const Skeleton& sk, const GutSurface& gut, sim::Model& model)
     addEndpoint(c.vertices, e, model.bodies);
   }
   c.triangles = cavity.triangles;
+  buildLungs(cavity, model);
   return enclosedVolume(cavity.vertices, cavity.triangles);
 }
 

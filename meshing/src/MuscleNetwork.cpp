@@ -20,6 +20,9 @@ constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib t
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
 constexpr double kAppositionReach = 0.04;  // [m] farthest rib point an apposed dome node is tied to
 constexpr std::size_t kAppositionRings = 3;  // [-] dome rings inside the rim that lie on the rib cage
+// [m] how far beyond the rib point an apposition spring is anchored (in the rib's frame), along the line from the
+// dome node: a spring this long holds the node at its distance from the rib face and lets it slide along the face
+constexpr double kAppositionSlide = 0.2;
 constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
 constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
 constexpr double kScaleneLength = 0.06;  // [m] rib 1 to the scalene anchors above it (cervical spine)
@@ -163,9 +166,13 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
 /// Apposition: the outer dome lies on the inner face of the lower rib cage (the zone of apposition), held there by
 /// the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs rather than
 /// bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer & Wilson 2016, J Appl
-/// Physiol 121:391). Each node of the first kAppositionRings rings inside the rim gets a two-sided spring
-/// (Cartilage group, its stiffness and damping times `fraction`) to the nearest point of the inner face of ribs 6-12
-/// within kAppositionReach.
+/// Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide along them: the apposed
+/// dome shortens and descends like a piston while the ribs rise past it. Each node of the first kAppositionRings
+/// rings inside the rim gets a two-sided spring (Cartilage group) toward the nearest point of the inner face of
+/// ribs 6-12 within kAppositionReach, anchored kAppositionSlide beyond that point on the same line: a long spring
+/// resists a change of the node's distance to the face and hardly a slide across it (a slide s lengthens it by about
+/// s^2 / 2 l). Its stiffness and damping along the line are those of a spring reaching only the rib point, the
+/// cartilage group's times `fraction`.
 void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, ElementSink& sink) {
   if (fraction <= 0.0) return;
   std::vector<Endpoint> face;
@@ -178,9 +185,13 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
   }
   for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
     for (int node : gut.domeRing[ring]) {
-      const Endpoint& rib = nearest(face, gut.rest.col(node));
-      if ((rib.world - gut.rest.col(node)).norm() <= kAppositionReach)
-        sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), rib, 0.0, fraction);
+      const Eigen::Vector3d p = gut.rest.col(node);
+      const Endpoint& rib = nearest(face, p);
+      const double reach = (rib.world - p).norm();
+      if (reach > kAppositionReach || reach < 1e-6) continue;
+      const Endpoint anchor = Endpoint::onBody(rib.body, rib.world + kAppositionSlide * (rib.world - p) / reach);
+      sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), anchor, 0.0,
+               fraction * (reach + kAppositionSlide) / reach);
     }
   }
 }

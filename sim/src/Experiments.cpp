@@ -173,6 +173,54 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
   return out;
 }
 
+std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
+  const StyleRun* calm = nullptr;
+  const StyleRun* deep = nullptr;
+  for (const StyleRun& r : runs)
+    if (r.frictionScale == 1.0) {
+      if (r.style.name == "calm") calm = &r;
+      if (r.style.name == "deep") deep = &r;
+    }
+  const std::string boussuges = "M-mode ultrasound, quiet breathing 18 +/- 3 mm and deep breathing 70 +/- 11 mm in men "
+                                "(Boussuges, Gole & Blanc 2009, Chest 135:391)";
+  const std::string wilson = "bucket-handle widening of the lower ribs (Wilson et al. 1987, J Appl Physiol 62:1872; "
+                             "De Troyer & Boriek 2011, Compr Physiol 1:1273)";
+  std::vector<Check> out;
+  if (calm) {
+    const Motion& m = calm->summary.motion;
+    out.push_back(check("physiology.calm.dome_descent", "dome descent (central tendon, craniocaudal), calm", "12 - 25 mm",
+                        boussuges, "mm", m.domeDescent * kMm, 12.0, 25.0));
+    out.push_back(check("physiology.calm.umbilicus_forward", "umbilicus anterior motion, smallest over the calm breaths",
+                        "> 0 mm (the belly moves out on every inhale)", "Konno & Mead 1967, J Appl Physiol 22:407", "mm",
+                        m.umbilicusAnteriorMin * kMm, 1e-9, kBig));
+    out.push_back(check("physiology.calm.lower_rib_expansion", "rib-8 lateral distance, change, calm", ">= 2 mm", wilson, "mm",
+                        m.lowerRibExpansion * kMm, 2.0, kBig));
+    out.push_back(check("physiology.calm.rib_cage_share", "rib-cage share of the tidal volume, calm, upright", "55 - 85 %",
+                        "seated at rest the abdomen gives about a quarter (J Appl Physiol 1968, 24:159); rib cage dominant "
+                        "upright (Sharp et al. 1975, J Appl Physiol 39:608)",
+                        "%", kPct * m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal), 55.0, 85.0));
+    out.push_back(check("physiology.calm.phase", "rib-cage / abdomen phase angle, calm", "< 30 deg",
+                        "12-23 deg in healthy young adults (Chen et al. 2015)", "deg", m.phaseAngle * 180.0 / M_PI, 0.0, 30.0));
+    out.push_back(check("physiology.calm.flow_reversals", "flow (dV/dt) sign changes per breath, calm", "2",
+                        "a spirogram: one inspiration, one expiration", "-", m.flowSignChanges, 2.0, 2.0));
+    out.push_back(check("physiology.calm.flow_jump", "largest frame-to-frame flow change, calm", "<= 20 % of peak flow",
+                        "smooth tidal airflow profiles (Benchetrit 2000, Respir Physiol 122:123)", "% of peak",
+                        m.maxFlowJump * kPct, 0.0, 20.0));
+  }
+  if (deep) {
+    const Motion& m = deep->summary.motion;
+    if (calm)
+      out.push_back(check("physiology.deep.dome_over_calm", "dome descent, deep over calm", ">= 2", boussuges, "-",
+                          m.domeDescent / calm->summary.motion.domeDescent, 2.0, kBig));
+    out.push_back(check("physiology.deep.dome_per_litre", "dome descent per litre inspired, deep", "20 - 35 mm/L",
+                        "derived: " + boussuges + " over an inspiratory capacity of 2-3.5 L", "mm/L",
+                        m.domeDescent * kMm / (deep->summary.tidalVolume * 1e3), 20.0, 35.0));
+    out.push_back(check("physiology.deep.lower_rib_expansion", "rib-8 lateral distance, change, deep", ">= 10 mm", wilson, "mm",
+                        m.lowerRibExpansion * kMm, 10.0, kBig));
+  }
+  return out;
+}
+
 namespace {
 
 // the trace's frame ranges [first, last) of the controller's inhale (or exhale) windows of the full cycles

@@ -87,6 +87,12 @@ Motion measureMotion(const Trace& t, const std::vector<std::string>& names, cons
   m.xiphoidAnterior = axis("xiphoid", 1, 1.0);
   m.xiphoidCranial = axis("xiphoid", 2, 1.0);
   m.umbilicusAnterior = axis("umbilicus", 1, 1.0);
+  if (const int u = landmark("umbilicus"); u >= 0) {
+    m.umbilicusAnteriorMin = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < cycles; ++c)
+      m.umbilicusAnteriorMin = std::min(m.umbilicusAnteriorMin, t.landmarks[insp[static_cast<std::size_t>(c)]](1, u) -
+                                                                    t.landmarks[exp[static_cast<std::size_t>(c)]](1, u));
+  }
   const int left = landmark("rib8_lateral_left"), right = landmark("rib8_lateral_right");
   if (left >= 0 && right >= 0)
     m.lowerRibExpansion = change([&](std::size_t i) { return (t.landmarks[i].col(left) - t.landmarks[i].col(right)).norm(); });
@@ -209,10 +215,22 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   out.time = state.time;
   out.activations = act;
 
-  // volumes: lung cavity from its bound surface, gut from the node surface
+  // volumes: lung cavity from its bound surface, the lungs from it (Lungs), gut from the node surface
   Eigen::Matrix3Xd cavity;
   anchorPositions(model.cavity.vertices, state, cavity);
-  out.lungVolume = model.cavity.triangles.cols() > 0 ? enclosedVolume(cavity, model.cavity.triangles) : 0.0;
+  out.thoracicCavityVolume =
+      model.cavity.triangles.cols() > 0 ? enclosedVolume(cavity, model.cavity.triangles) : 0.0;
+  out.lungVolume = out.thoracicCavityVolume - model.lungs.mediastinumVolume;
+  out.rightLungVolume = out.leftLungVolume = kNaN;
+  if (model.lungs.right.vertexCount() > 0) {
+    Eigen::Matrix3Xd x;
+    lungPositions(model.lungs.right, cavity, x);
+    const double right = enclosedVolume(x, model.lungs.right.triangles);
+    lungPositions(model.lungs.left, cavity, x);
+    const double left = enclosedVolume(x, model.lungs.left.triangles);
+    out.rightLungVolume = out.lungVolume * right / (right + left);
+    out.leftLungVolume = out.lungVolume - out.rightLungVolume;
+  }
   out.gutVolume =
       model.gut.triangles.cols() > 0 ? enclosedVolume(state.nodePosition, model.gut.triangles) : 0.0;
   out.gutVolumeError = work.constants.restGutVolume > 0.0
@@ -266,7 +284,7 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
     elastic += gutEnergy(kappa, work.constants.restGutVolume, out.gutVolume);
   // lung recoil: E = P0 dV + dV^2 / (2 C) while Ppl < 0, the potential of the pleural pressure
   if (model.cavity.compliance > 0.0) {
-    const double dv = out.lungVolume - work.constants.restCavityVolume;
+    const double dv = out.thoracicCavityVolume - work.constants.restCavityVolume;
     const double c = model.cavity.compliance, p0 = model.cavity.recoilPressure;
     const double dvZero = -p0 * c;  // [m^3] where Ppl reaches 0
     const double d = std::max(dv, dvZero);

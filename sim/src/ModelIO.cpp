@@ -2,6 +2,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/State.h"
 
 #include <nlohmann/json.hpp>
 
@@ -82,6 +83,47 @@ json writeAnchor(const AnchorSet& a, int i) {
 
 json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
+// lung surface: {"vertices": [{"cavity_vertices": [i, ...], "weights": [w, ...]}, ...], "triangles": [[a, b, c], ...]}
+void readLungSurface(const Reader& r, LungSurface& out) {
+  r.allowKeys({"vertices", "triangles"});
+  const Reader verts = r.at("vertices");
+  const auto n = static_cast<Eigen::Index>(verts.size());
+  out.cavityVertex.setConstant(kLungVertexSlots, n, -1);
+  out.weights.setZero(kLungVertexSlots, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Reader v = verts[static_cast<std::size_t>(i)];
+    v.allowKeys({"cavity_vertices", "weights"});
+    const Reader idx = v.at("cavity_vertices");
+    const Reader w = v.at("weights");
+    if (idx.size() < 1 || idx.size() > kLungVertexSlots)
+      idx.fail("must list 1 to " + std::to_string(kLungVertexSlots) + " cavity vertex indices");
+    if (w.size() != idx.size()) w.fail("must have as many entries as cavity_vertices (" + std::to_string(idx.size()) + ")");
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      out.cavityVertex(static_cast<Eigen::Index>(k), i) = idx[k].integer();
+      out.weights(static_cast<Eigen::Index>(k), i) = w[k].number();
+    }
+  }
+  const Reader tris = r.at("triangles");
+  out.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
+  for (std::size_t i = 0; i < tris.size(); ++i) out.triangles.col(static_cast<Eigen::Index>(i)) = tris[i].index3();
+}
+
+json writeLungSurface(const LungSurface& s) {
+  json verts = json::array();
+  for (int i = 0; i < s.vertexCount(); ++i) {
+    json idx = json::array(), w = json::array();
+    for (int k = 0; k < kLungVertexSlots; ++k) {
+      if (s.cavityVertex(k, i) < 0) continue;
+      idx.push_back(s.cavityVertex(k, i));
+      w.push_back(s.weights(k, i));
+    }
+    verts.push_back({{"cavity_vertices", std::move(idx)}, {"weights", std::move(w)}});
+  }
+  json tris = json::array();
+  for (int i = 0; i < s.triangles.cols(); ++i) tris.push_back({s.triangles(0, i), s.triangles(1, i), s.triangles(2, i)});
+  return {{"vertices", std::move(verts)}, {"triangles", std::move(tris)}};
+}
+
 // ---------------------------------------------------------------------------------------------
 // validation helpers
 
@@ -140,6 +182,27 @@ void validateTriangles(const Eigen::Matrix3Xi& t, const std::string& field, int 
     }
     if (t(0, i) == t(1, i) || t(1, i) == t(2, i) || t(0, i) == t(2, i))
       invalid(field + "[" + std::to_string(i) + "]", "degenerate triangle (repeated vertex)");
+  }
+}
+
+void validateLungVertices(const LungSurface& s, const std::string& field, int nCavity) {
+  if (s.weights.cols() != s.cavityVertex.cols()) invalid(field, "inconsistent array sizes");
+  for (int i = 0; i < s.vertexCount(); ++i) {
+    const std::string f = field + "[" + std::to_string(i) + "]";
+    double sum = 0.0;
+    int used = 0;
+    for (int k = 0; k < kLungVertexSlots; ++k) {
+      const int c = s.cavityVertex(k, i);
+      if (c < 0) continue;
+      if (c >= nCavity)
+        invalid(f + ".cavity_vertices", "index " + std::to_string(c) + " out of range [0, " + std::to_string(nCavity) + ")");
+      const double w = s.weights(k, i);
+      if (!std::isfinite(w) || w < 0.0) invalid(f + ".weights", "must be finite and >= 0, got " + num(w));
+      sum += w;
+      ++used;
+    }
+    if (used == 0) invalid(f + ".cavity_vertices", "must list at least one cavity vertex");
+    if (std::abs(sum - 1.0) > 1e-6) invalid(f + ".weights", "must sum to 1, got " + num(sum));
   }
 }
 
@@ -325,6 +388,29 @@ void validateModel(const Model& m) {
   requireNonNegative(m.cavity.recoilPressure, "cavity.recoil_pressure");
   requireNonNegative(m.cavity.compliance, "cavity.compliance");
 
+  // lungs: embedded in the cavity, together smaller than it
+  const double mediastinum = m.lungs.mediastinumVolume;
+  requireNonNegative(mediastinum, "lungs.mediastinum_volume");
+  if (!(mediastinum < cavityVolume))
+    invalid("lungs.mediastinum_volume", "must be smaller than the cavity's rest volume " + num(cavityVolume) +
+                                            " m^3, got " + num(mediastinum));
+  const bool hasRight = m.lungs.right.vertexCount() > 0, hasLeft = m.lungs.left.vertexCount() > 0;
+  if (hasRight != hasLeft) invalid(hasRight ? "lungs.left" : "lungs.right", "must be given with the other lung");
+  if (hasRight) {
+    const Eigen::Matrix3Xd cavityRest = restPoints(m.cavity.vertices, m);
+    for (const auto& [lung, name] : {std::pair<const LungSurface*, std::string>{&m.lungs.right, "lungs.right"},
+                                     {&m.lungs.left, "lungs.left"}}) {
+      validateLungVertices(*lung, name + ".vertices", m.cavity.vertices.size());
+      validateTriangles(lung->triangles, name + ".triangles", lung->vertexCount());
+      validateClosedSurface(lung->triangles, name + ".triangles");
+      Eigen::Matrix3Xd x;
+      lungPositions(*lung, cavityRest, x);
+      const double v = enclosedVolume(x, lung->triangles);
+      if (!(v > 0.0))
+        invalid(name + ".triangles", "enclosed rest volume must be > 0 (outward orientation), got " + num(v) + " m^3");
+    }
+  }
+
   // landmarks
   if (static_cast<int>(m.landmarks.name.size()) != m.landmarks.points.size())
     invalid("landmarks", "inconsistent array sizes");
@@ -342,7 +428,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
   const Reader root = doc.root();
   root.allowKeys({"format", "version", "name", "anatomy", "units", "frame", "gravity", "bodies", "joints", "nodes",
-                  "gut", "elements", "cavity", "landmarks"});
+                  "gut", "elements", "cavity", "lungs", "landmarks"});
 
   // header
   if (root.at("format").string() != kFormatName)
@@ -459,6 +545,16 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.cavity.triangles.resize(3, static_cast<Eigen::Index>(cavTris.size()));
   for (std::size_t i = 0; i < cavTris.size(); ++i) m.cavity.triangles.col(static_cast<Eigen::Index>(i)) = cavTris[i].index3();
 
+  // lungs: required; a model written before the two lungs is refused with the way to rebuild it
+  if (!root.has("lungs"))
+    throw Error(root.source() + ": lungs: missing (a model written before the two lungs; rebuild it with "
+                "'pneuma-cli model build')");
+  const Reader lungs = root.at("lungs");
+  lungs.allowKeys({"mediastinum_volume", "right", "left"});
+  m.lungs.mediastinumVolume = lungs.at("mediastinum_volume").number();
+  readLungSurface(lungs.at("right"), m.lungs.right);
+  readLungSurface(lungs.at("left"), m.lungs.left);
+
   // landmarks
   const Reader landmarks = root.at("landmarks");
   for (std::size_t i = 0; i < landmarks.size(); ++i) {
@@ -555,6 +651,10 @@ std::string serializeModel(const Model& m) {
                    {"triangles", triangles(m.cavity.triangles)},
                    {"recoil_pressure", m.cavity.recoilPressure},
                    {"compliance", m.cavity.compliance}};
+
+  doc["lungs"] = {{"mediastinum_volume", m.lungs.mediastinumVolume},
+                  {"right", writeLungSurface(m.lungs.right)},
+                  {"left", writeLungSurface(m.lungs.left)}};
 
   json landmarks = json::array();
   for (int i = 0; i < m.landmarks.points.size(); ++i) {

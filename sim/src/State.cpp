@@ -20,4 +20,11 @@ void anchorPositions(const AnchorSet& anchors, const State& state, Eigen::Matrix
   for (int i = 0; i < anchors.size(); ++i) out.col(i) = anchorPosition(anchors, i, state);
 }
 
+void lungPositions(const LungSurface& lung, const Eigen::Matrix3Xd& cavity, Eigen::Matrix3Xd& out) {
+  out.setZero(3, lung.vertexCount());
+  for (int i = 0; i < lung.vertexCount(); ++i)
+    for (int k = 0; k < kLungVertexSlots; ++k)
+      if (lung.cavityVertex(k, i) >= 0) out.col(i) += lung.weights(k, i) * cavity.col(lung.cavityVertex(k, i));
+}
+
 }  // namespace pneuma::sim

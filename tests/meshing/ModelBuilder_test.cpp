@@ -3,11 +3,13 @@
 #include "pneuma/meshing/MeshTools.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/State.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -175,6 +177,47 @@ TEST_P(BuiltPresets, VolumesAreWithinPhysiologicalRanges) {
   EXPECT_LT(s.cavityVolume * 1e6, kCavityMaxMl);
   EXPECT_GT(s.gutVolume * 1e6, kGutMinMl);
   EXPECT_LT(s.gutVolume * 1e6, kGutMaxMl);
+}
+
+// the two lungs: closed, outward, free of self-intersections at rest (CGAL), split 53.5 : 46.5 as on upright CT
+// (Yamada et al. 2020: right 53.3 +/- 1.3 % standing), with the mediastinum (heart about 0.8 L, great vessels,
+// trachea, oesophagus, the vertebral bodies' bulge) between them; lungs at end-expiration in the range of FRC gas
+// plus lung tissue (resources/anatomy/README.md, "Lungs")
+TEST_P(BuiltPresets, LungsSplitAsOnCtAroundTheMediastinum) {
+  const sim::Model& m = model();
+  Eigen::Matrix3Xd cavity(3, m.cavity.vertices.size());
+  for (int i = 0; i < m.cavity.vertices.size(); ++i) {
+    const int b = m.cavity.vertices.body[static_cast<std::size_t>(i)];
+    if (b >= 0) {
+      cavity.col(i) = m.bodies.com.col(b) + m.cavity.vertices.local.col(i);
+      continue;
+    }
+    cavity.col(i).setZero();
+    for (int k = 0; k < 3; ++k)
+      if (m.cavity.vertices.nodes(k, i) >= 0)
+        cavity.col(i) += m.cavity.vertices.weights(k, i) * m.nodes.rest.col(m.cavity.vertices.nodes(k, i));
+  }
+  double volume[2] = {0.0, 0.0};
+  int side = 0;
+  for (const sim::LungSurface* lung : {&m.lungs.right, &m.lungs.left}) {
+    TriangleMesh mesh;
+    sim::lungPositions(*lung, cavity, mesh.vertices);
+    mesh.triangles = lung->triangles;
+    const MeshCheck c = checkMesh(mesh);
+    EXPECT_TRUE(c.isValid()) << GetParam() << " lung " << side << ": manifold " << c.isManifold << ", closed "
+                             << c.isClosed << ", self-intersecting " << c.isSelfIntersecting;
+    volume[side++] = enclosedVolume(mesh.vertices, mesh.triangles);
+  }
+  const double cavityVolume = enclosedVolume(cavity, m.cavity.triangles);
+  EXPECT_NEAR(volume[0] / (volume[0] + volume[1]), 0.535, 0.002) << GetParam();
+  EXPECT_NEAR(m.lungs.mediastinumVolume, cavityVolume - volume[0] - volume[1], 1e-9);
+  EXPECT_GT(m.lungs.mediastinumVolume * 1e6, 700.0) << GetParam();  // the heart alone is 0.6-0.9 L
+  EXPECT_LT(m.lungs.mediastinumVolume * 1e6, 1600.0) << GetParam();
+  RecordProperty("lungs_ml", std::to_string((cavityVolume - m.lungs.mediastinumVolume) * 1e6));
+  RecordProperty("mediastinum_ml", std::to_string(m.lungs.mediastinumVolume * 1e6));
+  std::printf("%s: cavity %.0f mL, mediastinum %.0f mL, lungs %.0f mL (right %.0f, left %.0f)\n", GetParam().c_str(),
+              cavityVolume * 1e6, m.lungs.mediastinumVolume * 1e6, (cavityVolume - m.lungs.mediastinumVolume) * 1e6,
+              volume[0] * 1e6, volume[1] * 1e6);
 }
 
 TEST_P(BuiltPresets, TetGenVolumeEqualsSurfaceVolumeAndSurfaceHasNoSlivers) {

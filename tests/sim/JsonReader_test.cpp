@@ -132,6 +132,8 @@ TEST(JsonLoaders, ModelRejectsUnknownDuplicateAndWrappedKeys) {
           "cavity": {"vertices": [{"nodes": [0], "weights": [1]}, {"nodes": [1], "weights": [1]},
                                   {"nodes": [2], "weights": [1]}, {"nodes": [3], "weights": [1]}],
                      "triangles": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]},
+          "lungs": {"mediastinum_volume": 0, "right": {"vertices": [], "triangles": []},
+                    "left": {"vertices": [], "triangles": []}},
           "landmarks": [{"name": "xiphoid", "body": 0, "local": [0, 0, 0]},
                         {"name": "umbilicus", "body": 0, "local": [0, 0, 0]},
                         {"name": "diaphragm_apex", "body": 0, "local": [0, 0, 0]},

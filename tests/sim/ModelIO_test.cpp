@@ -66,6 +66,17 @@ Model tinyModel() {
   for (int i = 0; i < 4; ++i) m.cavity.vertices.addNodePoint(Eigen::Vector3i(i, -1, -1), Eigen::Vector3d(1, 0, 0));
   m.cavity.triangles = m.gut.triangles;
 
+  // two lungs: the cavity tetrahedron shrunk by half towards its centroid (each vertex 5/8 its own corner and
+  // 1/8 each other corner), and a mediastinum of a tenth of the cavity
+  for (LungSurface* lung : {&m.lungs.right, &m.lungs.left}) {
+    lung->cavityVertex.setConstant(kLungVertexSlots, 4, -1);
+    lung->weights.setZero(kLungVertexSlots, 4);
+    for (int v = 0; v < 4; ++v)
+      for (int k = 0; k < 4; ++k) lung->cavityVertex(k, v) = k, lung->weights(k, v) = k == v ? 0.625 : 0.125;
+    lung->triangles = m.cavity.triangles;
+  }
+  m.lungs.mediastinumVolume = 0.1 * 1e-3 / 6.0;
+
   for (const char* n : {"xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right"}) {
     m.landmarks.name.push_back(n);
     m.landmarks.points.addNodePoint(Eigen::Vector3i(1, 2, -1), Eigen::Vector3d(0.25, 0.75, 0));
@@ -121,6 +132,61 @@ TEST(ModelIO, RejectsCorruptedFilesNamingTheField) {
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["bodies"][0]["inertia"][0][0] = -1.0; })
                 .rfind("model.json: bodies[0].inertia: must be positive definite", 0),
             0u);
+}
+
+// a model.json written before the lungs is refused in one line that names the missing block; a malformed lung
+// block names its field
+TEST(ModelIO, LungBlockIsRequiredAndChecked) {
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j.erase("lungs"); }),
+            "model.json: lungs: missing (a model written before the two lungs; rebuild it with 'pneuma-cli model "
+            "build')");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"].erase("left"); }), "model.json: lungs.left: missing");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][2]["cavity_vertices"][1] = 4; }),
+            "model.json: lungs.right.vertices[2].cavity_vertices: index 4 out of range [0, 4)");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["left"]["vertices"][0]["weights"][1] = -0.125; }),
+            "model.json: lungs.left.vertices[0].weights: must be finite and >= 0, got -0.125");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["left"]["vertices"][0]["weights"][1] = 0.5; }),
+            "model.json: lungs.left.vertices[0].weights: must sum to 1, got 1.375");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][1]["weights"].erase(0); }),
+            "model.json: lungs.right.vertices[1].weights: must have as many entries as cavity_vertices (4)");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["mediastinum_volume"] = 1.0; }),
+            "model.json: lungs.mediastinum_volume: must be smaller than the cavity's rest volume 0.000166667 m^3, "
+            "got 1");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["triangles"].erase(3); }),
+            "model.json: lungs.right.triangles: must be a closed surface of at least 4 triangles, got 3");
+  EXPECT_NE(rejectionOf([](nlohmann::json& j) { std::swap(j["lungs"]["left"]["triangles"][1][0], j["lungs"]["left"]["triangles"][1][1]); })
+                .find("model.json: lungs.left.triangles[1]: edge"),
+            std::string::npos);
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
+              for (auto& t : j["lungs"]["left"]["triangles"]) std::swap(t[0], t[1]);
+            }).rfind("model.json: lungs.left.triangles: enclosed rest volume must be > 0", 0),
+            0u);
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["left"] = {{"vertices", nlohmann::json::array()}, {"triangles", nlohmann::json::array()}}; }),
+            "model.json: lungs.left: must be given with the other lung");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][0]["bones"] = 1; })
+                .rfind("model.json: lungs.right.vertices[0].bones: unknown field", 0),
+            0u);
+}
+
+// the lungs' volume is the cavity's minus the constant mediastinum, so its swing is the cavity's; the right and left
+// lungs split it as their surfaces do (here two equal surfaces: half each)
+TEST(ModelIO, LungVolumeIsTheCavityMinusTheMediastinum) {
+  auto model = std::make_shared<const Model>(tinyModel());
+  SimulationOptions o;
+  o.settleTime = 0.0;
+  Simulation sim(model, std::make_unique<BreathStyleController>(loadBreathStyle("calm")), o);
+  sim.advance(0.1);
+  const Metrics& m = sim.latestMetrics();
+  EXPECT_GT(m.thoracicCavityVolume, 0.0);
+  EXPECT_DOUBLE_EQ(m.lungVolume, m.thoracicCavityVolume - model->lungs.mediastinumVolume);
+  EXPECT_DOUBLE_EQ(m.rightLungVolume, 0.5 * m.lungVolume);
+  EXPECT_DOUBLE_EQ(m.rightLungVolume + m.leftLungVolume, m.lungVolume);
+  // a lung vertex follows its cavity corners: the lung is the cavity shrunk by half about its centroid
+  Eigen::Matrix3Xd cavity, x;
+  anchorPositions(model->cavity.vertices, sim.state(), cavity);
+  lungPositions(model->lungs.left, cavity, x);
+  const Eigen::Vector3d centroid = cavity.rowwise().mean();
+  for (int v = 0; v < 4; ++v) EXPECT_LT((x.col(v) - (centroid + 0.5 * (cavity.col(v) - centroid))).norm(), 1e-15);
 }
 
 // gut.drag is optional: a model written before the visceral drag existed loads without it

@@ -63,41 +63,35 @@ TEST(Breathing, CalmExpirationFallsWithoutRebound) {
   expectPassed(breathStyleChecks(runs({"calm"})), {"calm.expiration_rebound"});
 }
 
-// the mechanism, not only the volume: in a calm breath the central tendon descends as in M-mode ultrasound
-// (18 +/- 3 mm in men, Boussuges et al. 2009, Chest 135:391; 12-25 mm here) and more than it moves forward (the
-// dome hung on horizontal strands swung 19-28 mm forward while rising), and the belly moves out (Konno & Mead)
-TEST(Breathing, CalmDomeDescendsRatherThanSwingingForward) {
+// the mechanism, not only the volume: the breath's motion in anatomical axes against published physiology
+// (sim::physiologyChecks, shared with validate's Physiology section). Calm: the central tendon descends 12-25 mm
+// (M-mode ultrasound, Boussuges et al. 2009), the belly moves out on every inhale, rib 8's lateral distance grows
+// >= 2 mm, the rib cage and the abdomen move within 30 deg of each other (Chen et al. 2015), and the flow is a
+// spirogram's (two reversals per breath, no jump above 20 % of peak flow). Deep: the dome descends at least twice
+// as far as in a calm breath, 20-35 mm per litre inspired.
+TEST(Breathing, MotionWithinPublishedPhysiology) {
   REQUIRE_DEFAULT_MODEL();
-  const Motion& m = run("calm").summary.motion;
-  RecordProperty("dome_descent_mm", std::to_string(m.domeDescent * 1e3));
-  RecordProperty("dome_anterior_mm", std::to_string(m.domeAnterior * 1e3));
-  EXPECT_GT(m.domeDescent, 0.012);
-  EXPECT_LT(m.domeDescent, 0.025);
-  EXPECT_LT(std::abs(m.domeAnterior), m.domeDescent);
-  EXPECT_GT(m.umbilicusAnterior, 0.0);
-  RecordProperty("lower_rib_expansion_mm", std::to_string(m.lowerRibExpansion * 1e3));
-  // bucket-handle widening of the lower ribs (rib 8's lateral distance): at least 2 mm in a calm breath (1.2 mm
-  // while the caudal external intercostals pulled rib 10 toward the fixed floating ribs)
-  EXPECT_GT(m.lowerRibExpansion, 0.002);
+  const std::vector<Check> checks = physiologyChecks(runs({"calm", "deep"}));
+  for (const Check& c : checks) RecordProperty(c.id, std::to_string(c.measured));
+  expectPassed(checks, {"physiology.calm.dome_descent", "physiology.calm.umbilicus_forward", "physiology.calm.lower_rib_expansion",
+                        "physiology.calm.phase", "physiology.calm.flow_reversals", "physiology.calm.flow_jump",
+                        "physiology.deep.dome_over_calm", "physiology.deep.dome_per_litre"});
 }
 
-// rib cage and abdomen move together (phase 12-23 deg in healthy young adults, Chen et al. 2015; below 30 here,
-// 115 deg before the breath styles' drives were reworked) and the flow is a spirogram's: one inspiration and one
-// expiration per breath; deep breathing lowers the dome by 20-35 mm per litre (Boussuges et al. 2009: 70 +/- 11 mm
-// over an inspiratory capacity of 2-3.5 L)
-TEST(Breathing, RibCageAndAbdomenInPhaseAndDomeDescentPerLitre) {
+// What the model does not reach yet (issue 13), kept visible: a deep breath widens rib 8 by 5-6 mm against the
+// >= 10 mm bound, and the calm rib cage gives under half of the tidal volume against 55-85 % upright. When one
+// of them comes within range this test fails: move its id into MotionWithinPublishedPhysiology.
+TEST(Breathing, KnownGapsToPublishedPhysiologyAreStillOpen) {
   REQUIRE_DEFAULT_MODEL();
-  const Motion& calm = run("calm").summary.motion;
-  RecordProperty("rc_ab_phase_deg", std::to_string(calm.phaseAngle * 180.0 / M_PI));
-  EXPECT_LT(std::abs(calm.phaseAngle), 30.0 * M_PI / 180.0);
-  EXPECT_GT(calm.ribCageTidal, 0.0);
-  EXPECT_GT(calm.abdomenTidal, 0.0);
-  EXPECT_EQ(calm.flowSignChanges, 2.0);
-  const StyleRun& deep = run("deep");
-  const double perLitre = deep.summary.motion.domeDescent / (deep.summary.tidalVolume * 1e3);  // [m/L]
-  RecordProperty("deep_dome_mm_per_l", std::to_string(perLitre * 1e3));
-  EXPECT_GT(perLitre, 0.020);
-  EXPECT_LT(perLitre, 0.035);
+  const std::vector<Check> checks = physiologyChecks(runs({"calm", "deep"}));
+  int seen = 0;
+  for (const Check& c : checks)
+    if (c.id == "physiology.deep.lower_rib_expansion" || c.id == "physiology.calm.rib_cage_share") {
+      ++seen;
+      EXPECT_FALSE(c.isPassed()) << c.id << " = " << c.measured << " " << c.unit << " is now within " << c.target;
+      EXPECT_GT(c.measured, c.id == "physiology.deep.lower_rib_expansion" ? 4.0 : 25.0) << c.id << " regressed";
+    }
+  EXPECT_EQ(seen, 2);
 }
 
 // Table 2 slow/deep: 12 b/m; tidal volume above calm and within 1-3 L

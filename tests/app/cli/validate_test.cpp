@@ -46,11 +46,20 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   EXPECT_NE(html.find("data:image/png;base64,iVBORw0KGgo"), std::string::npos);  // PNG signature in base64
   EXPECT_EQ(html.find("src=\"figure"), std::string::npos);  // no external image references
   EXPECT_NE(slurp(out + "/figure6_lung_volume.svg").find("500 mL"), std::string::npos);
-  // the physiology section: the calm dome descent beside its published range and source, in both reports; the
-  // figure is report.json's styles.calm.dome_descent_mm
+  // the physiology section: every physiology check of report.json is a row of both reports, the calm dome descent
+  // beside its published range, its figure report.json's styles.calm.dome_descent_mm
   const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
   ASSERT_TRUE(report["styles"]["calm"]["dome_descent_mm"].is_number());
-  const std::string row = "| calm | dome descent (central tendon, craniocaudal) | ";
+  ASSERT_TRUE(report["physiology"].is_array());
+  int within = 0;
+  for (const auto& c : report["physiology"]) {
+    const std::string id = c["id"].get<std::string>();
+    EXPECT_NE(md.find("| " + id + " |"), std::string::npos) << id;
+    EXPECT_NE(html.find("<td>" + id + "</td>"), std::string::npos) << id;
+    within += c["passed"].get<bool>();
+  }
+  EXPECT_EQ(report["physiology_within"].get<int>(), within);
+  const std::string row = "| physiology.calm.dome_descent | dome descent (central tendon, craniocaudal), calm | ";
   const std::size_t at = md.find(row);
   ASSERT_NE(at, std::string::npos);
   EXPECT_NEAR(std::stod(md.substr(at + row.size())), report["styles"]["calm"]["dome_descent_mm"].get<double>(),

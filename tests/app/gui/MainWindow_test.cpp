@@ -9,6 +9,7 @@
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
 
+#include <QCheckBox>
 #include <QComboBox>
 #include <QFile>
 #include <QLabel>
@@ -16,6 +17,7 @@
 #include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
+
 #include <gtest/gtest.h>
 #include <vtkCaptionActor2D.h>
 #include <vtkCoordinate.h>
@@ -120,6 +122,34 @@ TEST(MainWindow, InhaleShowsForceColouredMusclesAndHidingThemRemovesThem) {
   EXPECT_LT(forceColouredPixels(w.window.grabView()), inhale);
 }
 
+// the two lungs are drawn (translucent, inside the rib cage) and the "Lungs" check box hides them
+TEST_F(DefaultModelWindow, LungsAreDrawnAndTheirCheckBoxHidesThem) {
+  viz::DisplayOptions o = window.scene().options();
+  EXPECT_TRUE(o.showLungs);
+  o.showBones = o.showGut = o.showLandmarks = false;
+  o.showGroup.fill(false);
+  window.setDisplayOptions(o);
+  const QImage with = window.grabView();
+  QCheckBox* box = nullptr;
+  for (QCheckBox* c : window.findChildren<QCheckBox*>())
+    if (c->text() == "Lungs") box = c;
+  ASSERT_NE(box, nullptr);
+  EXPECT_TRUE(box->isChecked());
+  box->click();
+  QApplication::processEvents();
+  EXPECT_FALSE(window.scene().options().showLungs);
+  const QImage without = window.grabView();
+  ASSERT_EQ(with.size(), without.size());
+  // the lungs cover a good part of the view; where they are, the backdrop shows through them (translucent)
+  int covered = 0;
+  for (int y = 0; y < with.height(); ++y)
+    for (int x = 0; x < with.width(); ++x) {
+      const QColor a = with.pixelColor(x, y), b = without.pixelColor(x, y);
+      covered += std::abs(a.red() - b.red()) + std::abs(a.green() - b.green()) + std::abs(a.blue() - b.blue()) > 30;
+    }
+  EXPECT_GT(covered, with.width() * with.height() / 50);
+}
+
 TEST(MainWindow, ExportedPlotFilesHoldThePlottedData) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(2.5));
@@ -148,7 +178,7 @@ TEST(MainWindow, ExportedPlotFilesHoldThePlottedData) {
   QFile svgFile(out.filePath("volume.svg"));
   ASSERT_TRUE(svgFile.open(QIODevice::ReadOnly));
   const QByteArray svgText = svgFile.readAll();
-  EXPECT_TRUE(svgText.contains("Lung-cavity volume"));
+  EXPECT_TRUE(svgText.contains("Lung volume"));
   EXPECT_TRUE(svgText.contains("volume [mL]"));
 
   // png: decodes, and is not blank

@@ -82,6 +82,14 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
 /// below calm end-expiration, umbilicus >= 1 cm posterior, xiphoid down.
 std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 
+/// The breath's motion in anatomical axes (Summary::motion) against published physiology, on runs named "calm"
+/// and "deep" (ids "physiology.<style>.<figure>"; checks whose runs are missing are left out), each with its source:
+/// calm dome descent 12-25 mm (M-mode ultrasound, Boussuges et al. 2009); deep dome descent >= 2 x calm and
+/// 20-35 mm per litre inspired; the umbilicus forward on every calm inhale; rib 8's lateral distance growing
+/// >= 2 mm calm and >= 10 mm deep; the calm rib-cage share 55-85 % upright; calm rib-cage / abdomen phase
+/// < 30 deg; two flow reversals per calm breath and no frame-to-frame flow jump above 20 % of peak flow.
+std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs);
+
 /// [m] backward sway of the spine top during inhales (Section 5: "during a deep inhale, as the ribs are
 /// pulled upward, the spine moves backward"): for every full inhale after settling (the controller's
 /// windows [settle + k T, settle + (k + inhaleFraction) T), T = 60 / breathsPerMinute), the most posterior

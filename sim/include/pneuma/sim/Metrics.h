@@ -20,7 +20,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Measurements at one output frame.
 struct Metrics {
   double time = 0.0;              ///< [s] simulated time of the frame
-  double lungVolume = 0.0;        ///< [m^3] volume enclosed by the bound lung-cavity surface (Figure 6)
+  /// [m^3] the two lungs: thoracicCavityVolume minus the mediastinum's constant volume (Lungs), so its tidal swing
+  /// is the cavity's (Figure 6)
+  double lungVolume = 0.0;
+  double thoracicCavityVolume = 0.0;  ///< [m^3] volume enclosed by the bound lung-cavity surface (Cavity)
+  double rightLungVolume = kNaN;  ///< [m^3] the right lung's share of lungVolume (Lungs); NaN without lung surfaces
+  double leftLungVolume = kNaN;   ///< [m^3] the left lung's share, lungVolume - rightLungVolume
   double gutVolume = 0.0;         ///< [m^3] gut volume V (sum of centroid -> face tetrahedra, Section 6.2)
   double gutVolumeError = 0.0;    ///< [-] signed relative error (V - V0) / V0
   double gutPressure = 0.0;       ///< [Pa] P = kappa (V0/V - 1), Eq. 4 (before clamping at 0)
@@ -69,6 +74,7 @@ struct Motion {
   double xiphoidCranial = kNaN;      ///< [m] its cranial motion
   double lowerRibExpansion = kNaN;   ///< [m] change of the distance between "rib8_lateral_left" and "_right"
   double umbilicusAnterior = kNaN;   ///< [m] anterior motion of "umbilicus"
+  double umbilicusAnteriorMin = kNaN;  ///< [m] its smallest value over the cycles (> 0: forward on every inhale)
   /// [m^3] abdomen's share of the tidal volume: the change of Metrics::abdomenVolume (Konno & Mead 1967)
   double abdomenTidal = kNaN;
   double ribCageTidal = kNaN;        ///< [m^3] the rest of the lung-volume change, tidal minus abdomenTidal

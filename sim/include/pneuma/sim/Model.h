@@ -152,6 +152,35 @@ struct Cavity {
   double compliance = 0.0;       ///< [m^3/Pa] C, the lung compliance; 0 = no pleural pressure
 };
 
+constexpr int kLungVertexSlots = 6;  ///< cavity vertices one lung vertex may combine (LungSurface)
+
+/// One lung's closed surface, embedded in the lung cavity (ArtiSynth-style embedding): each vertex is a convex
+/// combination of up to six cavity vertices, x_v = sum_k w_k c_{i_k}, with c the posed cavity vertices (Cavity).
+/// A vertex on a cavity wall takes the three corners of the cavity triangle it lies on, so the lung's costal and
+/// diaphragmatic faces move with the walls exactly; a vertex on the mediastinal face takes the two cavity points
+/// straight above and below it (three corners each), so that face follows the ribs above and the diaphragm below.
+struct LungSurface {
+  Eigen::Matrix<int, 6, Eigen::Dynamic> cavityVertex;  ///< cavity vertex indices, -1 marks an unused slot (6 x #V)
+  Eigen::Matrix<double, 6, Eigen::Dynamic> weights;    ///< [-] >= 0, summing to 1; 0 in unused slots     (6 x #V)
+  Eigen::Matrix3Xi triangles;                          ///< vertex indices, outward normals             (3 x #T)
+
+  int vertexCount() const { return static_cast<int>(cavityVertex.cols()); }
+};
+
+/// The two lungs: the lung cavity minus the mediastinum (heart, great vessels, trachea, oesophagus, the vertebral
+/// bodies' bulge), split at the midline. The heart and the mediastinum are incompressible, so the lungs' volume is
+/// the cavity's volume minus a constant:
+///   V_lungs = V_cavity - V_med,  V_right = V_lungs s_R,  V_left = V_lungs (1 - s_R),
+/// with s_R = V(right surface) / (V(right surface) + V(left surface)) of the posed surfaces, about 0.535 at rest
+/// (right 53.5 %, left 46.5 %: Yamada et al. 2020, "Lung volumes on CT, upright and supine", Sci Rep 10:19434).
+/// The tidal swing of V_lungs is thus exactly the cavity's. The surfaces are for display, export and the split.
+/// An empty Lungs (no surfaces, V_med = 0) makes the lungs the cavity (in-memory test models).
+struct Lungs {
+  LungSurface right;              ///< the right lung (x > 0: world RAS, +x toward the subject's right)
+  LungSurface left;               ///< the left lung
+  double mediastinumVolume = 0.0; ///< [m^3] V_med, the part of the cavity's rest volume the lungs do not fill, >= 0
+};
+
 /// Named points for measurement, bound like cavity vertices.
 /// Required names: "xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right".
 struct Landmarks {
@@ -173,6 +202,7 @@ struct Model {
   Gut gut;
   Elements elements;
   Cavity cavity;
+  Lungs lungs;
   Landmarks landmarks;
 };
 

@@ -44,4 +44,8 @@ inline Eigen::Vector3d anchorPosition(const AnchorSet& anchors, int i, const Sta
 /// resized).
 void anchorPositions(const AnchorSet& anchors, const State& state, Eigen::Matrix3Xd& out);
 
+/// World positions [m] of the vertices of `lung` (LungSurface: x_v = sum_k w_k c_{i_k}) from the posed cavity
+/// vertices `cavity` (3 x #C, anchorPositions() of Cavity::vertices), written into `out` (3 x #V, resized).
+void lungPositions(const LungSurface& lung, const Eigen::Matrix3Xd& cavity, Eigen::Matrix3Xd& out);
+
 }  // namespace pneuma::sim

@@ -1,0 +1,165 @@
+// No surface passes through another (issue 13): the lung cavity, the two lungs and the gut, posed at
+// end-expiration and end-inspiration (the frames of smallest and largest lung volume after settling) of every
+// shipped breath style (resources/presets/*.json) and every affect preset (resources/presets/affect/), checked
+// with the triangle-triangle crossing test of SurfaceCrossings.h: each surface against itself, and the pairs
+// that must not cross (each lung with the gut, with the cavity and with the other lung). Short runs: two
+// seconds of settling and one breath or a few seconds of each style. Skips when the default model is absent.
+#include "DefaultModel.h"
+#include "SurfaceCrossings.h"
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/pattern/PatternController.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+namespace pneuma::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using test::defaultModel;
+
+// the posed surfaces of one frame
+struct Posed {
+  Eigen::Matrix3Xd cavity, right, left, gut;
+};
+
+Posed pose(const Model& m, const State& s) {
+  Posed p;
+  anchorPositions(m.cavity.vertices, s, p.cavity);
+  lungPositions(m.lungs.right, p.cavity, p.right);
+  lungPositions(m.lungs.left, p.cavity, p.left);
+  p.gut = s.nodePosition;
+  return p;
+}
+
+// crossings per pair, e.g. {"cavity": 0, "right-gut": 3, ...}
+std::map<std::string, int> crossings(const Model& m, const State& s) {
+  using pneuma::test::countCrossings;
+  using pneuma::test::countSelfCrossings;
+  const Posed p = pose(m, s);
+  const Eigen::Matrix3Xi &tc = m.cavity.triangles, &tr = m.lungs.right.triangles, &tl = m.lungs.left.triangles,
+                         &tg = m.gut.triangles;
+  return {{"cavity", countSelfCrossings(p.cavity, tc)},
+          {"gut", countSelfCrossings(p.gut, tg)},
+          {"right", countSelfCrossings(p.right, tr)},
+          {"left", countSelfCrossings(p.left, tl)},
+          {"right-left", countCrossings(p.right, tr, p.left, tl)},
+          {"right-gut", countCrossings(p.right, tr, p.gut, tg)},
+          {"left-gut", countCrossings(p.left, tl, p.gut, tg)},
+          {"right-cavity", countCrossings(p.right, tr, p.cavity, tc)},
+          {"left-cavity", countCrossings(p.left, tl, p.cavity, tc)}};
+}
+
+std::string describe(const std::map<std::string, int>& c) {
+  std::ostringstream s;
+  for (const auto& [pair, n] : c) s << pair << " " << n << "; ";
+  return s.str();
+}
+
+// the lung's self-crossings that involve a face on the mediastinum (a vertex embedded between the cavity points
+// above and below it, 6 cavity slots): the embedding's own, as opposed to those it inherits from the cavity's walls
+int medialCrossings(const LungSurface& l, const Eigen::Matrix3Xd& x) {
+  std::vector<std::pair<int, int>> pairs;
+  pneuma::test::countSelfCrossings(x, l.triangles, pneuma::test::kCrossingTolerance, &pairs);
+  auto isMedial = [&](int f) {
+    for (int k = 0; k < 3; ++k)
+      if (l.cavityVertex(3, l.triangles(k, f)) >= 0) return true;
+    return false;
+  };
+  int n = 0;
+  for (const auto& [a, b] : pairs) n += isMedial(a) && isMedial(b);
+  return n;
+}
+
+// The cavity's walls cross at the costal margin once the model has settled (issue 13): the diaphragm's dome, bound to
+// the gut, moves outward through the rib-bound wall at ribs 7-8 on both sides (z about 230 mm), its nodes up to 25-80
+// mm beyond the wall's plane, and the gut crosses itself in 0-17 places. The lungs inherit it: their costal and
+// diaphragmatic faces lie on those walls (every lung self-crossing there is between two wall faces). It is the
+// mechanics' (nothing keeps the gut inside the rib cage), not the meshing's. Until it is fixed, those pairs are
+// reported and the test is skipped naming them; set this to true to enforce them.
+constexpr bool kEnforceWallCrossings = false;
+
+// runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after settling:
+// the two lungs never cross each other nor does a mediastinal face cross anything; the other crossings are added
+// to `wall` (see kEnforceWallCrossings)
+void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> controller, double duration,
+                       std::ostringstream& wall) {
+  const auto model = defaultModel();
+  SimulationOptions o;
+  o.settleTime = 2.0;
+  o.outputRate = 30.0;
+  o.recordSeconds = kTraceOnlyRecordSeconds;
+  Simulation sim(model, std::move(controller), o);
+  State lo, hi;
+  double vMin = 1e9, vMax = -1e9;
+  sim.advance(o.settleTime + duration, [&](const Simulation& s) {
+    if (s.state().time < o.settleTime) return true;
+    const double v = s.latestMetrics().lungVolume;
+    if (v < vMin) vMin = v, lo = s.state();
+    if (v > vMax) vMax = v, hi = s.state();
+    return true;
+  });
+  ASSERT_GT(vMax, vMin) << name;
+  for (const auto& [phase, state] : {std::pair<const char*, const State*>{"end-expiration", &lo}, {"end-inspiration", &hi}}) {
+    const std::map<std::string, int> c = crossings(*model, *state);
+    const Posed p = pose(*model, *state);
+    const int medial = medialCrossings(model->lungs.right, p.right) + medialCrossings(model->lungs.left, p.left);
+    EXPECT_EQ(c.at("right-left"), 0) << name << " at " << phase;
+    EXPECT_EQ(medial, 0) << name << " at " << phase << ": mediastinal faces cross";
+    int total = 0;
+    for (const auto& [pair, n] : c) total += n;
+    testing::Test::RecordProperty(name + "." + phase, describe(c));
+    if (kEnforceWallCrossings) EXPECT_EQ(total, 0) << name << " at " << phase << ": " << describe(c);
+    if (total > 0) wall << "\n  " << name << " at " << phase << ": " << describe(c);
+  }
+}
+
+// the known crossings at the costal margin, reported as a skip until kEnforceWallCrossings
+void reportWallCrossings(const std::ostringstream& wall) {
+  if (!wall.str().empty()) GTEST_SKIP() << "surfaces cross at the costal margin (kEnforceWallCrossings):" << wall.str();
+}
+
+TEST(Surfaces, DefaultModelAtRestHasNoCrossings) {
+  REQUIRE_DEFAULT_MODEL();
+  const Model& m = *defaultModel();
+  ASSERT_GT(m.lungs.right.vertexCount(), 0);
+  const std::map<std::string, int> c = crossings(m, makeInitialState(m));
+  for (const auto& [pair, n] : c) EXPECT_EQ(n, 0) << pair;
+}
+
+TEST(Surfaces, NoCrossingsInAnyBreathStyle) {
+  REQUIRE_DEFAULT_MODEL();
+  std::ostringstream wall;
+  for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) {
+    const BreathStyle s = loadBreathStyle(style);
+    // one breath of the periodic styles (at least 4 s), the forced exhale's whole manoeuvre
+    const double duration = s.cycles > 0 ? 7.0 : std::max(4.0, 60.0 / s.breathsPerMinute);
+    expectNoCrossings(style, std::make_unique<BreathStyleController>(s), duration, wall);
+  }
+  reportWallCrossings(wall);
+}
+
+TEST(Surfaces, NoCrossingsInAnyAffect) {
+  REQUIRE_DEFAULT_MODEL();
+  const pattern::DriveCalibration calibration = pattern::calibrateDrive(defaultModel());
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(fs::path(PNEUMA_RESOURCE_DIR) / "presets" / "affect"))
+    if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  ASSERT_GE(names.size(), 10u);
+  std::ostringstream wall;
+  for (const std::string& name : names)
+    expectNoCrossings("affect " + name, pattern::makeAffectController(name, PNEUMA_RESOURCE_DIR, 1, calibration), 4.0,
+                      wall);
+  reportWallCrossings(wall);
+}
+
+}  // namespace
+}  // namespace pneuma::sim
