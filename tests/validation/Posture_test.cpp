@@ -65,11 +65,6 @@ TEST(Posture, SettlingConvergesLyingDown) {
 // 1967): the rib cage's share of the calm tidal volume is smaller supine
 TEST(Posture, SupineRibCageShareBelowUpright) {
   REQUIRE_DEFAULT_MODEL();
-  GTEST_SKIP() << "defect (issue 13): the model gives the opposite direction, rib-cage share 32.1 % upright and "
-                  "37.5 % supine (calm): the abdomen's tidal volume is the same in both postures (349 vs 340 mL) and "
-                  "the rib cage's grows supine (165 vs 204 mL); the linear tension-only abdominal wall is stiffer "
-                  "supine (69 of 407 transversus/oblique elements slack against 118 upright) and has no upright tone "
-                  "(docs/cli.md, 'Posture')";
   expectPassed(postureCheck("posture.rib_cage_share"));
 }
 
