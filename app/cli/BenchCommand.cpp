@@ -30,6 +30,7 @@ struct BenchArgs {
   std::string out;
   double seconds = 4.0;  // [s] simulated per measurement
   std::string integrator;
+  std::string posture;
 };
 
 /// Keeps the points `keep` of an anchor set.
@@ -93,6 +94,7 @@ void runBench(const BenchArgs& args) {
   options.settleTime = 0.0;
   options.recordSeconds = sim::kTraceOnlyRecordSeconds;
   applyIntegrator(args.integrator, options.step.integrator);
+  applyPosture(args.posture, options.step.posture);
   std::shared_ptr<const sim::Model> model;
   std::vector<sim::BreathStyle> styles;
   try {
@@ -109,10 +111,12 @@ void runBench(const BenchArgs& args) {
   j["pneuma_version"] = PNEUMA_VERSION;
   j["model"] = modelDir;
   j["integrator"] = sim::integratorName(options.step.integrator);
+  j["posture"] = sim::postureName(options.step.posture);
   j["dt_s"] = dt;
   j["simulated_seconds"] = args.seconds;
-  std::printf("model %s: %d bodies, %d nodes, %d elements; %s, dt = %g s, %g s simulated per row\n\n", model->name.c_str(),
-              model->bodies.size(), model->nodes.size(), model->elements.size(), sim::integratorName(options.step.integrator), dt,
+  std::printf("model %s: %d bodies, %d nodes, %d elements; %s, %s, dt = %g s, %g s simulated per row\n\n",
+              model->name.c_str(), model->bodies.size(), model->nodes.size(), model->elements.size(),
+              sim::integratorName(options.step.integrator), sim::postureName(options.step.posture), dt,
               args.seconds);
 
   // real-time factor per breath style
@@ -160,6 +164,7 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "Also write bench.json into this directory");
   cmd->add_option("--seconds", args->seconds, "Simulated seconds per measurement (default 4)");
   addIntegratorOption(*cmd, args->integrator);
+  addPostureOption(*cmd, args->posture);
   cmd->callback([args] { runBench(*args); });
 }
 

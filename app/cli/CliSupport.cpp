@@ -62,15 +62,42 @@ void addModelOption(CLI::App& cmd, std::string& model) {
       "Model directory (default: $PNEUMA_MODEL_DIR, else <bindir>/../share/pneuma/models/default)");
 }
 
+namespace {
+
+// help text of an option naming one of `names`: "<what>: one of a, b (default a)"
+std::string choiceHelp(const std::string& what, const std::string& names, const char* defaultName) {
+  return what + ": one of " + names + " (default " + defaultName + ")";
+}
+
+// "<flag>: unknown <kind> 'value' (valid: a, b)", exit 2
+[[noreturn]] void failUnknown(const char* flag, const char* kind, const std::string& value,
+                              const std::string& names) {
+  fail(kExitBadInput,
+       std::string(flag) + ": unknown " + kind + " '" + value.substr(0, 60) + "' (valid: " + names + ")");
+}
+
+}  // namespace
+
 void addIntegratorOption(CLI::App& cmd, std::string& name) {
   cmd.add_option("--integrator", name,
-                 "One of " + sim::integratorNames() + " (default " +
-                     sim::integratorName(sim::StepOptions{}.integrator) + ")");
+                 choiceHelp("Time integration scheme", sim::integratorNames(),
+                            sim::integratorName(sim::StepOptions{}.integrator)));
 }
 
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind) {
   if (!name.empty() && !sim::integratorFromName(name, kind))
-    fail(kExitBadInput, "--integrator: unknown integrator '" + name + "' (valid: " + sim::integratorNames() + ")");
+    failUnknown("--integrator", "integrator", name, sim::integratorNames());
+}
+
+void addPostureOption(CLI::App& cmd, std::string& name) {
+  cmd.add_option("--posture", name,
+                 choiceHelp("Gravity relative to the body", sim::postureNames(),
+                            sim::postureName(sim::StepOptions{}.posture)));
+}
+
+void applyPosture(const std::string& name, sim::Posture& posture) {
+  if (!name.empty() && !sim::postureFromName(name, posture))
+    failUnknown("--posture", "posture", name, sim::postureNames());
 }
 
 }  // namespace pneuma::app

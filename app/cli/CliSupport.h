@@ -43,6 +43,13 @@ void addIntegratorOption(CLI::App& cmd, std::string& name);
 /// Sets `kind` from an --integrator value ("" keeps it); an unknown name fails with kExitBadInput and the valid names.
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind);
 
+/// Adds `--posture NAME` to `cmd`; applyPosture() reads it.
+void addPostureOption(CLI::App& cmd, std::string& name);
+
+/// Sets `posture` from a --posture value ("" keeps it); an unknown name fails with kExitBadInput and the
+/// valid names.
+void applyPosture(const std::string& name, sim::Posture& posture);
+
 /// Fails with kExitBadInput and "<flag>: must be in [lo, hi] unit, got v" unless `range` contains `v`.
 void checkOption(const sim::Range& range, const char* flag, double v);
 

@@ -44,6 +44,7 @@ struct SimulateArgs {
   bool force = false;       // replace an earlier run's results in `out`
   std::uint64_t seed = 0;
   std::string integrator;
+  std::string posture;
   double dt = 0.0;          // [s]
   double settle = 0.0;      // [s]
   std::function<bool(const char*)> isGiven;
@@ -78,6 +79,7 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (a.vtk) s.outputs.vtk = true;
   if (a.isGiven("--seed")) s.seed = a.seed;
   applyIntegrator(a.integrator, s.options.step.integrator);
+  applyPosture(a.posture, s.options.step.posture);
   if (a.isGiven("--dt")) {
     checkOption(sim::kTimeStepRange, "--dt", a.dt);
     s.options.dt = a.dt;
@@ -213,6 +215,7 @@ void runSimulate(const SimulateArgs& args) {
   j["controller"] = controllerText;
   j["controller_kind"] = sim::controllerKindName(scenario.controller);
   j["integrator"] = sim::integratorName(scenario.options.step.integrator);
+  j["posture"] = sim::postureName(scenario.options.step.posture);
   j["dt_s"] = simulation ? nlohmann::json(simulation->dt()) : none;
   j["steps"] = sum.steps;
   j["seed"] = scenario.seed;
@@ -300,6 +303,7 @@ void addSimulateCommand(CLI::App& app) {
           },
           "UINT64"));
   addIntegratorOption(*cmd, args->integrator);
+  addPostureOption(*cmd, args->posture);
   cmd->add_option("--dt", args->dt,
                   "Time step [s] (default: the integrator's, 1/60 s for implicit-euler-joints; 10 ms for affect and "
                   "pattern runs)");

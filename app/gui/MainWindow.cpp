@@ -114,7 +114,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
 
   m_messageTimer = new QTimer(this);
   m_messageTimer->setSingleShot(true);
-  connect(m_messageTimer, &QTimer::timeout, this, [this] { m_statusModel->setText(m_modelText); });
+  connect(m_messageTimer, &QTimer::timeout, this, [this] { m_statusModel->setText(modelStatus()); });
 
   m_refresh = new QTimer(this);
   m_refresh->setInterval(kRefreshMs);
@@ -385,6 +385,7 @@ void MainWindow::buildDocks() {
     m_settings = s;
     m_plots->setBreathPeriod(60.0 / s.style.breathsPerMinute);
     if (m_worker) m_worker->requestSettings(s);
+    showPosture();
   });
 
   auto* tabs = new QTabWidget(this);
@@ -426,6 +427,15 @@ void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
   m_view->renderWindow()->Render();
 }
 
+QString MainWindow::modelStatus() const {
+  if (!m_model) return m_modelText;
+  return m_modelText + QString(", posture %1").arg(sim::postureName(m_settings.options.step.posture));
+}
+
+void MainWindow::showPosture() {
+  if (!m_messageTimer->isActive()) m_statusModel->setText(modelStatus());
+}
+
 void MainWindow::showMessage(const QString& text, int milliseconds) {
   m_statusModel->setText(text);
   m_messageTimer->start(milliseconds);
@@ -463,7 +473,7 @@ QString MainWindow::openModel(const QString& dir) {
                     .arg(model->bodies.size())
                     .arg(model->elements.size())
                     .arg(model->nodes.size());
-  m_statusModel->setText(m_modelText);
+  m_statusModel->setText(modelStatus());
   setWindowTitle(QString("Pneuma \u2014 %1").arg(QString::fromStdString(model->name)));
 
   if (!m_worker) {
@@ -532,6 +542,19 @@ QString MainWindow::setBreathStyle(const QString& name) {
   m_params->setSettings(m_settings, m_document.model());
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   if (m_worker) m_worker->requestSettings(m_settings);
+  return {};
+}
+
+QString MainWindow::setPosture(const QString& name) {
+  if (!sim::postureFromName(name.toStdString(), m_settings.options.step.posture)) {
+    const QString error = QString("unknown posture '%1' (valid: %2)")
+                              .arg(name.left(60), QString::fromStdString(sim::postureNames()));
+    report("Unknown posture", error);
+    return error;
+  }
+  m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
+  if (m_worker) m_worker->requestSettings(m_settings);
+  showPosture();
   return {};
 }
 

@@ -55,6 +55,9 @@ class MainWindow : public QMainWindow {
   QString saveScenario(const QString& path);
   /// Selects a breath style preset by name ("calm", "deep", "panting", "forced-exhale").
   QString setBreathStyle(const QString& name);
+  /// Selects the posture by name (sim::postureNames()); a new posture restarts the run, which settles in it.
+  /// @return empty, or the error (an unknown name lists the valid ones).
+  QString setPosture(const QString& name);
 
   void play();
   void pause();
@@ -119,6 +122,10 @@ class MainWindow : public QMainWindow {
   void report(const QString& title, const QString& message);
   /// Shows `text` in the status bar for a while, then the model line again.
   void showMessage(const QString& text, int milliseconds);
+  /// The status bar's model text with the run's posture ("Model: ... , posture supine").
+  QString modelStatus() const;
+  /// Shows modelStatus() now unless a message is on show (it comes back when the message ends).
+  void showPosture();
   void select(const viz::Pick& pick);
   void exportPlotInteractive(const PlotView* plot);
   void updateTimeline();

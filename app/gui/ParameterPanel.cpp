@@ -3,6 +3,7 @@
 #include "pneuma/sim/Error.h"
 
 #include <QCheckBox>
+#include <QComboBox>
 #include <QFormLayout>
 #include <QLabel>
 #include <QLineEdit>
@@ -69,6 +70,20 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
   });
   form->addRow(QString(), m_gravity);
 
+  // the names in sim's order; a new posture restarts the run (SimWorker), which settles in it
+  m_posture = new QComboBox;
+  m_posture->addItems(QString::fromStdString(sim::postureNames()).split(", "));
+  m_posture->setToolTip(
+      "Direction of gravity relative to the body: upright (seated, the paper's subject), supine "
+      "(lying on the back), prone, left- or right-lateral. A change restarts the run.");
+  connect(m_posture, &QComboBox::textActivated, this, [this](const QString& name) {
+    if (!sim::postureFromName(name.toStdString(), m_settings.options.step.posture)) return;
+    emit settingsEdited(m_settings);
+  });
+  auto* postureLabel = new QLabel("Posture");
+  postureLabel->setToolTip(m_posture->toolTip());
+  form->addRow(postureLabel, m_posture);
+
   m_reason = new QLabel;
   m_reason->setWordWrap(true);
   m_reason->setStyleSheet("color: #b00020;");
@@ -99,6 +114,8 @@ void ParameterPanel::setSettings(const RunSettings& settings, std::shared_ptr<co
   }
   const QSignalBlocker block(m_gravity);
   m_gravity->setChecked(m_settings.options.step.gravity);
+  const QSignalBlocker blockPosture(m_posture);
+  m_posture->setCurrentText(sim::postureName(m_settings.options.step.posture));
   m_reason->clear();
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 /// @file ParameterPanel.h
 /// The parameter panel: breathing frequency, contraction ratios r, gain scales, gut kappa, joint
-/// friction and gravity. Each edit is checked with the sim's own validators before anything is applied;
-/// an invalid value stays in its field, marked red, with the validator's reason shown under the panel.
+/// friction, gravity and the posture (a combo box of sim::postureNames()). Each edit is checked with the
+/// sim's own validators before anything is applied; an invalid value stays in its field, marked red, with the
+/// validator's reason shown under the panel.
 
 #include "gui/SimWorker.h"
 
@@ -13,6 +14,7 @@
 #include <vector>
 
 class QCheckBox;
+class QComboBox;
 class QLabel;
 class QLineEdit;
 
@@ -33,6 +35,8 @@ class ParameterPanel : public QWidget {
   QString refusal() const;
   /// The field editing the breathing frequency [breaths/min] (for tests and shortcuts).
   QLineEdit* frequencyField() const { return m_fields.front().edit; }
+  /// The posture combo box (for tests).
+  QComboBox* postureBox() const { return m_posture; }
 
  signals:
   /// A valid edit: apply at the next sync point.
@@ -54,6 +58,7 @@ class ParameterPanel : public QWidget {
   std::shared_ptr<const sim::Model> m_model;
   std::vector<Field> m_fields;
   QCheckBox* m_gravity = nullptr;
+  QComboBox* m_posture = nullptr;
   QLabel* m_reason = nullptr;
 };
 

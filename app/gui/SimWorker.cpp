@@ -120,8 +120,15 @@ void SimWorker::sync() {
     m_samples.clear();
     ++m_generation;
   }
+  // a new posture turns gravity: the run starts over from the rest pose and settles in it
+  const bool isNewPosture = p.settings && p.settings->options.step.posture != m_settings.options.step.posture;
   if (p.settings) applySettings(*p.settings);
-  if (p.doReset) {
+  if (isNewPosture && m_pattern) {
+    // an affect's drive was calibrated in the old posture: back to the breath style until one is pushed again
+    m_sim->setController(std::make_unique<sim::BreathStyleController>(m_settings.style));
+    m_pattern = nullptr;
+  }
+  if (p.doReset || isNewPosture) {
     m_sim->reset();
     m_runUntil = -1.0;
     m_samples.clear();

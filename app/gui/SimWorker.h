@@ -25,7 +25,7 @@ class QTimer;
 namespace pneuma::app {
 
 /// The user-editable run settings: the breath style (frequency, r values) and the simulation options
-/// (gains, kappa, joint friction, gravity).
+/// (gains, kappa, joint friction, gravity, posture). A new posture restarts the run from the rest pose.
 struct RunSettings {
   sim::BreathStyle style;
   sim::SimulationOptions options;

@@ -73,6 +73,11 @@ int main(int argc, char** argv) {
   const QCommandLineOption style("style", "Breath style: calm, deep, panting or forced-exhale.", "NAME");
   const QCommandLineOption affect("affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).",
                                   "NAME");
+  const QCommandLineOption posture(
+      "posture",
+      QString::fromStdString("Gravity relative to the body: " + pneuma::sim::postureNames() + " (default " +
+                             pneuma::sim::postureName(pneuma::sim::StepOptions{}.posture) + ")."),
+      "NAME");
   const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.", "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
@@ -83,7 +88,7 @@ int main(int argc, char** argv) {
   const QCommandLineOption measure("measure",
                                    "Run for SECONDS of wall time, print render fps and real-time factor, exit.",
                                    "SECONDS");
-  parser.addOptions({model, style, affect, camera, labels, speed, screenshot, after, measure});
+  parser.addOptions({model, style, affect, posture, camera, labels, speed, screenshot, after, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -132,6 +137,7 @@ int main(int argc, char** argv) {
   QApplication::processEvents();
   const bool isScripted = parser.isSet(screenshot);
   if (parser.isSet(style) && !window.setBreathStyle(parser.value(style)).isEmpty() && isScripted) return 2;
+  if (parser.isSet(posture) && !window.setPosture(parser.value(posture)).isEmpty() && isScripted) return 2;
   const QString modelDir = parser.isSet(model) ? parser.value(model) : pneuma::app::MainWindow::defaultModelDir();
   const bool hasModel = window.openModel(modelDir).isEmpty();
   if (hasModel && parser.isSet(affect)) {

@@ -286,6 +286,39 @@ std::vector<Check> swayChecks(const StyleRun& withFriction, const StyleRun& fric
                 sec5, "-", std::abs(b) / std::max(std::abs(a), 1e-12), 0.0, 0.5)};
 }
 
+double settleDrift(const StyleRun& r, double window) {
+  if (r.trace.size() == 0) return 0.0;
+  const std::size_t end = settledFrame(r);
+  std::size_t start = end;
+  while (start > 0 && r.trace.time[start] > r.settleTime - window) --start;
+  if (r.trace.time[start] > r.settleTime - window + 1e-9) return 0.0;
+  return r.trace.lungVolume[end] - r.trace.lungVolume[start];
+}
+
+std::vector<Check> postureChecks(const StyleRun& upright, const StyleRun& supine) {
+  const auto share = [](const StyleRun& r) {
+    const Motion& m = r.summary.motion;
+    return m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal);
+  };
+  const std::string name = upright.style.name;
+  const double eev = upright.summary.endExpiratoryVolume;
+  const double bound = 0.02 * supine.summary.tidalVolume;  // [m^3] settling drift
+  return {
+      check("posture.rib_cage_share",
+            "rib-cage share of the tidal volume, " + name + ", supine minus upright",
+            "<= -1 percentage point (more abdominal supine)",
+            "Sharp et al. 1975, J Appl Physiol 39:608; Konno & Mead 1967", "%",
+            (share(supine) - share(upright)) * kPct, -kBig, -1.0),
+      check("posture.end_expiratory_volume",
+            "end-expiratory lung volume, " + name + ", supine relative to upright",
+            "<= -1 % (lung volumes 5.3-14.7 % larger upright)",
+            "Yamada et al. 2020, Sci Rep, doi:10.1038/s41598-020-73240-8", "%",
+            (supine.summary.endExpiratoryVolume - eev) / eev * kPct, -kBig, -1.0),
+      check("posture.settled_supine", "lung-volume drift in the last 0.5 s of settling, " + name + ", supine",
+            "within 2 % of the tidal volume", "pneuma (the settling reaches the posture's rest)", "mL",
+            settleDrift(supine) * kMl, -bound * kMl, bound * kMl)};
+}
+
 ImpactRun runHeavyImpact(std::shared_ptr<const Model> modelPtr, const ExperimentSettings& settings) {
   const Model& model = *modelPtr;
   const int umbilicus = model.landmarks.find("umbilicus");

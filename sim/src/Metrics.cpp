@@ -260,21 +260,19 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
 
   // energies: kinetic, elastic (elements at the current pose, gut, joint springs), gravity
   double kinetic = 0.0, gravity = 0.0;
+  const Vector3d g = postureGravity(model, options);  // zero when gravity is off
   for (int b = 0; b < model.bodies.size(); ++b) {
     if (model.bodies.isFixed[at(b)]) continue;
     const Matrix3d r = state.bodyOrientation[at(b)].toRotationMatrix();
     const Vector3d om = r.transpose() * state.bodyAngularVelocity.col(b);
     kinetic += 0.5 * model.bodies.mass(b) * state.bodyVelocity.col(b).squaredNorm() +
                0.5 * om.dot(model.bodies.inertia[at(b)] * om);
-    if (options.gravity)
-      gravity -=
-          model.bodies.mass(b) * model.gravity.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
+    gravity -= model.bodies.mass(b) * g.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
   }
   for (int n = 0; n < model.nodes.size(); ++n) {
     if (model.nodes.isFixed(n)) continue;
     kinetic += 0.5 * model.nodes.mass(n) * state.nodeVelocity.col(n).squaredNorm();
-    if (options.gravity)
-      gravity -= model.nodes.mass(n) * model.gravity.dot(state.nodePosition.col(n) - model.nodes.rest.col(n));
+    gravity -= model.nodes.mass(n) * g.dot(state.nodePosition.col(n) - model.nodes.rest.col(n));
   }
   double elastic = 0.0;
   for (int e = 0; e < el.size(); ++e) {

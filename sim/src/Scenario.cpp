@@ -68,8 +68,8 @@ void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
 }
 
 void parseOverrides(const Field& o, SimulationOptions& opt) {
-  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "joint_friction_scale", "gut_drag_scale", "kappa_pa",
-               "active_gain_scale", "passive_gain_scale"});
+  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "posture", "joint_friction_scale",
+               "gut_drag_scale", "kappa_pa", "active_gain_scale", "passive_gain_scale"});
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
     if (!integratorFromName(name, opt.step.integrator))
@@ -78,6 +78,11 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("dt_s")) opt.dt = o.at("dt_s").numberIn(kTimeStepRange);
   if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").numberIn(kSettleTimeRange);
   if (o.has("gravity")) opt.step.gravity = o.at("gravity").boolean();
+  if (o.has("posture")) {
+    const std::string name = o.at("posture").string();
+    if (!postureFromName(name, opt.step.posture))
+      o.at("posture").fail("unknown posture '" + excerptOf(name) + "' (valid: " + postureNames() + ")");
+  }
   if (o.has("joint_friction_scale")) opt.step.jointFrictionScale = o.at("joint_friction_scale").nonNegative();
   if (o.has("gut_drag_scale")) opt.step.gutDragScale = o.at("gut_drag_scale").nonNegative();
   if (o.has("kappa_pa")) opt.step.kappa = o.at("kappa_pa").positive();
@@ -169,6 +174,7 @@ std::string serializeScenario(const Scenario& s) {
   if (s.options.dt) o["dt_s"] = *s.options.dt;
   o["settle_time_s"] = s.options.settleTime;
   o["gravity"] = st.gravity;
+  o["posture"] = postureName(st.posture);
   o["joint_friction_scale"] = st.jointFrictionScale;
   o["gut_drag_scale"] = st.gutDragScale;
   if (st.kappa) o["kappa_pa"] = *st.kappa;

@@ -12,6 +12,10 @@
 
 namespace pneuma::sim {
 
+namespace {
+constexpr long long kCheckpointVersion = 2;  // 2 adds simulation.posture
+}  // namespace
+
 void validateSimulationOptions(const SimulationOptions& o) {
   validateStepOptions(o.step);
   if (o.dt) kTimeStepRange.check("dt", *o.dt);
@@ -177,8 +181,9 @@ void Simulation::restore(const SimulationCheckpoint& c) {
 
 void Simulation::save(std::ostream& out) const {
   CheckpointWriter w(out);
-  w.write("pneuma.checkpoint", 1);
+  w.write("pneuma.checkpoint", kCheckpointVersion);
   w.write("simulation.dt", m_dt);
+  w.write("simulation.posture", postureName(m_options.step.posture));
   w.write("simulation.nextFrameTime", m_nextFrameTime);
   writeActivations(w, "simulation.activations", m_activations);
   writeState(w, m_state);
@@ -192,13 +197,20 @@ void Simulation::save(std::ostream& out) const {
 
 void Simulation::load(std::istream& in, const std::string& source) {
   CheckpointReader r(in, source);
-  if (r.readInt("pneuma.checkpoint") != 1) r.fail("pneuma.checkpoint", "unknown version");
+  if (const long long version = r.readInt("pneuma.checkpoint"); version != kCheckpointVersion)
+    r.fail("pneuma.checkpoint", "version " + std::to_string(version) + ", this build reads version " +
+                                    std::to_string(kCheckpointVersion));
   const double dt = r.readDouble("simulation.dt");
   if (dt != m_dt) {
     std::ostringstream os;
     os << "saved at dt = " << dt << " s, this run steps at " << m_dt << " s";
     r.fail("simulation.dt", os.str());
   }
+  // the posture is the direction of gravity: a run continues only in the posture it was saved in
+  const std::string posture = r.readString("simulation.posture");
+  if (posture != postureName(m_options.step.posture))
+    r.fail("simulation.posture", "saved in posture '" + posture.substr(0, 40) + "', this run is " +
+                                     postureName(m_options.step.posture));
   SimulationCheckpoint c;
   c.nextFrameTime = r.readDouble("simulation.nextFrameTime");
   c.activations = readActivations(r, "simulation.activations");

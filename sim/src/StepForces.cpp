@@ -187,18 +187,18 @@ void accumulateVisceralDrag(const Model& model, const State& s, const StepOption
       w.scratch.nodeForce.col(n) -= beta * model.nodes.mass(n) * s.nodeVelocity.col(n);
 }
 
-// gravity on moving bodies and nodes; gyroscopic torque -w x (I w)
+// gravity (the posture's, postureGravity()) on moving bodies and nodes; gyroscopic torque -w x (I w)
 void accumulateGravityAndGyroscopic(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
+  const Vector3d g = postureGravity(model, o);
   for (int b = 0; b < model.bodies.size(); ++b) {
     if (model.bodies.isFixed[at(b)]) continue;
-    if (o.gravity) w.scratch.bodyForce.col(b) += model.bodies.mass(b) * model.gravity;
+    if (o.gravity) w.scratch.bodyForce.col(b) += model.bodies.mass(b) * g;
     const Matrix3d& r = w.scratch.rotation[at(b)];
     const Vector3d om = s.bodyAngularVelocity.col(b);
     w.scratch.bodyTorque.col(b) -= om.cross(r * (model.bodies.inertia[at(b)] * (r.transpose() * om)));
   }
   if (o.gravity) {
-    for (int n = 0; n < model.nodes.size(); ++n)
-      w.scratch.nodeForce.col(n) += model.nodes.mass(n) * model.gravity;
+    for (int n = 0; n < model.nodes.size(); ++n) w.scratch.nodeForce.col(n) += model.nodes.mass(n) * g;
   }
 }
 

@@ -1,5 +1,6 @@
-// The step's options: integrator names, default time steps, validation.
+// The step's options: integrator and posture names, the posture's gravity, default time steps, validation.
 #include <cmath>
+#include <cstddef>
 #include <sstream>
 #include <utility>
 
@@ -14,27 +15,61 @@ namespace {
 const std::pair<IntegratorKind, const char*> kIntegratorNames[] = {
     {IntegratorKind::SymplecticEuler, "symplectic-euler"},
     {IntegratorKind::ImplicitEulerJoints, "implicit-euler-joints"}};
-}  // namespace
 
-const char* integratorName(IntegratorKind k) {
-  for (const auto& [kind, name] : kIntegratorNames)
-    if (kind == k) return name;
+const std::pair<Posture, const char*> kPostureNames[] = {{Posture::Upright, "upright"},
+                                                         {Posture::Supine, "supine"},
+                                                         {Posture::Prone, "prone"},
+                                                         {Posture::LeftLateral, "left-lateral"},
+                                                         {Posture::RightLateral, "right-lateral"}};
+
+// lookups in a table of (value, name) pairs
+template <typename E, std::size_t N>
+const char* nameIn(const std::pair<E, const char*> (&table)[N], E value) {
+  for (const auto& [v, name] : table)
+    if (v == value) return name;
   return "?";
 }
 
-std::string integratorNames() {
+template <typename E, std::size_t N>
+std::string namesIn(const std::pair<E, const char*> (&table)[N]) {
   std::string out;
-  for (const auto& [kind, name] : kIntegratorNames) out += (out.empty() ? "" : ", ") + std::string(name);
+  for (const auto& entry : table) out += (out.empty() ? "" : ", ") + std::string(entry.second);
   return out;
 }
 
-bool integratorFromName(const std::string& name, IntegratorKind& out) {
-  for (const auto& [kind, n] : kIntegratorNames)
+template <typename E, std::size_t N>
+bool valueIn(const std::pair<E, const char*> (&table)[N], const std::string& name, E& out) {
+  for (const auto& [v, n] : table)
     if (name == n) {
-      out = kind;
+      out = v;
       return true;
     }
   return false;
+}
+}  // namespace
+
+const char* integratorName(IntegratorKind k) { return nameIn(kIntegratorNames, k); }
+std::string integratorNames() { return namesIn(kIntegratorNames); }
+bool integratorFromName(const std::string& name, IntegratorKind& out) {
+  return valueIn(kIntegratorNames, name, out);
+}
+
+const char* postureName(Posture p) { return nameIn(kPostureNames, p); }
+std::string postureNames() { return namesIn(kPostureNames); }
+bool postureFromName(const std::string& name, Posture& out) { return valueIn(kPostureNames, name, out); }
+
+Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o) {
+  if (!o.gravity) return Eigen::Vector3d::Zero();
+  // the upright gravity turned into the body frame: quarter turns, exact in floating point
+  const Eigen::Vector3d& g = model.gravity;
+  switch (o.posture) {
+    case Posture::Upright: return g;
+    case Posture::Supine: return {g.x(), g.z(), -g.y()};        // R_x(-90 deg): -z -> -y
+    case Posture::Prone: return {g.x(), -g.z(), g.y()};         // R_x(+90 deg): -z -> +y
+    case Posture::LeftLateral: return {g.z(), g.y(), -g.x()};   // R_y(+90 deg): -z -> -x
+    case Posture::RightLateral: return {-g.z(), g.y(), g.x()};  // R_y(-90 deg): -z -> +x
+  }
+  return g;
 }
 
 double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 1e-5 : 1.0 / 60.0; }

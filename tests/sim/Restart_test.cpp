@@ -104,9 +104,10 @@ SimulationCheckpoint runToCheckpoint(Simulation& sim, std::string& text) {
 
 // the uninterrupted run against three restarts from the checkpoint: a copy in a new Simulation, the same
 // Simulation sent back, and a file written, read back and loaded into a new Simulation
-void expectExactRestarts(const ControllerFactory& makeController, const std::string& name) {
+void expectExactRestarts(const ControllerFactory& makeController, const std::string& name,
+                         const SimulationOptions& options = runOptions()) {
   const auto model = defaultModel();
-  Simulation whole(model, makeController(), runOptions());
+  Simulation whole(model, makeController(), options);
   std::string text;
   const SimulationCheckpoint checkpoint = runToCheckpoint(whole, text);
   const std::string path = ::testing::TempDir() + "pneuma_restart_" + name + ".txt";
@@ -116,7 +117,7 @@ void expectExactRestarts(const ControllerFactory& makeController, const std::str
   const double lungVolume = whole.latestMetrics().lungVolume;
   ASSERT_NE(uninterrupted.nodePosition, checkpoint.state.nodePosition);
 
-  Simulation copy(model, makeController(), runOptions());
+  Simulation copy(model, makeController(), options);
   copy.restore(checkpoint);
   copy.advance(kAfter);
   expectSameState(copy.state(), uninterrupted, name + ": in-process copy");
@@ -126,7 +127,7 @@ void expectExactRestarts(const ControllerFactory& makeController, const std::str
   whole.advance(kAfter);
   expectSameState(whole.state(), uninterrupted, name + ": the same Simulation sent back");
 
-  Simulation resumed(model, makeController(), runOptions());
+  Simulation resumed(model, makeController(), options);
   {
     std::ifstream file(path);
     ASSERT_TRUE(file) << path;
@@ -156,6 +157,16 @@ INSTANTIATE_TEST_SUITE_P(EveryStyle, BreathStyleRestart,
                              if (c == '-') c = '_';
                            return n;
                          });
+
+// lying on the back (gravity posterior, StepOptions::posture): the file carries the posture and the run goes
+// on bit-identically
+TEST(ExactRestart, SupineCalmContinuesBitIdentically) {
+  REQUIRE_DEFAULT_MODEL();
+  SimulationOptions supine = runOptions();
+  supine.step.posture = Posture::Supine;
+  const BreathStyle calm = loadBreathStyle("calm");
+  expectExactRestarts([&] { return std::make_unique<BreathStyleController>(calm); }, "supine", supine);
+}
 
 // a plausible drive calibration (concave responses), so that the affect test needs no calibration run; the
 // rest volume is learned while settling, which the checkpoint must carry
@@ -212,6 +223,17 @@ TEST(ExactRestart, LoadRefusesAnotherTimeStep) {
   SimulationOptions other = runOptions();
   other.dt = 0.01;
   expectLoadError(other, savedCalmRun(0.1), "run.ckpt: checkpoint field 'simulation.dt'");
+}
+
+// a run saved upright does not continue lying down (gravity would turn at the restart), and the message names
+// both
+TEST(ExactRestart, LoadRefusesAnotherPosture) {
+  REQUIRE_DEFAULT_MODEL();
+  SimulationOptions supine = runOptions();
+  supine.step.posture = Posture::Supine;
+  expectLoadError(
+      supine, savedCalmRun(0.1),
+      "run.ckpt: checkpoint field 'simulation.posture': saved in posture 'upright', this run is supine");
 }
 
 // a damaged file fails with an Error naming the field, before anything is changed

@@ -46,6 +46,7 @@ TEST(Scenario, MinimalFileGetsDocumentedDefaults) {
   EXPECT_FALSE(s.outputs.vtk);
   EXPECT_EQ(s.options.settleTime, SimulationOptions{}.settleTime);
   EXPECT_EQ(s.options.step.integrator, StepOptions{}.integrator);
+  EXPECT_EQ(s.options.step.posture, Posture::Upright);
 }
 
 TEST(Scenario, RelativePathsResolveAgainstTheScenarioDirectory) {
@@ -61,6 +62,7 @@ TEST(Scenario, RelativePathsResolveAgainstTheScenarioDirectory) {
 TEST(Scenario, OverridesReachTheSimulationOptions) {
   const Scenario s = parseScenario(
       with(R"("overrides": {"integrator": "symplectic-euler", "dt_s": 0.0002, "settle_time_s": 0.5, "gravity": false,
+              "posture": "supine",
               "joint_friction_scale": 0, "gut_drag_scale": 0.5, "kappa_pa": 40000, "active_gain_scale": {"rectus": 1.5},
               "passive_gain_scale": {"cartilage": 2}}, "outputs": {"output_rate_hz": 25, "vtk": true})"),
       "o.json", "");
@@ -68,6 +70,7 @@ TEST(Scenario, OverridesReachTheSimulationOptions) {
   EXPECT_EQ(s.options.dt, 0.0002);
   EXPECT_EQ(s.options.settleTime, 0.5);
   EXPECT_FALSE(s.options.step.gravity);
+  EXPECT_EQ(s.options.step.posture, Posture::Supine);
   EXPECT_EQ(s.options.step.jointFrictionScale, 0.0);
   EXPECT_EQ(s.options.step.gutDragScale, 0.5);
   EXPECT_EQ(s.options.step.kappa, 40000.0);
@@ -87,7 +90,12 @@ TEST(Scenario, SerializeThenParseIsTheIdentity) {
     EXPECT_EQ(b.controller, a.controller);
     EXPECT_EQ(b.duration, a.duration);
     EXPECT_EQ(b.seed, a.seed);
+    EXPECT_EQ(b.options.step.posture, a.options.step.posture);
   }
+  // the lying example keeps its posture through a save
+  const Scenario supine = loadScenario(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios/calm-supine.json");
+  EXPECT_EQ(supine.options.step.posture, Posture::Supine);
+  EXPECT_NE(serializeScenario(supine).find(R"("posture": "supine")"), std::string::npos);
 }
 
 TEST(Scenario, ExampleTimelineIsNeutralThenStartleAtTenSeconds) {
@@ -121,6 +129,9 @@ TEST(Scenario, BadFieldsAreNamedByTheirJsonPath) {
               {"overrides.active_gain_scale.diaphram: unknown muscle group", "diaphragm"});
   expectError(with(R"("overrides": {"passive_gain_scale": {"rectus": -1}})"), {"overrides.passive_gain_scale.rectus: must be >= 0"});
   expectError(with(R"("overrides": {"gravity": "yes"})"), {"overrides.gravity: must be true or false"});
+  expectError(with(R"("overrides": {"posture": "sitting"})"),
+              {"overrides.posture: unknown posture 'sitting' (valid: upright, supine, prone, left-lateral, right-lateral)"});
+  expectError(with(R"("overrides": {"posture": 1})"), {"overrides.posture"});
   expectError(with(R"("outputs": {"output_rate_hz": 0})"),
               {"outputs.output_rate_hz: must be in [0.01, 10000] Hz, got 0"});
   expectError(with(R"("outputs": {"png": true})"), {"outputs.png: unknown field"});

@@ -200,3 +200,58 @@ TEST(PleuralPressure, ForceIsMinusTheGradientOfTheRecoilEnergy) {
 
 }  // namespace
 }  // namespace pneuma::sim
+
+namespace pneuma::sim {
+namespace {
+
+// the posture turns gravity into the body frame (postureGravity()): each posture pulls every free node and
+// body with m g along its own axis (supine posteriorly, -y), and the gravity energy of computeMetrics() is
+// the potential of that force (its finite-difference gradient on a displaced node equals minus the force)
+TEST(Posture, GravityPointsAlongThePostureAxisAndIsTheGradientOfItsEnergy) {
+  const Model toy = test::makeToyTorso();
+  const double g = toy.gravity.norm();
+  ASSERT_GT(g, 0.0);
+  const std::pair<const char*, Eigen::Vector3d> expected[] = {{"upright", -Eigen::Vector3d::UnitZ()},
+                                                              {"supine", -Eigen::Vector3d::UnitY()},
+                                                              {"prone", Eigen::Vector3d::UnitY()},
+                                                              {"left-lateral", -Eigen::Vector3d::UnitX()},
+                                                              {"right-lateral", Eigen::Vector3d::UnitX()}};
+  const State s0 = makeInitialState(toy);
+  int node = -1;
+  for (int n = 0; n < toy.nodes.size() && node < 0; ++n)
+    if (!toy.nodes.isFixed(n)) node = n;
+  ASSERT_GE(node, 0);
+  for (const auto& [name, down] : expected) {
+    SCOPED_TRACE(name);
+    StepOptions on, off;
+    ASSERT_TRUE(postureFromName(name, on.posture));
+    EXPECT_EQ(postureName(on.posture), std::string(name));
+    off.gravity = false;
+    off.posture = on.posture;
+    EXPECT_EQ(postureGravity(toy, on), g * down);  // quarter turns are exact
+    EXPECT_EQ(postureGravity(toy, off), Eigen::Vector3d::Zero());
+    StepWork wOn = makeStepWork(toy), wOff = makeStepWork(toy);
+    computeForces(toy, s0, relaxedActivations(), on, wOn);
+    computeForces(toy, s0, relaxedActivations(), off, wOff);
+    const Eigen::Vector3d pull = wOn.scratch.nodeForce.col(node) - wOff.scratch.nodeForce.col(node);
+    EXPECT_LT((pull - toy.nodes.mass(node) * g * down).norm(), 1e-12 * toy.nodes.mass(node) * g);
+    auto energy = [&](int k, double h) {
+      State s = s0;
+      s.nodePosition(k, node) += h;
+      StepWork w = makeStepWork(toy);
+      Metrics out;
+      computeMetrics(toy, s, relaxedActivations(), on, w, out);
+      return out.gravityEnergy;
+    };
+    const double h = 1e-4;  // [m] the energy is linear in x
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(-(energy(k, h) - energy(k, -h)) / (2 * h), pull(k), 1e-9 * toy.nodes.mass(node) * g) << k;
+  }
+  Posture p = Posture::Supine;
+  EXPECT_FALSE(postureFromName("sitting", p));
+  EXPECT_EQ(p, Posture::Supine);
+  EXPECT_EQ(postureNames(), "upright, supine, prone, left-lateral, right-lateral");
+}
+
+}  // namespace
+}  // namespace pneuma::sim

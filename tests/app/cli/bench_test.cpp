@@ -11,9 +11,11 @@ using pneuma::test::toyModelDir;
 
 TEST(CliBench, ReportsEveryStyleAndIncreasingElementCounts) {
   const std::string out = freshOutDir("bench");
-  auto r = runCli({"bench", "--model", toyModelDir(), "--seconds", "0.3", "--out", out});
+  auto r =
+      runCli({"bench", "--model", toyModelDir(), "--seconds", "0.3", "--posture", "supine", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/bench.json"));
+  EXPECT_EQ(j["posture"], "supine");
   std::vector<std::string> styles;
   for (const auto& s : j.at("styles")) {
     styles.push_back(s["style"]);

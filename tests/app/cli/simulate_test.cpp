@@ -59,12 +59,13 @@ TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
   for (const char* key : {"tidal_volume_ml", "breaths_per_minute", "end_expiratory_volume_ml", "max_gut_volume_error_pct",
                           "mean_gut_volume_error_pct", "dome_descent_mm", "xiphoid_anterior_mm",
                           "lower_rib_expansion_mm", "umbilicus_anterior_mm", "rib_cage_tidal_ml", "abdomen_tidal_ml",
-                          "rc_ab_phase_deg", "real_time_factor", "dt_s", "steps", "integrator", "model",
+                          "rc_ab_phase_deg", "real_time_factor", "dt_s", "steps", "integrator", "posture", "model",
                           "controller", "pneuma_version", "partial", "tracking_rms_pct"})
     EXPECT_TRUE(s.contains(key)) << key;
   EXPECT_FALSE(s["partial"].get<bool>());
   EXPECT_EQ(s["pneuma_version"], PNEUMA_VERSION);
   EXPECT_EQ(s["integrator"], "implicit-euler-joints");
+  EXPECT_EQ(s["posture"], "upright");
   EXPECT_TRUE(s["tracking_rms_pct"].is_null());  // no volume target for a breath style
   EXPECT_GT(s["tidal_volume_ml"].get<double>(), 0.0);
   EXPECT_GE(s["breaths_per_minute"].get<double>(), 0.0);
@@ -207,15 +208,21 @@ TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
   const std::string file = out + "/run.json";
   std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "name": "deep-short", "model": ")" << toyModelDir()
                       << R"(", "duration_s": 30, "controller": {"style": "deep"},
-      "overrides": {"settle_time_s": 0.5}, "outputs": {"output_rate_hz": 10, "plots": false}})";
+      "overrides": {"settle_time_s": 0.5, "posture": "supine"}, "outputs": {"output_rate_hz": 10, "plots": false}})";
   auto r = runCli({"simulate", "--scenario", file, "--duration", "2", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
   EXPECT_EQ(s["scenario"], "deep-short");
+  EXPECT_EQ(s["posture"], "supine");
   EXPECT_EQ(s["duration_s"].get<double>(), 2.0);  // the command line wins
   EXPECT_NEAR(s["simulated_time_s"].get<double>(), 2.5, 1e-6);
   EXPECT_EQ(s["frames"].get<int>(), 25);
   EXPECT_FALSE(fs::exists(out + "/lung_volume.png"));  // plots off in the scenario
+  r = runCli(
+      {"simulate", "--scenario", file, "--duration", "0.5", "--posture", "upright", "--force", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  EXPECT_EQ(s["posture"], "upright");  // the command line wins
 
   // a bad scenario names the file and the JSON path, exit 2
   std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "duration_s": 3, "controller": {"style": "deep"},
@@ -306,6 +313,8 @@ TEST(CliSimulate, BadInputIsOneLineErrorAndExit2) {
       {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--dt", "-1", "--out", out}, "--dt"},
       {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--integrator", "rk4", "--out", out},
        "rk4"},
+      {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--posture", "sitting", "--out", out},
+       "--posture: unknown posture 'sitting' (valid: upright, supine, prone, left-lateral, right-lateral)"},
       // inputs that would never finish (issue 15, class 5): refused at once, naming the option and the value
       {{"--model", toyModelDir(), "--style", "calm", "--duration", "1", "--dt", "1e-300", "--out", out},
        "--dt: must be in [1e-06, 0.05] s, got 1e-300"},

@@ -12,7 +12,9 @@
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFile>
+#include <QLabel>
 #include <QLineEdit>
+#include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
 
@@ -316,6 +318,65 @@ TEST(MainWindow, ScenarioRoundTripKeepsModelAndParameters) {
   EXPECT_EQ(w.window.model()->name, "toy_torso");
 }
 
+namespace {
+
+// mean displacement [m] of the free gut nodes from the rest pose in the instant on screen
+Eigen::Vector3d shownGutSag(const MainWindow& window) {
+  const sim::Model& m = *window.model();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (int n = 0; n < m.nodes.size(); ++n)
+    if (!m.nodes.isFixed(n)) {
+      sum += window.shown()->state.nodePosition.col(n) - m.nodes.rest.col(n);
+      ++count;
+    }
+  return sum / std::max(count, 1);
+}
+
+}  // namespace
+
+// the Parameters panel's posture box lists sim's postures; lying on the back restarts the run, and what it shows
+// then has the viscera sinking posteriorly (-y) where upright they sink caudally (-z); an unknown name is refused
+// with the valid ones and a scenario keeps the posture
+TEST(MainWindow, PostureBoxRestartsTheRunWithGravityTurned) {
+  ToyWindow w;
+  QComboBox* box = w.window.parameters()->postureBox();
+  ASSERT_NE(box, nullptr);
+  QStringList names;
+  for (int i = 0; i < box->count(); ++i) names << box->itemText(i);
+  EXPECT_EQ(names.join(", ").toStdString(), sim::postureNames());
+  EXPECT_EQ(box->currentText(), "upright");
+  ASSERT_TRUE(w.window.runUntil(1.5));
+  const Eigen::Vector3d upright = shownGutSag(w.window);
+  EXPECT_LT(upright.z(), 0.0);
+  EXPECT_GT(-upright.z(), 3.0 * std::abs(upright.y()));
+
+  box->setCurrentText("supine");
+  emit box->textActivated("supine");
+  EXPECT_EQ(w.window.parameters()->settings().options.step.posture, sim::Posture::Supine);
+  ASSERT_TRUE(w.window.runUntil(1.5));
+  EXPECT_NEAR(w.window.shown()->state.time, 1.5, 0.05);  // started over, not 3 s into the old run
+  const Eigen::Vector3d supine = shownGutSag(w.window);
+  EXPECT_LT(supine.y(), 0.0);
+  EXPECT_GT(-supine.y(), 3.0 * std::abs(supine.z()));
+  bool isStated = false;  // the status bar says which posture runs
+  for (const QLabel* label : w.window.statusBar()->findChildren<QLabel*>())
+    isStated = isStated || label->text().endsWith(", posture supine");
+  EXPECT_TRUE(isStated);
+
+  const QString error = w.window.setPosture("sitting");
+  EXPECT_EQ(error.toStdString(),
+            "unknown posture 'sitting' (valid: upright, supine, prone, left-lateral, right-lateral)");
+  EXPECT_EQ(w.window.parameters()->settings().options.step.posture, sim::Posture::Supine);
+
+  QTemporaryDir out;
+  ASSERT_EQ(w.window.saveScenario(out.filePath("lying.json")), QString());
+  ASSERT_EQ(w.window.setPosture("upright"), QString());
+  EXPECT_EQ(box->currentText(), "upright");
+  ASSERT_EQ(w.window.openScenario(out.filePath("lying.json")), QString());
+  EXPECT_EQ(box->currentText(), "supine");
+}
+
 TEST(MainWindow, ClickingAMuscleSelectsItAndAddsItsForceTrace) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(3.0));
@@ -421,6 +482,12 @@ TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   // the target is defined once control starts after settling
   EXPECT_TRUE(std::isfinite(volume->series()[1].y.back()));
   EXPECT_GT(volume->series()[1].y.back(), 0.0);
+  // a new posture restarts the run with the breath style: the affect's drive was calibrated upright
+  ASSERT_EQ(window.setPosture("supine"), QString());
+  ASSERT_TRUE(window.runUntil(3.0)) << window.lastError().toStdString();
+  EXPECT_NEAR(window.shown()->state.time, 3.0, 0.05);
+  const auto& series = window.plots()->volumePlot()->series();
+  EXPECT_TRUE(series.size() < 2 || series[1].y.empty() || !std::isfinite(series[1].y.back()));
 }
 
 TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {

@@ -107,6 +107,19 @@ double expirationRebound(const StyleRun& run);
 /// friction by less than half as much.
 std::vector<Check> swayChecks(const StyleRun& deepWithFriction, const StyleRun& deepFrictionless);
 
+/// [m^3] lung-volume change over the last `window` [s] of the settling phase, V(settle) - V(settle - window):
+/// how far the relaxed torso still is from its equilibrium when the controller starts (0 when the trace is
+/// shorter).
+double settleDrift(const StyleRun& run, double window = 0.5);
+
+/// Posture (StepOptions::posture): the same breath style played upright and supine (lying on the back).
+/// People breathe more with the abdomen supine (Sharp et al. 1975, J Appl Physiol 39:608; Konno & Mead 1967),
+/// and their end-expiratory lung volume falls supine (lung volumes 5.3-14.7 % larger sitting or standing,
+/// Yamada et al. 2020). Checks: rib-cage share of the tidal volume (Motion::ribCageTidal over the tidal
+/// volume) at least 1 percentage point lower supine; end-expiratory volume at least 1 % lower supine; the
+/// supine run settled (|settleDrift()| under 2 % of its tidal volume in the last 0.5 s of settling).
+std::vector<Check> postureChecks(const StyleRun& upright, const StyleRun& supine);
+
 /// The heavy-impact run (Figure 4).
 struct ImpactRun {
   int struckNodes = 0;            ///< wall nodes given the impact speed

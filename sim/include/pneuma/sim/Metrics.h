@@ -40,7 +40,8 @@ struct Metrics {
   Activations activations{};      ///< control input in effect at this frame
   double kineticEnergy = 0.0;     ///< [J] sum of 1/2 m v^2 + 1/2 w^T I w over bodies and nodes
   double elasticEnergy = 0.0;     ///< [J] springs (one-sided muscles, two-sided cartilage), gut pressure, spine joints
-  double gravityEnergy = 0.0;     ///< [J] m g . x summed, relative to the rest pose (0 when gravity is off)
+  double gravityEnergy = 0.0;  ///< [J] -m g . x summed with the posture's g (postureGravity()), relative to
+                               ///< the rest pose (0 when gravity is off)
   double maxJointError = 0.0;     ///< [m] largest ball-joint separation after the step
   Eigen::Matrix3Xd landmarks;     ///< [m] landmark positions, world, in Model::landmarks order (3 x #L)
 };

@@ -7,7 +7,8 @@
 /// all time-varying quantities live in State.
 ///
 /// Conventions (all SI, radians):
-///  - world frame is RAS: +x toward the subject's right, +y anterior, +z superior; gravity is -z.
+///  - world frame is RAS: +x toward the subject's right, +y anterior, +z superior; gravity is -z upright
+///    (StepOptions::posture turns it).
 ///  - each rigid body's frame has its origin at the body's centre of mass and, at rest, axes parallel
 ///    to the world axes. Body-frame points are therefore `restWorldPoint - com`.
 ///  - structures of arrays: one column (or entry) per item, Eigen::Matrix3X* for 3-vectors.
@@ -194,7 +195,7 @@ struct Landmarks {
 struct Model {
   std::string name;                         ///< e.g. "adult_male"
   std::string anatomy;                      ///< anatomy preset it was built from
-  Eigen::Vector3d gravity{0.0, 0.0, -9.81}; ///< [m/s^2]
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81}; ///< [m/s^2] upright (postureGravity() turns it)
   Bodies bodies;
   Joints joints;
   Nodes nodes;

@@ -12,7 +12,7 @@
 ///     "controller": {"style": "calm"},            // or {"affect": "startle"}, or {"pattern": "file.json"},
 ///                                                 // or {"pattern": { ...inline pattern file... }}
 ///     "overrides": {"integrator": "implicit-euler-joints", "dt_s": 0.002, "settle_time_s": 2,
-///                   "gravity": true, "joint_friction_scale": 1, "kappa_pa": 2e4,
+///                   "gravity": true, "posture": "upright", "joint_friction_scale": 1, "kappa_pa": 2e4,
 ///                   "active_gain_scale": {"diaphragm": 1.1}, "passive_gain_scale": {"cartilage": 2}},
 ///     "outputs": {"output_rate_hz": 60, "csv": true, "plots": true, "vtk": false}
 ///   }
@@ -57,8 +57,8 @@ struct Scenario {
 };
 
 /// Parses the text of a scenario file. Relative "model" and "pattern" paths are resolved against
-/// `baseDir` (the scenario file's directory). Checks every field's type and range, the integrator and
-/// group names; the style, affect or pattern itself is checked when the controller is made.
+/// `baseDir` (the scenario file's directory). Checks every field's type and range, the integrator,
+/// group and posture names; the style, affect or pattern itself is checked when the controller is made.
 /// @throws Error "<sourceName>: <json path>: <reason>", e.g. "run.json: overrides.dt_s: must be > 0, got -1".
 Scenario parseScenario(const std::string& jsonText, const std::string& sourceName, const std::string& baseDir);
 

@@ -29,7 +29,7 @@ namespace pneuma::sim {
 
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
-  StepOptions step;             ///< integrator, gravity, friction scale, kappa override, gain scales
+  StepOptions step;             ///< integrator, gravity and posture, friction scale, kappa override, gain scales
   std::optional<double> dt;     ///< [s] time step in kTimeStepRange; unset: resolveOptions() picks it
   double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange
   double outputRate = 60.0;     ///< [Hz] metrics and recording rate, in kOutputRateRange
@@ -116,7 +116,7 @@ class Simulation {
   void save(std::ostream& out) const;
   /// Reads what save() wrote and restore()s it; the controller state is read into a copy of the current
   /// controller. @throws Error naming `source` and the field when the data is not a checkpoint of this model,
-  /// dt or controller.
+  /// dt, posture or controller.
   void load(std::istream& in, const std::string& source = "checkpoint");
 
   const Model& model() const { return *m_model; }

@@ -44,10 +44,29 @@ bool integratorFromName(const std::string& name, IntegratorKind& out);
 /// volumes agree within 1 % with dt 5 ms (docs/validation figures), and it is the real-time factor's budget.
 double defaultTimeStep(IntegratorKind k);
 
+/// The body's posture: which way gravity points in the body (model) frame, RAS (+x right, +y anterior,
+/// +z superior). The model's rest pose is built upright and Model::gravity is the upright gravity; another
+/// posture turns it (postureGravity()), and the settling phase lets the viscera and the dome find their new
+/// rest.
+///   upright        gravity -z (caudal): the paper's seated subject (the default)
+///   supine         gravity -y (posterior): lying on the back
+///   prone          gravity +y (anterior): lying on the front
+///   left-lateral   gravity -x: lying on the left side
+///   right-lateral  gravity +x: lying on the right side
+enum class Posture { Upright, Supine, Prone, LeftLateral, RightLateral };
+
+/// "upright", "supine", "prone", "left-lateral" or "right-lateral".
+const char* postureName(Posture p);
+/// All valid names, comma separated (for error messages).
+std::string postureNames();
+/// Inverse of postureName(); returns false when unknown.
+bool postureFromName(const std::string& name, Posture& out);
+
 /// Per-run physical switches and solver settings.
 struct StepOptions {
   IntegratorKind integrator = IntegratorKind::ImplicitEulerJoints;
-  bool gravity = true;                ///< apply Model::gravity to bodies and nodes
+  bool gravity = true;                ///< apply gravity (postureGravity()) to bodies and nodes
+  Posture posture = Posture::Upright; ///< direction of gravity relative to the body
   double jointFrictionScale = 1.0;    ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
   double gutDragScale = 1.0;          ///< [-] multiplies the visceral drag Model::gut.drag; 0 = none
   std::optional<double> kappa;        ///< [Pa] gut bulk modulus of Eq. 4, > 0; unset: Model::gut.kappa
@@ -68,6 +87,12 @@ struct StepOptions {
 /// [Pa] The gut's bulk modulus kappa of Eq. 4 a step uses: StepOptions::kappa when set, else Model::gut.kappa.
 /// The one rule for it; resolveOptions() (Simulation.h) reports it with the time step to the CLI and the app.
 inline double effectiveKappa(const Model& model, const StepOptions& o) { return o.kappa.value_or(model.gut.kappa); }
+
+/// [m/s^2] The gravity a run applies, in the body frame: zero when `o.gravity` is off, else Model::gravity
+/// (the upright gravity) turned by a quarter turn for the lying postures, g = R(o.posture) Model::gravity:
+/// supine R_x(-90 deg), prone R_x(+90 deg), left-lateral R_y(+90 deg), right-lateral R_y(-90 deg). The one
+/// rule every reader of gravity uses (the step's forces, the gravity energy of computeMetrics()).
+Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o);
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
 /// @throws Error naming the field and value.
