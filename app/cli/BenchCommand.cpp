@@ -28,6 +28,7 @@ namespace {
 struct BenchArgs {
   std::string model;
   std::string out;
+  bool force = false;    // replace an earlier bench.json in `out`
   double seconds = 4.0;  // [s] simulated per measurement
   std::string integrator;
   std::string posture;
@@ -89,7 +90,7 @@ std::pair<double, double> measure(std::shared_ptr<const sim::Model> model, const
 void runBench(const BenchArgs& args) {
   const std::string modelDir = resolveModelDir(args.model);
   checkOption(sim::kDurationRange, "--seconds", args.seconds);
-  if (!args.out.empty()) prepareOutputDir(args.out);
+  if (!args.out.empty()) prepareOutputDir(args.out, "bench", {"bench.json"}, args.force);
   sim::SimulationOptions options;
   options.settleTime = 0.0;
   options.recordSeconds = sim::kTraceOnlyRecordSeconds;
@@ -161,7 +162,8 @@ void addBenchCommand(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand("bench", "Real-time factor per breath style and step time per element count");
   addModelOption(*cmd, args->model);
-  cmd->add_option("--out", args->out, "Also write bench.json into this directory");
+  cmd->add_option("--out", args->out, "Also write bench.json into this directory (created if missing)");
+  cmd->add_flag("--force", args->force, "Replace an earlier bench.json in --out");
   cmd->add_option("--seconds", args->seconds, "Simulated seconds per measurement (default 4)");
   addIntegratorOption(*cmd, args->integrator);
   addPostureOption(*cmd, args->posture);

@@ -6,12 +6,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -31,9 +33,42 @@ std::string resolveModelDir(const std::string& requested) {
   return dir;
 }
 
-void prepareOutputDir(const std::string& dir) {
+void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own, bool force) {
   if (dir.empty()) fail(kExitBadInput, "--out: must not be empty");
   std::error_code ec;
+  if (fs::is_directory(dir, ec)) {
+    // only this command's own entries, and those only with --force
+    auto isOwn = [&](const std::string& name) {
+      for (const std::string pattern : own) {
+        const bool isSuffix = pattern.size() > 1 && pattern[0] == '*';
+        if (isSuffix ? name.size() > pattern.size() - 1 &&
+                           name.compare(name.size() - (pattern.size() - 1), std::string::npos, pattern, 1) == 0
+                     : name == pattern)
+          return true;
+      }
+      return false;
+    };
+    std::vector<std::string> entries;
+    bool isEarlierRun = false;  // an own entry with something in it (an empty frames/ may be a mount point)
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+      entries.push_back(e.path().filename().string());
+      isEarlierRun = isEarlierRun || !(e.is_directory(ec) && fs::is_empty(e.path(), ec));
+    }
+    std::sort(entries.begin(), entries.end());
+    for (const std::string& name : entries)
+      if (!isOwn(name))
+        fail(kExitBadInput, "--out: '" + dir + "' holds '" + name.substr(0, 60) + "', which pneuma-cli " + command +
+                                " does not write; give a new or empty directory");
+    if (isEarlierRun && !force) {
+      std::string earlier = entries.front();
+      for (const std::string name : own)
+        if (name[0] != '*' && fs::exists(fs::path(dir) / name)) {
+          earlier = name;
+          break;
+        }
+      fail(kExitBadInput, "--out: '" + dir + "' holds an earlier run (" + earlier + "); add --force to replace it");
+    }
+  }
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir)) fail(kExitBadInput, "--out: cannot create directory '" + dir + "'" + (ec ? ": " + ec.message() : ""));
   // probe: can we create a file there?

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <initializer_list>
 #include <string>
 
 namespace CLI {
@@ -53,8 +54,13 @@ void applyPosture(const std::string& name, sim::Posture& posture);
 /// Fails with kExitBadInput and "<flag>: must be in [lo, hi] unit, got v" unless `range` contains `v`.
 void checkOption(const sim::Range& range, const char* flag, double v);
 
-/// Creates `dir` (and parents) and checks that a file can be written in it; fails with kExitBadInput otherwise.
-void prepareOutputDir(const std::string& dir);
+/// Prepares the --out directory `dir` of `pneuma-cli <command>`, which writes only the entries `own` (exact names,
+/// or "*.ext" patterns; the exact names first, the one that marks an earlier run first of all, e.g. "summary.json").
+/// An existing `dir` may hold nothing but such entries, so a command never overwrites what it did not write: any
+/// other entry fails with kExitBadInput naming it, and an earlier run (any own entry but an empty directory) is
+/// replaced only with `force`. Then creates
+/// `dir` (and parents) and checks that a file can be written in it; fails with kExitBadInput otherwise.
+void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own, bool force);
 
 /// Shortest round-trip text of a double for CSV/JSON ("%.9g"); "nan" never appears: non-finite gives "".
 std::string formatNumber(double v);

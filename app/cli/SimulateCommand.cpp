@@ -100,12 +100,8 @@ void runSimulate(const SimulateArgs& args) {
   const sim::Scenario scenario = scenarioFromArgs(args);
   const std::string modelDir =
       resolveModelDir(!args.model.empty() ? args.model : scenario.model == "default" ? "" : scenario.model);
-  prepareOutputDir(args.out);
-  // an earlier run's results are replaced only on request
-  for (const char* earlier : {"summary.json", "timeseries.csv"}) {
-    if (!args.force && fs::exists(fs::path(args.out) / earlier))
-      fail(kExitBadInput, "--out: '" + args.out + "' holds an earlier run (" + earlier + "); add --force to replace it");
-  }
+  prepareOutputDir(args.out, "simulate", {"summary.json", "timeseries.csv", "frames.pvd", "frames", "*.png", "*.svg"},
+                   args.force);
 
   // Ctrl-C from here on: the first stops within one step (the drive calibration too) and the outputs are
   // still written; a second ends the process at once (InterruptGuard)
@@ -226,19 +222,20 @@ void runSimulate(const SimulateArgs& args) {
   j["interrupted"] = isInterrupted;
   j["error"] = failure.empty() ? none : nlohmann::json(failure);
   const bool ran = simulation && record.size() > 0;
+  const bool breathed = ran && sum.cycles > 0;  // the breath figures exist only when a full breath was found
   j["real_time_factor"] = ran ? jsonNumber(sum.realTimeFactor) : none;
-  j["tidal_volume_ml"] = ran ? jsonNumber(sum.tidalVolume * 1e6) : none;
-  j["breaths_per_minute"] = ran ? jsonNumber(sum.breathsPerMinute) : none;
+  j["tidal_volume_ml"] = breathed ? jsonNumber(sum.tidalVolume * 1e6) : none;
+  j["breaths_per_minute"] = breathed ? jsonNumber(sum.breathsPerMinute) : none;
   j["cycles"] = sum.cycles;
-  j["end_expiratory_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * 1e6) : none;
-  j["end_inspiratory_volume_ml"] = ran ? jsonNumber(sum.endInspiratoryVolume * 1e6) : none;
+  j["end_expiratory_volume_ml"] = breathed ? jsonNumber(sum.endExpiratoryVolume * 1e6) : none;
+  j["end_inspiratory_volume_ml"] = breathed ? jsonNumber(sum.endInspiratoryVolume * 1e6) : none;
   // the lungs' parts at end-expiration: the right/left split of the latest frame, the constant mediastinum
   const sim::Metrics* latest = ran ? &simulation->latestMetrics() : nullptr;
   const double rightShare = latest != nullptr ? latest->rightLungVolume / latest->lungVolume : sim::kNaN;
-  j["end_expiratory_right_lung_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * rightShare * 1e6) : none;
-  j["end_expiratory_left_lung_volume_ml"] = ran ? jsonNumber(sum.endExpiratoryVolume * (1.0 - rightShare) * 1e6) : none;
+  j["end_expiratory_right_lung_volume_ml"] = breathed ? jsonNumber(sum.endExpiratoryVolume * rightShare * 1e6) : none;
+  j["end_expiratory_left_lung_volume_ml"] = breathed ? jsonNumber(sum.endExpiratoryVolume * (1.0 - rightShare) * 1e6) : none;
   j["end_expiratory_thoracic_cavity_volume_ml"] =
-      ran ? jsonNumber((sum.endExpiratoryVolume + model->lungs.mediastinumVolume) * 1e6) : none;
+      breathed ? jsonNumber((sum.endExpiratoryVolume + model->lungs.mediastinumVolume) * 1e6) : none;
   j["max_gut_volume_error_pct"] = ran ? jsonNumber(sum.maxGutVolumeError * 100.0) : none;
   j["mean_gut_volume_error_pct"] = ran ? jsonNumber(sum.meanGutVolumeError * 100.0) : none;
   writeMotion(sum.motion, j);
@@ -258,10 +255,13 @@ void runSimulate(const SimulateArgs& args) {
   // a short human-readable report on stdout
   std::printf("%s: %s%s\n", scenario.name.c_str(), controllerText.c_str(),
               isInterrupted ? " (interrupted, partial results)" : "");
+  if (breathed)
+    std::printf("  tidal volume %.0f mL, %.1f breaths/min", sum.tidalVolume * 1e6, sum.breathsPerMinute);
+  else if (ran)
+    std::printf("  no full breath found");
   if (ran)
-    std::printf(
-        "  tidal volume %.0f mL, %.1f breaths/min, max gut volume error %.3f %%, real-time factor %.2f\n",
-        sum.tidalVolume * 1e6, sum.breathsPerMinute, sum.maxGutVolumeError * 100.0, sum.realTimeFactor);
+    std::printf(", max gut volume error %.3f %%, real-time factor %.2f\n", sum.maxGutVolumeError * 100.0,
+                sum.realTimeFactor);
   std::printf("  wrote %s%zu files in %s\n", hasSummary ? "summary.json and " : "", files.size(),
               args.out.c_str());
   if (!failure.empty() || !writeErrors.empty()) {

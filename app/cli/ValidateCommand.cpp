@@ -33,6 +33,7 @@ struct ValidateArgs {
   std::string model;
   std::string out = "validation";
   bool isQuick = false;
+  bool force = false;  // replace an earlier report in `out`
   std::string integrator;
   std::optional<double> dt;  // [s] unset: sim::resolveOptions() picks it
 };
@@ -93,7 +94,7 @@ viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
 
 void runValidate(const ValidateArgs& args) {
   const std::string modelDir = resolveModelDir(args.model);
-  prepareOutputDir(args.out);
+  prepareOutputDir(args.out, "validate", {"report.json", "report.md", "report.html", "*.png", "*.svg"}, args.force);
   sim::ExperimentSettings settings;
   if (args.isQuick) {
     settings.simulation.settleTime = 1.0;
@@ -215,8 +216,10 @@ void runValidate(const ValidateArgs& args) {
   j["physiology_within"] = within;
   for (const sim::StyleRun& r : runs) {
     nlohmann::json& style = j["styles"][r.style.name];
-    style = {{"tidal_volume_ml", r.summary.tidalVolume * 1e6}, {"breaths_per_minute", r.summary.breathsPerMinute},
-             {"end_expiratory_volume_ml", r.summary.endExpiratoryVolume * 1e6},
+    // as in summary.json, the breath figures are null when no full breath was found (a forced exhale)
+    const auto breath = [&](double v) { return r.summary.cycles > 0 ? jsonNumber(v) : nlohmann::json(nullptr); };
+    style = {{"tidal_volume_ml", breath(r.summary.tidalVolume * 1e6)}, {"breaths_per_minute", breath(r.summary.breathsPerMinute)},
+             {"end_expiratory_volume_ml", breath(r.summary.endExpiratoryVolume * 1e6)},
              {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
              {"real_time_factor", r.summary.realTimeFactor}};
     writeMotion(r.summary.motion, style);
@@ -298,7 +301,8 @@ void addValidateCommand(CLI::App& app) {
   auto args = std::make_shared<ValidateArgs>();
   CLI::App* cmd = app.add_subcommand("validate", "Rerun the papers' experiments; write report.html, report.md, report.json");
   addModelOption(*cmd, args->model);
-  cmd->add_option("--out", args->out, "Output directory (default: ./validation)");
+  cmd->add_option("--out", args->out, "Output directory (default: ./validation; created if missing)");
+  cmd->add_flag("--force", args->force, "Replace an earlier report in --out");
   cmd->add_flag("--quick", args->isQuick, "Shorter runs (same checks), for tests and quick looks");
   addIntegratorOption(*cmd, args->integrator);
   cmd->add_option_function<double>(

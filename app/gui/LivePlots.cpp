@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 namespace pneuma::app {
@@ -16,6 +17,24 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kHistorySeconds = 120.0;  // [s] kept for the window and for picked traces
+constexpr double kSegmentSeconds = 6.0;    // [s] of history per segment
+constexpr std::size_t kSegmentBuckets = 512;  // MinMaxSeries buckets per segment: exact up to 512 / 6 s = 85 Hz
+constexpr double kForceRate = 60.0;        // [Hz] most element-force frames kept per simulated second
+
+// the columns of a segment: time, lung volume [m^3], target volume [m^3], gut volume error [-], then r, alpha and
+// mean tension [N] of each muscle group
+enum Column : std::size_t { kTime, kLung, kTarget, kGut, kFirstGroupColumn };
+constexpr std::size_t kColumnsPerGroup = 3;
+
+const std::vector<sim::ElementGroup>& muscleGroups() {
+  static const std::vector<sim::ElementGroup> groups = [] {
+    std::vector<sim::ElementGroup> g;
+    for (int i = 0; i < sim::kElementGroupCount; ++i)
+      if (sim::isMuscleGroup(static_cast<sim::ElementGroup>(i))) g.push_back(static_cast<sim::ElementGroup>(i));
+    return g;
+  }();
+  return groups;
+}
 
 // short legend names of the muscle groups
 QString shortLabel(sim::ElementGroup g) {
@@ -56,15 +75,45 @@ LivePlots::LivePlots(QWidget* parent) : QWidget(parent), m_cursor(kNaN) {
 }
 
 void LivePlots::clear() {
-  m_history.clear();
+  m_segments.clear();
+  m_forces.clear();
+  m_hasLatest = false;
   m_isDirty = true;
 }
 
 void LivePlots::append(std::vector<PlotSample> samples) {
-  for (PlotSample& s : samples) m_history.push_back(std::move(s));
-  while (!m_history.empty() && m_history.back().time - m_history.front().time > kHistorySeconds)
-    m_history.pop_front();
-  m_isDirty = m_isDirty || !samples.empty();
+  for (const PlotSample& s : samples) appendSample(s);
+  if (samples.empty()) return;
+  m_latest = std::move(samples.back());
+  m_latest.elementForce.clear();
+  m_hasLatest = true;
+  m_isDirty = true;
+  // forget what lies beyond the history (the newest segment and force frame always stay)
+  const double from = m_latest.time - kHistorySeconds;
+  while (m_segments.size() > 1 && m_segments.front().columns[kTime].buckets().back().vMax < from) m_segments.pop_front();
+  while (m_forces.size() > 1 && m_forces[1].time <= from) m_forces.pop_front();
+}
+
+void LivePlots::appendSample(const PlotSample& s) {
+  if (m_segments.empty() || s.time - m_segments.back().columns[kTime].buckets().front().tMin >= kSegmentSeconds) {
+    const std::size_t columnCount = kFirstGroupColumn + kColumnsPerGroup * muscleGroups().size();
+    m_segments.push_back({std::vector<viz::MinMaxSeries>(columnCount, viz::MinMaxSeries(kSegmentBuckets))});
+  }
+  std::vector<viz::MinMaxSeries>& c = m_segments.back().columns;
+  c[kTime].append(s.time, s.time);  // a bucket's minimum is its first sample time, its maximum its last
+  c[kLung].append(s.time, s.lungVolume);
+  c[kTarget].append(s.time, s.targetVolume);
+  c[kGut].append(s.time, s.gutVolumeError);
+  std::size_t k = kFirstGroupColumn;
+  for (const sim::ElementGroup g : muscleGroups()) {
+    const auto i = static_cast<std::size_t>(g);
+    c[k++].append(s.time, s.activations[i].r);
+    c[k++].append(s.time, s.activations[i].alpha);
+    c[k++].append(s.time, s.groupMeanTension[i]);
+  }
+  // element forces for the picked traces, at most kForceRate frames per simulated second
+  if (!s.elementForce.empty() && (m_forces.empty() || s.time >= m_forces.back().time + (1.0 - 1e-6) / kForceRate))
+    m_forces.push_back({s.time, s.elementForce});
 }
 
 void LivePlots::setWindow(double seconds) {
@@ -91,91 +140,101 @@ void LivePlots::clearTraces() {
 }
 
 double LivePlots::tidalVolume() const {
-  if (m_history.empty()) return 0.0;
-  const double from = m_history.back().time - m_breathPeriod;
+  if (!m_hasLatest) return 0.0;
+  const double from = m_latest.time - m_breathPeriod;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (auto it = m_history.rbegin(); it != m_history.rend() && it->time >= from; ++it)
-    lo = std::min(lo, it->lungVolume), hi = std::max(hi, it->lungVolume);
-  return hi - lo;
+  for (auto seg = m_segments.rbegin(); seg != m_segments.rend(); ++seg) {
+    const auto& time = seg->columns[kTime].buckets();
+    const auto& volume = seg->columns[kLung].buckets();
+    for (std::size_t k = time.size(); k-- > 0 && time[k].vMax >= from;)
+      lo = std::min(lo, volume[k].vMin), hi = std::max(hi, volume[k].vMax);
+    if (time.front().vMin < from) break;
+  }
+  return hi >= lo ? hi - lo : 0.0;
 }
 
 bool LivePlots::refresh() {
   if (!m_isDirty) return false;
   m_isDirty = false;
 
-  // only the shown window is handed to the plots
-  std::size_t first = 0;
-  if (!m_history.empty()) {
-    const double from = m_history.back().time - m_window;
-    while (first < m_history.size() && m_history[first].time < from) ++first;
+  // the shown window as a table: per bucket its first and last sample time, and each column's minimum and maximum
+  // in the order they occurred (a bucket of one sample gives one row)
+  const double from = m_hasLatest && m_window > 0.0 ? m_latest.time - m_window : -std::numeric_limits<double>::infinity();
+  std::vector<double> time;
+  std::vector<std::vector<double>> columns(m_segments.empty() ? 0 : m_segments.front().columns.size());
+  for (const Segment& seg : m_segments) {
+    const auto& tb = seg.columns[kTime].buckets();
+    for (std::size_t k = 0; k < tb.size(); ++k) {
+      if (tb[k].vMax < from) continue;
+      const bool isPair = tb[k].vMax > tb[k].vMin;
+      time.push_back(tb[k].vMin);
+      if (isPair) time.push_back(tb[k].vMax);
+      for (std::size_t c = kTime + 1; c < columns.size(); ++c) {
+        const viz::MinMaxSeries::Bucket& b = seg.columns[c].buckets()[k];
+        const bool minFirst = b.tMin <= b.tMax;
+        columns[c].push_back(minFirst ? b.vMin : b.vMax);
+        if (isPair) columns[c].push_back(minFirst ? b.vMax : b.vMin);
+      }
+    }
   }
-  const std::size_t n = m_history.size() - first;
-  std::vector<double> time(n);
-  for (std::size_t k = 0; k < n; ++k) time[k] = m_history[first + k].time;
-  auto column = [&](auto value) {
-    std::vector<double> y(n);
-    for (std::size_t k = 0; k < n; ++k) y[k] = value(m_history[first + k]);
+  const std::size_t n = time.size();
+  auto column = [&](std::size_t c, double scale) {
+    std::vector<double> y = c < columns.size() ? columns[c] : std::vector<double>(n, kNaN);
+    for (double& v : y) v *= scale;
     return y;
   };
 
   // lung volume [mL], with the affect pattern's target when one plays
-  std::vector<PlotView::Series> volume{{"lung volume", QColor(20, 90, 190), false,
-                                        column([](const PlotSample& s) { return 1e6 * s.lungVolume; }), QString()}};
-  if (std::any_of(m_history.begin() + static_cast<std::ptrdiff_t>(first), m_history.end(),
-                  [](const PlotSample& s) { return std::isfinite(s.targetVolume); })) {
+  std::vector<PlotView::Series> volume{{"lung volume", QColor(20, 90, 190), false, column(kLung, 1e6), QString()}};
+  std::vector<double> target = column(kTarget, 1e6);
+  if (std::any_of(target.begin(), target.end(), [](double v) { return std::isfinite(v); })) {
     volume[0].legend = "simulated";
-    volume.push_back({"target volume", QColor(230, 90, 20), true,
-                      column([](const PlotSample& s) { return 1e6 * s.targetVolume; }), "target"});
+    volume.push_back({"target volume", QColor(230, 90, 20), true, std::move(target), "target"});
   }
   m_plots[0]->setData(time, std::move(volume));
   // read-out: the two lungs, their split and the tidal volume
   QString note;
   if (n > 0) {
-    const PlotSample& last = m_history.back();
-    note = QString("lungs %1 mL").arg(1e6 * last.lungVolume, 0, 'f', 0);
-    if (std::isfinite(last.rightLungVolume))
-      note += QString(" (R %1 L %2)").arg(1e6 * last.rightLungVolume, 0, 'f', 0).arg(1e6 * last.leftLungVolume, 0, 'f', 0);
+    note = QString("lungs %1 mL").arg(1e6 * m_latest.lungVolume, 0, 'f', 0);
+    if (std::isfinite(m_latest.rightLungVolume))
+      note += QString(" (R %1 L %2)").arg(1e6 * m_latest.rightLungVolume, 0, 'f', 0).arg(1e6 * m_latest.leftLungVolume, 0, 'f', 0);
     note += QString("  VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
   }
   m_plots[0]->setNote(note);
 
   // gut volume error [%]
-  m_plots[1]->setData(time, {{"gut volume error", QColor(120, 40, 160), false,
-                              column([](const PlotSample& s) { return 100.0 * s.gutVolumeError; }), QString()}});
-  if (n > 0) m_plots[1]->setNote(QString("now %1 %").arg(100.0 * m_history.back().gutVolumeError, 0, 'f', 3));
+  m_plots[1]->setData(time, {{"gut volume error", QColor(120, 40, 160), false, column(kGut, 100.0), QString()}});
+  if (n > 0) m_plots[1]->setNote(QString("now %1 %").arg(100.0 * m_latest.gutVolumeError, 0, 'f', 3));
 
-  // activations r and alpha of the muscle groups
+  // activations r and alpha, and mean tension, of the muscle groups
   std::vector<PlotView::Series> act;
   std::vector<PlotView::Series> tension;
-  for (int g = 0; g < sim::kElementGroupCount; ++g) {
-    const auto group = static_cast<sim::ElementGroup>(g);
-    if (!sim::isMuscleGroup(group)) continue;
+  std::size_t c = kFirstGroupColumn;
+  for (const sim::ElementGroup group : muscleGroups()) {
     const QString name = viz::groupLabel(group);
-    act.push_back({"r " + name, colourOf(group), false,
-                   column([g](const PlotSample& s) { return s.activations[static_cast<std::size_t>(g)].r; }),
-                   shortLabel(group)});
-    act.push_back({"\u03b1 " + name, colourOf(group), true,
-                   column([g](const PlotSample& s) { return s.activations[static_cast<std::size_t>(g)].alpha; }),
-                   QString()});
-    tension.push_back({name, colourOf(group), false,
-                       column([g](const PlotSample& s) { return s.groupMeanTension[static_cast<std::size_t>(g)]; }),
-                       shortLabel(group)});
+    act.push_back({"r " + name, colourOf(group), false, column(c++, 1.0), shortLabel(group)});
+    act.push_back({"\u03b1 " + name, colourOf(group), true, column(c++, 1.0), QString()});
+    tension.push_back({name, colourOf(group), false, column(c++, 1.0), shortLabel(group)});
   }
   m_plots[2]->setData(time, std::move(act));
 
-  // picked traces: summed tension of their elements [N]
+  // picked traces: summed tension of their elements [N], from the latest force frame at or before each time
   for (std::size_t i = 0; i < m_traces.size(); ++i) {
     const Trace& t = m_traces[i];
-    tension.push_back({t.name, kTraceColours[i], true, column([&t](const PlotSample& s) {
-                         double sum = 0.0;
-                         for (int e : t.elements)
-                           if (static_cast<std::size_t>(e) < s.elementForce.size())
-                             sum += std::max(0.0, -static_cast<double>(s.elementForce[static_cast<std::size_t>(e)]));
-                         return sum;
-                       }),
-                       t.name});
+    std::vector<double> y(n, kNaN);
+    auto frame = m_forces.begin();
+    for (std::size_t k = 0; k < n; ++k) {
+      while (frame != m_forces.end() && std::next(frame) != m_forces.end() && std::next(frame)->time <= time[k]) ++frame;
+      if (frame == m_forces.end() || frame->time > time[k]) continue;
+      double sum = 0.0;
+      for (int e : t.elements)
+        if (static_cast<std::size_t>(e) < frame->elementForce.size())
+          sum += std::max(0.0, -static_cast<double>(frame->elementForce[static_cast<std::size_t>(e)]));
+      y[k] = sum;
+    }
+    tension.push_back({t.name, kTraceColours[i], true, std::move(y), t.name});
   }
-  m_plots[3]->setData(time, std::move(tension));
+  m_plots[3]->setData(std::move(time), std::move(tension));
   return true;
 }
 

@@ -4,11 +4,17 @@
 ///  1. lung-cavity volume [mL] with the current tidal volume;
 ///  2. gut volume error [%] with the 0.5 % and 2 % bands;
 ///  3. activations r (solid) and alpha (dashed) per muscle group [-];
-///  4. total tension per muscle group [N], plus the force trace of each picked element or body.
+///  4. mean tension per element of each muscle group [N], plus the force trace of each picked element or body.
+/// Memory is bounded whatever the output rate and run length: the last kHistorySeconds are kept in segments whose
+/// quantities are thinned by viz::MinMaxSeries (every peak and trough kept; exact up to kSegmentBuckets samples
+/// per segment, i.e. up to about 85 Hz), and the element forces behind the picked traces at most kForceRate
+/// times per simulated second.
 
 #include "gui/SimWorker.h"
 
 #include <QWidget>
+
+#include "viz/MinMaxSeries.h"
 
 #include <deque>
 #include <vector>
@@ -53,7 +59,23 @@ class LivePlots : public QWidget {
   double tidalVolume() const;
 
  private:
-  std::deque<PlotSample> m_history;
+  /// A stretch of the history: column 0 is the time itself (so each bucket's first and last sample time), the
+  /// others the plotted quantities in the order of appendColumns(). All columns receive the same samples, so
+  /// their buckets line up.
+  struct Segment {
+    std::vector<viz::MinMaxSeries> columns;
+  };
+  /// The element forces of one sample, for the picked traces.
+  struct ForceFrame {
+    double time;                      // [s]
+    std::vector<float> elementForce;  // [N] signed, per element
+  };
+  void appendSample(const PlotSample& s);
+
+  std::deque<Segment> m_segments;
+  std::deque<ForceFrame> m_forces;
+  PlotSample m_latest;          // the newest sample (for the notes)
+  bool m_hasLatest = false;
   std::vector<PlotView*> m_plots;
   std::vector<Trace> m_traces;
   double m_window = 20.0;       // [s]

@@ -428,7 +428,7 @@ void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
 }
 
 QString MainWindow::modelStatus() const {
-  if (!m_model) return m_modelText;
+  if (!m_document.model()) return m_modelText;
   return m_modelText + QString(", posture %1").arg(sim::postureName(m_settings.options.step.posture));
 }
 
@@ -552,7 +552,7 @@ QString MainWindow::setPosture(const QString& name) {
     report("Unknown posture", error);
     return error;
   }
-  m_params->setSettings(m_settings, m_model ? m_model->gut.kappa : 0.0);
+  m_params->setSettings(m_settings, m_document.model());
   if (m_worker) m_worker->requestSettings(m_settings);
   showPosture();
   return {};

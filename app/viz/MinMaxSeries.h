@@ -22,10 +22,15 @@ class MinMaxSeries {
   /// The thinned curve in time order: one point per single-sample bucket, else its minimum and its maximum.
   void points(std::vector<double>& t, std::vector<double>& v) const;
 
- private:
+  /// One bucket: its smallest and its largest sample, with their times.
   struct Bucket {
     double tMin, vMin, tMax, vMax;
   };
+  /// The buckets in time order. Which samples share a bucket depends only on how many were appended, so series
+  /// fed the same samples (the columns of one table) have buckets that span the same samples.
+  const std::vector<Bucket>& buckets() const { return m_buckets; }
+
+ private:
   void mergePairs();
   std::size_t m_maxBuckets;
   std::size_t m_span = 1;    // samples per bucket

@@ -4,15 +4,27 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <fstream>
+
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
 using pneuma::test::slurp;
 using pneuma::test::toyModelDir;
 
 TEST(CliBench, ReportsEveryStyleAndIncreasingElementCounts) {
+  // an earlier bench.json in --out: refused, untouched, then replaced with --force
   const std::string out = freshOutDir("bench");
-  auto r =
-      runCli({"bench", "--model", toyModelDir(), "--seconds", "0.3", "--posture", "supine", "--out", out});
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/bench.json") << "earlier";
+  const std::vector<std::string> args = {"bench", "--model", toyModelDir(), "--seconds", "0.3", "--posture", "supine", "--out", out};
+  auto r = runCli(args);
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("holds an earlier run (bench.json); add --force to replace it"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out + "/bench.json"), "earlier");
+  std::vector<std::string> forced = args;
+  forced.push_back("--force");
+  r = runCli(forced);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/bench.json"));
   EXPECT_EQ(j["posture"], "supine");
@@ -30,4 +42,16 @@ TEST(CliBench, ReportsEveryStyleAndIncreasingElementCounts) {
   ASSERT_EQ(el.size(), 4u);
   for (std::size_t i = 1; i < el.size(); ++i) EXPECT_GT(el[i]["elements"].get<int>(), el[i - 1]["elements"].get<int>());
   EXPECT_NE(r.out.find("real-time factor"), std::string::npos);
+}
+
+// data loss: bench writes only into a new or empty folder or over an earlier bench.json, never over other files
+TEST(CliBench, FolderOfOtherFilesIsRefused) {
+  const std::string out = freshOutDir("bench_foreign");
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/results.csv") << "mine";
+  const auto r = runCli({"bench", "--model", toyModelDir(), "--seconds", "0.3", "--force", "--out", out});
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("holds 'results.csv', which pneuma-cli bench does not write"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out + "/results.csv"), "mine");
+  EXPECT_FALSE(std::filesystem::exists(out + "/bench.json"));
 }

@@ -204,8 +204,9 @@ TEST(CliSimulate, AffectAddsTargetAndMeasuredVolumeFraction) {
 
 TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
   const std::string out = freshOutDir("scenario");
-  fs::create_directories(out);
-  const std::string file = out + "/run.json";
+  const std::string inputs = freshOutDir("scenario_inputs");
+  fs::create_directories(inputs);
+  const std::string file = inputs + "/run.json";
   std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "name": "deep-short", "model": ")" << toyModelDir()
                       << R"(", "duration_s": 30, "controller": {"style": "deep"},
       "overrides": {"settle_time_s": 0.5, "posture": "supine"}, "outputs": {"output_rate_hz": 10, "plots": false}})";
@@ -264,6 +265,41 @@ TEST(CliSimulate, EarlierRunIsReplacedOnlyWithForce) {
   r = runCli(again);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/summary.json"))["duration_s"].get<double>(), 1.0);
+}
+
+// data loss: an --out that holds files simulate does not write is refused, even with --force, and left as it was
+TEST(CliSimulate, FolderOfOtherFilesIsRefused) {
+  const std::string out = freshOutDir("foreign");
+  fs::create_directories(out);
+  std::ofstream(out + "/thesis.tex") << "chapter 1";
+  for (const bool force : {false, true}) {
+    std::vector<std::string> run = {"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5",
+                                    "--settle", "0", "--out", out};
+    if (force) run.push_back("--force");
+    const auto r = runCli(run);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("holds 'thesis.tex', which pneuma-cli simulate does not write"), std::string::npos) << r.err;
+    EXPECT_EQ(pneuma::test::lineCount(r.err), 1) << r.err;
+    EXPECT_EQ(slurp(out + "/thesis.tex"), "chapter 1");
+    EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator()), 1);
+  }
+}
+
+// messages: a run too short for a full breath reports its breath figures as null, not as 0 or as the range of a
+// fraction of a breath
+TEST(CliSimulate, NoFullBreathGivesNullBreathFigures) {
+  const std::string out = freshOutDir("nobreath");
+  const auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--settle", "0",
+                         "--output-rate", "20", "--out", out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
+  EXPECT_EQ(s["cycles"].get<int>(), 0);
+  for (const char* key : {"tidal_volume_ml", "breaths_per_minute", "end_expiratory_volume_ml", "end_inspiratory_volume_ml",
+                          "dome_descent_mm", "rib_cage_fraction"})
+    EXPECT_TRUE(s[key].is_null()) << key << " = " << s[key];
+  EXPECT_TRUE(s["max_gut_volume_error_pct"].is_number());  // measured whether or not it breathed
+  EXPECT_NE(r.out.find("no full breath found"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("breaths/min"), std::string::npos) << r.out;
 }
 
 // integers do not wrap: --seed -1 is not 2^64 - 1

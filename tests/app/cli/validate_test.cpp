@@ -5,14 +5,27 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <fstream>
+
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
 using pneuma::test::slurp;
 using pneuma::test::toyModelDir;
 
 TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
+  // an earlier report in --out: refused, untouched, then replaced with --force
   const std::string out = freshOutDir("validate");
-  auto r = runCli({"validate", "--quick", "--dt", "0.002", "--model", toyModelDir(), "--out", out});
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/report.json") << "earlier";
+  const std::vector<std::string> args = {"validate", "--quick", "--dt", "0.002", "--model", toyModelDir(), "--out", out};
+  auto r = runCli(args);
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("holds an earlier run (report.json); add --force to replace it"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out + "/report.json"), "earlier");
+  std::vector<std::string> forced = args;
+  forced.push_back("--force");
+  r = runCli(forced);
   ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 1) << r.err;
 
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/report.json"));
@@ -68,6 +81,22 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   EXPECT_NE(html.find("<h2>Physiology</h2>"), std::string::npos);
   // stdout carries the table
   EXPECT_NE(r.out.find("calm.tidal_volume"), std::string::npos);
+}
+
+// data loss: validate writes only into a new or empty folder or over an earlier report, never over other files
+TEST(CliValidate, FolderOfOtherFilesIsRefused) {
+  const std::string out = freshOutDir("validate_foreign");
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/report.txt") << "mine";
+  for (const bool force : {false, true}) {
+    std::vector<std::string> args = {"validate", "--quick", "--model", toyModelDir(), "--out", out};
+    if (force) args.push_back("--force");
+    const auto r = runCli(args);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("holds 'report.txt', which pneuma-cli validate does not write"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(out + "/report.txt"), "mine");
+    EXPECT_FALSE(std::filesystem::exists(out + "/report.json"));
+  }
 }
 
 TEST(CliValidate, MissingModelIsBadInput) {

@@ -1,0 +1,104 @@
+// The live plots over long and fast runs (issue 15, class 12): memory and plotted points do not grow with the
+// output rate or the run length, every peak and trough stays visible, and at display rates the plots are exact.
+#include "GuiTestSupport.h"
+#include "gui/LivePlots.h"
+#include "gui/PlotView.h"
+
+#include <gtest/gtest.h>
+#include <malloc.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace pneuma;
+using pneuma::app::PlotSample;
+
+namespace {
+
+constexpr std::size_t kElements = 64;
+
+// a calm-looking sample at time t [s]: volume 3 L +/- 0.25 L at 15 breaths/min, every element at 10 N tension
+PlotSample sampleAt(double t) {
+  PlotSample s;
+  s.time = t;
+  s.lungVolume = 3e-3 + 0.25e-3 * std::sin(2.0 * M_PI * t / 4.0);
+  s.gutVolumeError = 1e-3 * std::cos(2.0 * M_PI * t / 4.0);
+  for (auto& a : s.activations) a.r = a.alpha = 0.5 + 0.5 * std::sin(2.0 * M_PI * t / 4.0);
+  s.elementForce.assign(kElements, -10.0f);
+  return s;
+}
+
+// feeds `seconds` at `rate` [Hz] from `t0` in batches of 1/30 s, as the main window's refresh does
+double feed(app::LivePlots& plots, double t0, double seconds, double rate) {
+  const auto count = static_cast<long>(std::lround(seconds * rate));
+  std::vector<PlotSample> batch;
+  for (long i = 1; i <= count; ++i) {
+    batch.push_back(sampleAt(t0 + static_cast<double>(i) / rate));
+    if (batch.size() >= static_cast<std::size_t>(rate / 30.0)) plots.append(std::move(batch)), batch.clear();
+  }
+  plots.append(std::move(batch));
+  return t0 + static_cast<double>(count) / rate;
+}
+
+// [bytes] allocated on the heap, small blocks and mapped ones
+std::size_t heapInUse() {
+  const struct mallinfo2 m = mallinfo2();
+  return m.uordblks + m.hblkhd;
+}
+
+}  // namespace
+
+// two hours at the highest output rate the scenario files allow would hold 1.2 million samples over the 120 s
+// history; 130 s at 2 kHz (260,000 samples, each with its element forces) shows the growth within seconds
+TEST(LivePlots, MemoryAndPlottedPointsStayBoundedAtAnyOutputRate) {
+  app::test::application();
+  app::LivePlots plots;
+  plots.addTrace({"element 3", {3}});
+  double t = feed(plots, 0.0, 2.0, 2000.0);
+  const std::size_t before = heapInUse();
+  t = feed(plots, t, 128.0, 2000.0);
+  // a single-sample spike and dip inside the shown window
+  plots.append({sampleAt(t + 0.0005)});
+  PlotSample spike = sampleAt(t + 0.001), dip = sampleAt(t + 0.0015);
+  spike.lungVolume = 10e-3;
+  dip.lungVolume = 1e-3;
+  plots.append({spike, dip});
+  t = feed(plots, t + 0.0015, 5.0, 2000.0);
+  const std::size_t after = heapInUse();
+  // the old history held every sample of 120 s: about 240,000 x 0.5 kB = 115 MB here
+  EXPECT_LT(after - std::min(after, before), 32u << 20) << "heap grew by " << (after - before) / 1024 << " kB";
+
+  ASSERT_TRUE(plots.refresh());
+  const app::PlotView& volume = *plots.volumePlot();
+  // the 20 s window: at most two points per bucket of the segments it covers, not the 40,000 samples
+  EXPECT_LT(volume.time().size(), 6000u);
+  EXPECT_GT(volume.time().size(), 1000u);
+  EXPECT_GE(volume.time().front(), t - 20.0 - 6.0);
+  EXPECT_DOUBLE_EQ(volume.time().back(), t);
+  const std::vector<double>& v = volume.series()[0].y;
+  EXPECT_DOUBLE_EQ(*std::max_element(v.begin(), v.end()), 10000.0);  // [mL] the spike, kept
+  EXPECT_DOUBLE_EQ(*std::min_element(v.begin(), v.end()), 1000.0);   // the dip, kept
+  EXPECT_TRUE(std::is_sorted(volume.time().begin(), volume.time().end()));
+  // the picked element's trace: 10 N wherever it has a frame, which is everywhere in the window
+  const app::PlotView& tension = *plots.plots()[3];
+  const std::vector<double>& trace = tension.series().back().y;
+  ASSERT_EQ(trace.size(), volume.time().size());
+  for (double y : trace) ASSERT_EQ(y, 10.0);
+  // the tidal volume still sees the last breath's extremes: 0.5 L peak to trough
+  EXPECT_NEAR(plots.tidalVolume(), 0.5e-3, 1e-6);
+}
+
+// at the app's 60 Hz every sample is plotted as it came, in the window and no further back
+TEST(LivePlots, DisplayRatesArePlottedExactly) {
+  app::test::application();
+  app::LivePlots plots;
+  const double t = feed(plots, 0.0, 30.0, 60.0);
+  ASSERT_TRUE(plots.refresh());
+  const app::PlotView& volume = *plots.volumePlot();
+  ASSERT_EQ(volume.time().size(), 20u * 60u + 1u);  // (t - 20 s, t]: the window's samples and its start
+  for (std::size_t k = 0; k < volume.time().size(); ++k) {
+    const double tk = t - 20.0 + static_cast<double>(k) / 60.0;
+    ASSERT_NEAR(volume.time()[k], tk, 1e-9);
+    ASSERT_EQ(volume.series()[0].y[k], 1e6 * sampleAt(volume.time()[k]).lungVolume);
+  }
+}
