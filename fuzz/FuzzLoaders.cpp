@@ -1,14 +1,14 @@
 #include "FuzzLoaders.h"
 
+#include <fstream>
+#include <sstream>
+
 #include "pneuma/meshing/AnatomyParams.h"
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/pattern/Pattern.h"
-
-#include <fstream>
-#include <sstream>
 
 namespace pneuma::fuzz {
 

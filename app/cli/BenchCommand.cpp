@@ -3,23 +3,21 @@
 /// and the wall time of one step against the number of spring elements (the model with every k-th
 /// element kept, k = 8, 4, 2, 1). Prints a table; with --out also writes bench.json.
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+
 #include "CliSupport.h"
 #include "Commands.h"
-
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Simulation.h"
 #include "viz/AtomicFile.h"
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <memory>
 
 namespace pneuma::app {
 
@@ -38,8 +36,10 @@ struct BenchArgs {
 sim::AnchorSet subset(const sim::AnchorSet& a, const std::vector<int>& keep) {
   sim::AnchorSet out;
   for (int i : keep) {
-    if (a.body[static_cast<std::size_t>(i)] >= 0) out.addBodyPoint(a.body[static_cast<std::size_t>(i)], a.local.col(i));
-    else out.addNodePoint(a.nodes.col(i), a.weights.col(i));
+    if (a.body[static_cast<std::size_t>(i)] >= 0)
+      out.addBodyPoint(a.body[static_cast<std::size_t>(i)], a.local.col(i));
+    else
+      out.addNodePoint(a.nodes.col(i), a.weights.col(i));
   }
   return out;
 }
@@ -50,7 +50,8 @@ sim::Model thinned(const sim::Model& model, int stride) {
   std::array<int, sim::kElementGroupCount> seen{};
   for (int e = 0; e < model.elements.size(); ++e) {
     const sim::ElementGroup g = model.elements.group[static_cast<std::size_t>(e)];
-    if (g == sim::ElementGroup::Cartilage || seen[static_cast<std::size_t>(g)]++ % stride == 0) keep.push_back(e);
+    if (g == sim::ElementGroup::Cartilage || seen[static_cast<std::size_t>(g)]++ % stride == 0)
+      keep.push_back(e);
   }
   sim::Model m = model;
   sim::Elements& el = m.elements;
@@ -74,7 +75,8 @@ sim::Model thinned(const sim::Model& model, int stride) {
   return m;
 }
 
-/// Runs `style` on `model` for `seconds` after a 0.5 s settle; returns (real-time factor, wall seconds per step).
+/// Runs `style` on `model` for `seconds` after a 0.5 s settle; returns (real-time factor, wall seconds per
+/// step).
 std::pair<double, double> measure(std::shared_ptr<const sim::Model> model, const sim::BreathStyle& style,
                                   const sim::SimulationOptions& options, double seconds) {
   sim::Simulation simulation(std::move(model), std::make_unique<sim::BreathStyleController>(style), options);
@@ -133,18 +135,22 @@ void runBench(const BenchArgs& args) {
     fail(kExitFailed, e.what());
   }
 
-  // step time against element count (calm breathing); a thinned model keeps every 8th, 4th or 2nd strand of its
-  // abdominal wall, so the gut pressure bulges it and it may blow up within seconds: measure a fixed 2 s and
-  // report a blow-up in its row
+  // step time against element count (calm breathing); a thinned model keeps every 8th, 4th or 2nd strand of
+  // its abdominal wall, so the gut pressure bulges it and it may blow up within seconds: measure a fixed 2 s
+  // and report a blow-up in its row
   constexpr double kThinnedSeconds = 2.0;  // [s]
-  const auto calm = std::find_if(styles.begin(), styles.end(), [](const sim::BreathStyle& s) { return s.name == "calm"; });
-  std::printf("\n%-16s %18s %16s   (%g s each)\n", "elements", "real-time factor", "step time [ms]", kThinnedSeconds);
+  const auto calm =
+      std::find_if(styles.begin(), styles.end(), [](const sim::BreathStyle& s) { return s.name == "calm"; });
+  std::printf("\n%-16s %18s %16s   (%g s each)\n", "elements", "real-time factor", "step time [ms]",
+              kThinnedSeconds);
   for (int stride : {8, 4, 2, 1}) {
     auto m = std::make_shared<const sim::Model>(thinned(*model, stride));
     try {
-      const auto [rtf, stepTime] = measure(m, calm != styles.end() ? *calm : styles.front(), options, kThinnedSeconds);
+      const auto [rtf, stepTime] =
+          measure(m, calm != styles.end() ? *calm : styles.front(), options, kThinnedSeconds);
       std::printf("%-16d %18.2f %16.3f\n", m->elements.size(), rtf, stepTime * 1e3);
-      j["elements"].push_back({{"elements", m->elements.size()}, {"real_time_factor", rtf}, {"step_time_ms", stepTime * 1e3}});
+      j["elements"].push_back(
+          {{"elements", m->elements.size()}, {"real_time_factor", rtf}, {"step_time_ms", stepTime * 1e3}});
     } catch (const sim::Error& e) {
       std::printf("%-16d %s\n", m->elements.size(), e.what());
       j["elements"].push_back({{"elements", m->elements.size()}, {"error", e.what()}});
@@ -160,7 +166,8 @@ void runBench(const BenchArgs& args) {
 
 void addBenchCommand(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
-  CLI::App* cmd = app.add_subcommand("bench", "Real-time factor per breath style and step time per element count");
+  CLI::App* cmd =
+      app.add_subcommand("bench", "Real-time factor per breath style and step time per element count");
   addModelOption(*cmd, args->model);
   cmd->add_option("--out", args->out, "Also write bench.json into this directory (created if missing)");
   cmd->add_flag("--force", args->force, "Replace an earlier bench.json in --out");

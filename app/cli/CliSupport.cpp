@@ -1,11 +1,8 @@
 #include "CliSupport.h"
 
-#include "pneuma/sim/Resources.h"
-
-#include <CLI/CLI.hpp>
-
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +11,8 @@
 #include <fstream>
 #include <iostream>
 #include <vector>
+
+#include "pneuma/sim/Resources.h"
 
 namespace fs = std::filesystem;
 
@@ -27,13 +26,15 @@ void fail(int code, const std::string& message) {
 std::string resolveModelDir(const std::string& requested) {
   const std::string dir = requested.empty() ? sim::defaultModelDir() : requested;
   if (!fs::is_directory(dir))
-    fail(kExitBadInput, "model directory '" + dir + "' does not exist (build the default model or pass --model DIR)");
+    fail(kExitBadInput,
+         "model directory '" + dir + "' does not exist (build the default model or pass --model DIR)");
   if (!fs::is_regular_file(fs::path(dir) / "model.json"))
     fail(kExitBadInput, "model directory '" + dir + "' has no model.json");
   return dir;
 }
 
-void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own, bool force) {
+void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own,
+                      bool force) {
   if (dir.empty()) fail(kExitBadInput, "--out: must not be empty");
   std::error_code ec;
   if (fs::is_directory(dir, ec)) {
@@ -41,8 +42,8 @@ void prepareOutputDir(const std::string& dir, const char* command, std::initiali
     auto isOwn = [&](const std::string& name) {
       for (const std::string pattern : own) {
         const bool isSuffix = pattern.size() > 1 && pattern[0] == '*';
-        if (isSuffix ? name.size() > pattern.size() - 1 &&
-                           name.compare(name.size() - (pattern.size() - 1), std::string::npos, pattern, 1) == 0
+        if (isSuffix ? name.size() > pattern.size() - 1 && name.compare(name.size() - (pattern.size() - 1),
+                                                                        std::string::npos, pattern, 1) == 0
                      : name == pattern)
           return true;
       }
@@ -57,8 +58,8 @@ void prepareOutputDir(const std::string& dir, const char* command, std::initiali
     std::sort(entries.begin(), entries.end());
     for (const std::string& name : entries)
       if (!isOwn(name))
-        fail(kExitBadInput, "--out: '" + dir + "' holds '" + name.substr(0, 60) + "', which pneuma-cli " + command +
-                                " does not write; give a new or empty directory");
+        fail(kExitBadInput, "--out: '" + dir + "' holds '" + name.substr(0, 60) + "', which pneuma-cli " +
+                                command + " does not write; give a new or empty directory");
     if (isEarlierRun && !force) {
       std::string earlier = entries.front();
       for (const std::string name : own)
@@ -66,13 +67,16 @@ void prepareOutputDir(const std::string& dir, const char* command, std::initiali
           earlier = name;
           break;
         }
-      fail(kExitBadInput, "--out: '" + dir + "' holds an earlier run (" + earlier + "); add --force to replace it");
+      fail(kExitBadInput,
+           "--out: '" + dir + "' holds an earlier run (" + earlier + "); add --force to replace it");
     }
   }
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) fail(kExitBadInput, "--out: cannot create directory '" + dir + "'" + (ec ? ": " + ec.message() : ""));
+  if (ec || !fs::is_directory(dir))
+    fail(kExitBadInput, "--out: cannot create directory '" + dir + "'" + (ec ? ": " + ec.message() : ""));
   // probe: can we create a file there?
-  const fs::path probe = fs::path(dir) / (".pneuma-write-test-" + std::to_string(static_cast<long>(getpid())));
+  const fs::path probe =
+      fs::path(dir) / (".pneuma-write-test-" + std::to_string(static_cast<long>(getpid())));
   {
     std::ofstream out(probe);
     if (!out) fail(kExitBadInput, "--out: directory '" + dir + "' is not writable");

@@ -3,14 +3,13 @@
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
 /// resources, preparing output directories, number formatting for JSON/CSV.
 
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <string>
+
 #include "pneuma/sim/Limits.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Step.h"
-
-#include <nlohmann/json.hpp>
-
-#include <initializer_list>
-#include <string>
 
 namespace CLI {
 class App;
@@ -41,7 +40,8 @@ void addModelOption(CLI::App& cmd, std::string& model);
 /// Adds `--integrator NAME` to `cmd`; applyIntegrator() reads it.
 void addIntegratorOption(CLI::App& cmd, std::string& name);
 
-/// Sets `kind` from an --integrator value ("" keeps it); an unknown name fails with kExitBadInput and the valid names.
+/// Sets `kind` from an --integrator value ("" keeps it); an unknown name fails with kExitBadInput and the
+/// valid names.
 void applyIntegrator(const std::string& name, sim::IntegratorKind& kind);
 
 /// Adds `--posture NAME` to `cmd`; applyPosture() reads it.
@@ -54,13 +54,14 @@ void applyPosture(const std::string& name, sim::Posture& posture);
 /// Fails with kExitBadInput and "<flag>: must be in [lo, hi] unit, got v" unless `range` contains `v`.
 void checkOption(const sim::Range& range, const char* flag, double v);
 
-/// Prepares the --out directory `dir` of `pneuma-cli <command>`, which writes only the entries `own` (exact names,
-/// or "*.ext" patterns; the exact names first, the one that marks an earlier run first of all, e.g. "summary.json").
-/// An existing `dir` may hold nothing but such entries, so a command never overwrites what it did not write: any
-/// other entry fails with kExitBadInput naming it, and an earlier run (any own entry but an empty directory) is
-/// replaced only with `force`. Then creates
-/// `dir` (and parents) and checks that a file can be written in it; fails with kExitBadInput otherwise.
-void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own, bool force);
+/// Prepares the --out directory `dir` of `pneuma-cli <command>`, which writes only the entries `own` (exact
+/// names, or "*.ext" patterns; the exact names first, the one that marks an earlier run first of all, e.g.
+/// "summary.json"). An existing `dir` may hold nothing but such entries, so a command never overwrites what
+/// it did not write: any other entry fails with kExitBadInput naming it, and an earlier run (any own entry
+/// but an empty directory) is replaced only with `force`. Then creates `dir` (and parents) and checks that a
+/// file can be written in it; fails with kExitBadInput otherwise.
+void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own,
+                      bool force);
 
 /// Shortest round-trip text of a double for CSV/JSON ("%.9g"); "nan" never appears: non-finite gives "".
 std::string formatNumber(double v);

@@ -1,19 +1,17 @@
 #include "ModelCommand.h"
 
-#include "ModelPreview.h"
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <iostream>
+#include <memory>
 
+#include "ModelPreview.h"
 #include "pneuma/meshing/AnatomyParams.h"
 #include "pneuma/meshing/ModelBuilder.h"
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
-
-#include <CLI/CLI.hpp>
-
-#include <chrono>
-#include <iostream>
-#include <memory>
 
 namespace pneuma::app {
 
@@ -62,7 +60,8 @@ void runInfo(const InfoOptions& o) {
   if (o.isJson) {
     std::cout << meshing::summaryJson(s) << "\n";
   } else {
-    std::cout << "model " << model.name << " (" << model.anatomy << ") in " << o.dir << "\n" << meshing::summaryText(s);
+    std::cout << "model " << model.name << " (" << model.anatomy << ") in " << o.dir << "\n"
+              << meshing::summaryText(s);
   }
 }
 
@@ -89,7 +88,9 @@ void addModelCommand(CLI::App& app) {
   auto build = std::make_shared<BuildOptions>();
   CLI::App* b = model->add_subcommand("build", "Build the torso model of an anatomy preset into a directory");
   b->add_option("--anatomy", build->anatomy, "Anatomy preset (JSON)")->check(CLI::ExistingFile);
-  b->add_option("--out", build->out, "Output model directory: new, empty or an earlier model (replaced as a whole)")->required();
+  b->add_option("--out", build->out,
+                "Output model directory: new, empty or an earlier model (replaced as a whole)")
+      ->required();
   b->add_flag("--no-preview", build->isPreviewSkipped, "Do not render preview_front.png / preview_side.png");
   b->callback([build] { guarded([&] { runBuild(*build); }); });
 

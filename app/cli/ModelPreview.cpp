@@ -1,10 +1,5 @@
 #include "ModelPreview.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/ModelIO.h"
-#include "viz/AtomicFile.h"
-#include "viz/ModelScene.h"
-
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkRenderWindow.h>
@@ -14,6 +9,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+#include "viz/AtomicFile.h"
+#include "viz/ModelScene.h"
 
 namespace pneuma::app {
 

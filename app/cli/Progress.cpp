@@ -28,9 +28,13 @@ void onSigint(int) {
 std::string formatSeconds(double s) {
   char buf[32];
   if (!std::isfinite(s)) return "--";
-  if (s >= 3600.0) std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s / 3600), static_cast<int>(std::fmod(s, 3600) / 60));
-  else if (s >= 60.0) std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s / 60), static_cast<int>(std::fmod(s, 60)));
-  else std::snprintf(buf, sizeof buf, "%.0fs", s);
+  if (s >= 3600.0)
+    std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s / 3600),
+                  static_cast<int>(std::fmod(s, 3600) / 60));
+  else if (s >= 60.0)
+    std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s / 60), static_cast<int>(std::fmod(s, 60)));
+  else
+    std::snprintf(buf, sizeof buf, "%.0fs", s);
   return buf;
 }
 
@@ -51,8 +55,11 @@ bool InterruptGuard::isInterrupted() { return g_interrupted.load(); }
 const std::atomic<bool>* InterruptGuard::flag() { return &g_interrupted; }
 
 ProgressBar::ProgressBar(std::string label, double totalTime)
-    : m_label(std::move(label)), m_total(totalTime), m_isTty(isatty(STDERR_FILENO) != 0),
-      m_start(std::chrono::steady_clock::now()), m_lastDraw(m_start) {}
+    : m_label(std::move(label)),
+      m_total(totalTime),
+      m_isTty(isatty(STDERR_FILENO) != 0),
+      m_start(std::chrono::steady_clock::now()),
+      m_lastDraw(m_start) {}
 
 void ProgressBar::update(double t) {
   if (!m_isTty) return;
@@ -71,8 +78,8 @@ void ProgressBar::draw(double t) {
   const int filled = static_cast<int>(fraction * kWidth);
   std::string bar(static_cast<std::size_t>(filled), '#');
   bar.resize(kWidth, '-');
-  std::fprintf(stderr, "\r%s [%s] %5.1f/%.1f s  RTF %.2f  ETA %s   ", m_label.c_str(), bar.c_str(), t, m_total, rtf,
-               formatSeconds(eta).c_str());
+  std::fprintf(stderr, "\r%s [%s] %5.1f/%.1f s  RTF %.2f  ETA %s   ", m_label.c_str(), bar.c_str(), t,
+               m_total, rtf, formatSeconds(eta).c_str());
   std::fflush(stderr);
   m_hasDrawn = true;
 }

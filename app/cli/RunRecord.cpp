@@ -1,12 +1,12 @@
 #include "RunRecord.h"
 
+#include <cmath>
+#include <sstream>
+
 #include "CliSupport.h"
 #include "viz/AtomicFile.h"
 #include "viz/ModelScene.h"
 #include "viz/Plot.h"
-
-#include <cmath>
-#include <sstream>
 
 namespace pneuma::app {
 
@@ -42,9 +42,12 @@ void RunRecord::writeCsvHeader() {
   csv << "time [s],lung_volume [mL],gut_volume_error [%],rib_cage_volume [mL],abdomen_volume [mL],"
          "right_lung_volume [mL],left_lung_volume [mL],thoracic_cavity_volume [mL]";
   for (int g = 0; g < sim::kElementGroupCount; ++g)
-    if (sim::isMuscleGroup(group(g))) csv << "," << sim::groupName(group(g)) << ".r [-]," << sim::groupName(group(g)) << ".alpha [-]";
-  for (int g = 0; g < sim::kElementGroupCount; ++g) csv << "," << sim::groupName(group(g)) << ".mean_tension [N]";
-  for (const std::string& name : m_model.landmarks.name) csv << "," << name << ".x [mm]," << name << ".y [mm]," << name << ".z [mm]";
+    if (sim::isMuscleGroup(group(g)))
+      csv << "," << sim::groupName(group(g)) << ".r [-]," << sim::groupName(group(g)) << ".alpha [-]";
+  for (int g = 0; g < sim::kElementGroupCount; ++g)
+    csv << "," << sim::groupName(group(g)) << ".mean_tension [N]";
+  for (const std::string& name : m_model.landmarks.name)
+    csv << "," << name << ".x [mm]," << name << ".y [mm]," << name << ".z [mm]";
   if (m_hasVolumeTarget) csv << ",target_volume_fraction [-],measured_volume_fraction [-]";
   csv << "\n";
   m_csv->write(csv.str());
@@ -113,7 +116,8 @@ std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std
   save(gut, "gut_volume_error");
 
   viz::Plot act("Muscle activations (" + runLabel + ")", "time [s]", "r, alpha [-]");
-  viz::Plot ten("Mean element tension per group (" + runLabel + ")", "time [s]", "mean tension per element [N]");
+  viz::Plot ten("Mean element tension per group (" + runLabel + ")", "time [s]",
+                "mean tension per element [N]");
   for (int g = 0; g < sim::kElementGroupCount; ++g) {
     const std::size_t i = static_cast<std::size_t>(g);
     const std::string name = sim::groupName(group(g));
@@ -131,7 +135,8 @@ std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std
   save(ten, "tensions");
 
   if (m_hasVolumeTarget) {
-    viz::Plot vf("Volume fraction: pattern target vs measured (" + runLabel + ")", "time [s]", "volume fraction [-]");
+    viz::Plot vf("Volume fraction: pattern target vs measured (" + runLabel + ")", "time [s]",
+                 "volume fraction [-]");
     curve(m_target, 1.0, t, v);
     vf.addSeries(viz::Plot::Series{"target", t, v, {0.84, 0.15, 0.16}, true});
     curve(m_measured, 1.0, t, v);

@@ -7,14 +7,14 @@
 /// file, renamed by commitCsv()), and the plots keep each series thinned to the minima and maxima of at most
 /// kPlotBuckets buckets (viz::MinMaxSeries), so an hour's plot is as small as a minute's.
 
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
 #include "viz/AtomicFile.h"
 #include "viz/MinMaxSeries.h"
-
-#include <memory>
-#include <string>
-#include <vector>
 
 namespace pneuma::app {
 

@@ -2,19 +2,17 @@
 /// `pneuma-cli scenario check FILE...` and `pneuma-cli scenario show FILE`: validate scenario files
 /// (every field, and the style, affect or pattern they name) without running them.
 
-#include "CliSupport.h"
-#include "Commands.h"
-
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Resources.h"
-#include "pneuma/sim/Scenario.h"
-
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "CliSupport.h"
+#include "Commands.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Resources.h"
+#include "pneuma/sim/Scenario.h"
 
 namespace pneuma::app {
 
@@ -37,11 +35,13 @@ sim::Scenario loadChecked(const std::string& path) {
 }  // namespace
 
 void addScenarioCommand(CLI::App& app) {
-  CLI::App* cmd = app.add_subcommand("scenario", "Check or show scenario files (docs/cli.md, 'Scenario files')");
+  CLI::App* cmd =
+      app.add_subcommand("scenario", "Check or show scenario files (docs/cli.md, 'Scenario files')");
   cmd->require_subcommand(1);
 
   auto files = std::make_shared<std::vector<std::string>>();
-  CLI::App* check = cmd->add_subcommand("check", "Validate scenario files; exit 0 when all are valid, 2 otherwise");
+  CLI::App* check =
+      cmd->add_subcommand("check", "Validate scenario files; exit 0 when all are valid, 2 otherwise");
   check->add_option("FILE", *files, "Scenario files")->required();
   check->callback([files] {
     for (const std::string& f : *files) {

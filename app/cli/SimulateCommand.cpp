@@ -1,11 +1,20 @@
 /// @file SimulateCommand.cpp
 /// `pneuma-cli simulate`: one run of a breath style, an affect, a pattern file or a scenario file.
 
+#include <CLI/CLI.hpp>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
 #include "CliSupport.h"
 #include "Commands.h"
 #include "Progress.h"
 #include "RunRecord.h"
-
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
@@ -14,17 +23,6 @@
 #include "pneuma/sim/pattern/PatternController.h"
 #include "viz/AtomicFile.h"
 #include "viz/VtkSeriesWriter.h"
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
-#include <charconv>
-#include <cmath>
-#include <cstdio>
-#include <functional>
-#include <filesystem>
-#include <iostream>
-#include <memory>
 
 namespace pneuma::app {
 
@@ -37,16 +35,16 @@ namespace fs = std::filesystem;
 struct SimulateArgs {
   std::string model;
   std::string style, affect, scenario, pattern;
-  double duration = 0.0;    // [s]
+  double duration = 0.0;  // [s]
   std::string out;
   double outputRate = 0.0;  // [Hz]
   bool vtk = false;
-  bool force = false;       // replace an earlier run's results in `out`
+  bool force = false;  // replace an earlier run's results in `out`
   std::uint64_t seed = 0;
   std::string integrator;
   std::string posture;
-  double dt = 0.0;          // [s]
-  double settle = 0.0;      // [s]
+  double dt = 0.0;      // [s]
+  double settle = 0.0;  // [s]
   std::function<bool(const char*)> isGiven;
 };
 
@@ -71,7 +69,8 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
     checkOption(sim::kDurationRange, "--duration", a.duration);
     s.duration = a.duration;
   }
-  if (a.scenario.empty() && !a.isGiven("--duration")) fail(kExitBadInput, "--duration is required (simulated seconds)");
+  if (a.scenario.empty() && !a.isGiven("--duration"))
+    fail(kExitBadInput, "--duration is required (simulated seconds)");
   if (a.isGiven("--output-rate")) {
     checkOption(sim::kOutputRateRange, "--output-rate", a.outputRate);
     s.options.outputRate = a.outputRate;
@@ -98,10 +97,11 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
 
 void runSimulate(const SimulateArgs& args) {
   const sim::Scenario scenario = scenarioFromArgs(args);
-  const std::string modelDir =
-      resolveModelDir(!args.model.empty() ? args.model : scenario.model == "default" ? "" : scenario.model);
-  prepareOutputDir(args.out, "simulate", {"summary.json", "timeseries.csv", "frames.pvd", "frames", "*.png", "*.svg"},
-                   args.force);
+  const std::string modelDir = resolveModelDir(!args.model.empty()           ? args.model
+                                               : scenario.model == "default" ? ""
+                                                                             : scenario.model);
+  prepareOutputDir(args.out, "simulate",
+                   {"summary.json", "timeseries.csv", "frames.pvd", "frames", "*.png", "*.svg"}, args.force);
 
   // Ctrl-C from here on: the first stops within one step (the drive calibration too) and the outputs are
   // still written; a second ends the process at once (InterruptGuard)
@@ -130,9 +130,11 @@ void runSimulate(const SimulateArgs& args) {
   } catch (const sim::Error& e) {
     // a controller given on the command line is named by its flag, not by its scenario-file path
     std::string message = e.what();
-    const std::string field = std::string("controller.") + sim::controllerKindName(scenario.controller) + ": ";
+    const std::string field =
+        std::string("controller.") + sim::controllerKindName(scenario.controller) + ": ";
     if (args.scenario.empty() && message.rfind(field, 0) == 0)
-      message = std::string("--") + sim::controllerKindName(scenario.controller) + ": " + message.substr(field.size());
+      message = std::string("--") + sim::controllerKindName(scenario.controller) + ": " +
+                message.substr(field.size());
     fail(kExitBadInput, message);
   }
   const bool hasTarget = scenario.controller != sim::ControllerKind::Style;
@@ -166,8 +168,10 @@ void runSimulate(const SimulateArgs& args) {
     try {
       simulation->advance(total, [&](const sim::Simulation& s) {
         const auto* pattern = dynamic_cast<const sim::pattern::PatternController*>(&s.controller());
-        if (pattern != nullptr) record.append(s.latestMetrics(), pattern->targetFraction(), pattern->measuredFraction());
-        else record.append(s.latestMetrics());
+        if (pattern != nullptr)
+          record.append(s.latestMetrics(), pattern->targetFraction(), pattern->measuredFraction());
+        else
+          record.append(s.latestMetrics());
         if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());
         bar.update(s.state().time);
         return true;
@@ -232,8 +236,10 @@ void runSimulate(const SimulateArgs& args) {
   // the lungs' parts at end-expiration: the right/left split of the latest frame, the constant mediastinum
   const sim::Metrics* latest = ran ? &simulation->latestMetrics() : nullptr;
   const double rightShare = latest != nullptr ? latest->rightLungVolume / latest->lungVolume : sim::kNaN;
-  j["end_expiratory_right_lung_volume_ml"] = breathed ? jsonNumber(sum.endExpiratoryVolume * rightShare * 1e6) : none;
-  j["end_expiratory_left_lung_volume_ml"] = breathed ? jsonNumber(sum.endExpiratoryVolume * (1.0 - rightShare) * 1e6) : none;
+  j["end_expiratory_right_lung_volume_ml"] =
+      breathed ? jsonNumber(sum.endExpiratoryVolume * rightShare * 1e6) : none;
+  j["end_expiratory_left_lung_volume_ml"] =
+      breathed ? jsonNumber(sum.endExpiratoryVolume * (1.0 - rightShare) * 1e6) : none;
   j["end_expiratory_thoracic_cavity_volume_ml"] =
       breathed ? jsonNumber((sum.endExpiratoryVolume + model->lungs.mediastinumVolume) * 1e6) : none;
   j["max_gut_volume_error_pct"] = ran ? jsonNumber(sum.maxGutVolumeError * 100.0) : none;
@@ -279,10 +285,13 @@ void runSimulate(const SimulateArgs& args) {
 
 void addSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  CLI::App* cmd = app.add_subcommand("simulate", "Simulate breathing; write timeseries.csv, summary.json and plots");
+  CLI::App* cmd =
+      app.add_subcommand("simulate", "Simulate breathing; write timeseries.csv, summary.json and plots");
   addModelOption(*cmd, args->model);
-  auto* style = cmd->add_option("--style", args->style, "Breath style preset (calm, deep, panting, forced-exhale)");
-  auto* affect = cmd->add_option("--affect", args->affect, "Affect preset (neutral, startle, ... see docs/cli.md)");
+  auto* style =
+      cmd->add_option("--style", args->style, "Breath style preset (calm, deep, panting, forced-exhale)");
+  auto* affect =
+      cmd->add_option("--affect", args->affect, "Affect preset (neutral, startle, ... see docs/cli.md)");
   cmd->add_option("--scenario", args->scenario, "Scenario file (JSON); other options override it");
   auto* pattern = cmd->add_option("--pattern", args->pattern, "Pattern file (JSON, docs/patterns.md)");
   style->excludes(affect)->excludes(pattern);
@@ -290,7 +299,8 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_option("--duration", args->duration, "Simulated seconds after the settling phase (> 0)");
   cmd->add_option("--out", args->out, "Output directory (created if missing)")->required();
   cmd->add_flag("--force", args->force, "Replace the results of an earlier run in --out");
-  cmd->add_option("--output-rate", args->outputRate, "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
+  cmd->add_option("--output-rate", args->outputRate,
+                  "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
   cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
   // digits only and in range: CLI11 would read -1 as 2^64 - 1 and saturate 2^64
   cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams, 0 to 2^64 - 1 (default 0)")
@@ -299,14 +309,16 @@ void addSimulateCommand(CLI::App& app) {
             std::uint64_t x = 0;
             const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
             const bool ok = !v.empty() && v[0] != '-' && ec == std::errc() && end == v.data() + v.size();
-            return ok ? std::string() : "must be an integer in [0, 18446744073709551615], got " + v.substr(0, 60);
+            return ok ? std::string()
+                      : "must be an integer in [0, 18446744073709551615], got " + v.substr(0, 60);
           },
           "UINT64"));
   addIntegratorOption(*cmd, args->integrator);
   addPostureOption(*cmd, args->posture);
-  cmd->add_option("--dt", args->dt,
-                  "Time step [s] (default: the integrator's, 1/60 s for implicit-euler-joints; 10 ms for affect and "
-                  "pattern runs)");
+  cmd->add_option(
+      "--dt", args->dt,
+      "Time step [s] (default: the integrator's, 1/60 s for implicit-euler-joints; 10 ms for affect and "
+      "pattern runs)");
   cmd->add_option("--settle", args->settle, "Settling time before the controller starts [s] (default 2)");
   args->isGiven = [cmd](const char* flag) { return cmd->count(flag) > 0; };
   cmd->callback([args] { runSimulate(*args); });

@@ -2,26 +2,24 @@
 /// `pneuma-cli validate`: reruns the papers' experiments (sim/Experiments.h) on a model and writes
 /// report.html (self-contained, plots embedded), report.md and report.json. Exit 0 iff every check passes.
 
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
 #include "CliSupport.h"
 #include "Commands.h"
-
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Experiments.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
 #include "viz/AtomicFile.h"
 #include "viz/Plot.h"
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
-#include <chrono>
-#include <cstring>
-#include <cstdio>
-#include <filesystem>
-#include <memory>
-#include <optional>
-#include <sstream>
 
 namespace pneuma::app {
 
@@ -40,7 +38,7 @@ struct ValidateArgs {
 
 /// A figure of the report: its plot and a caption.
 struct Figure {
-  std::string stem;     // file name without extension
+  std::string stem;  // file name without extension
   std::string caption;
   viz::Plot plot;
 };
@@ -50,7 +48,8 @@ std::string base64(const std::vector<unsigned char>& bytes) {
   std::string out;
   out.reserve((bytes.size() + 2) / 3 * 4);
   for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const unsigned v = (bytes[i] << 16) | (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0) | (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+    const unsigned v = (bytes[i] << 16) | (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0) |
+                       (i + 2 < bytes.size() ? bytes[i + 2] : 0);
     out += table[(v >> 18) & 63];
     out += table[(v >> 12) & 63];
     out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
@@ -77,8 +76,8 @@ viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
   double base = 0.0;
   for (const sim::StyleRun& r : runs)
     if (r.style.name == "calm") base = r.summary.endExpiratoryVolume;
-  viz::Plot plot("Lung volume of the breath styles (cf. Zordan et al. 2004, Fig. 6)", "time since settling [s]",
-                 "volume above calm end-expiration [mL]");
+  viz::Plot plot("Lung volume of the breath styles (cf. Zordan et al. 2004, Fig. 6)",
+                 "time since settling [s]", "volume above calm end-expiration [mL]");
   for (const sim::StyleRun& r : runs) {
     std::vector<double> t, v;
     for (std::size_t i = 0; i < r.trace.size(); ++i)
@@ -94,7 +93,8 @@ viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
 
 void runValidate(const ValidateArgs& args) {
   const std::string modelDir = resolveModelDir(args.model);
-  prepareOutputDir(args.out, "validate", {"report.json", "report.md", "report.html", "*.png", "*.svg"}, args.force);
+  prepareOutputDir(args.out, "validate", {"report.json", "report.md", "report.html", "*.png", "*.svg"},
+                   args.force);
   sim::ExperimentSettings settings;
   if (args.isQuick) {
     settings.simulation.settleTime = 1.0;
@@ -119,7 +119,8 @@ void runValidate(const ValidateArgs& args) {
   // the experiments; a blow-up fails the run (exit 1) with the simulator's diagnosis
   const auto wallStart = std::chrono::steady_clock::now();
   auto progress = [](const std::string& what) { std::fprintf(stderr, "validate: %s\n", what.c_str()); };
-  // an experiment that blows up becomes a failing check carrying the simulator's diagnosis; the others still run
+  // an experiment that blows up becomes a failing check carrying the simulator's diagnosis; the others still
+  // run
   std::vector<sim::StyleRun> runs;
   std::vector<sim::Check> blowUps;
   auto attempt = [&](const std::string& id, const std::string& what, auto&& experiment) {
@@ -142,16 +143,20 @@ void runValidate(const ValidateArgs& args) {
     }
   };
   for (const sim::BreathStyle& s : styles)
-    attempt(s.name, "breath style '" + s.name + "'", [&] { runs.push_back(sim::runBreathStyle(model, s, settings)); });
+    attempt(s.name, "breath style '" + s.name + "'",
+            [&] { runs.push_back(sim::runBreathStyle(model, s, settings)); });
   sim::StyleRun deepFrictionless;
   const sim::StyleRun* deep = nullptr;
   for (const sim::StyleRun& r : runs) deep = r.style.name == "deep" ? &r : deep;
-  const bool hasSway = deep != nullptr && attempt("sway", "deep breathing without joint friction (spine sway)", [&] {
-    deepFrictionless = sim::runBreathStyle(model, deep->style, settings, 0.0);
-  });
+  const bool hasSway =
+      deep != nullptr && attempt("sway", "deep breathing without joint friction (spine sway)", [&] {
+        deepFrictionless = sim::runBreathStyle(model, deep->style, settings, 0.0);
+      });
   sim::ImpactRun impact;
-  const bool hasImpact = attempt("impact", "heavy impact", [&] { impact = sim::runHeavyImpact(model, settings); });
-  const double wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+  const bool hasImpact =
+      attempt("impact", "heavy impact", [&] { impact = sim::runHeavyImpact(model, settings); });
+  const double wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
 
   std::vector<sim::Check> checks = blowUps;
   for (const sim::Check& c : sim::breathStyleChecks(runs)) checks.push_back(c);
@@ -161,14 +166,18 @@ void runValidate(const ValidateArgs& args) {
     for (const sim::Check& c : sim::impactChecks(impact)) checks.push_back(c);
   int failed = 0;
   for (const sim::Check& c : checks) failed += !c.isPassed();
-  // physiology: the motion against published ranges, reported beside the papers' checks (not in the exit status)
+  // physiology: the motion against published ranges, reported beside the papers' checks (not in the exit
+  // status)
   const std::vector<sim::Check> physiology = sim::physiologyChecks(runs);
   int within = 0;
   for (const sim::Check& c : physiology) within += c.isPassed();
 
   // figures
   std::vector<Figure> figures;
-  figures.push_back({"figure6_lung_volume", "Lung volume of the four breath styles; dashed: the 500 mL calm tidal volume of Figure 6.", figure6(runs)});
+  figures.push_back(
+      {"figure6_lung_volume",
+       "Lung volume of the four breath styles; dashed: the 500 mL calm tidal volume of Figure 6.",
+       figure6(runs)});
   if (hasSway) {
     viz::Plot p("Spine sway during deep breathing (cf. Sec. 5)", "time [s]",
                 "anterior position of " + deep->spineBody + " [mm]");
@@ -177,18 +186,24 @@ void runValidate(const ValidateArgs& args) {
       for (const Eigen::Vector3d& p3 : r->spineTop) y.push_back((p3.y() - r->spineTop.front().y()) * 1e3);
       p.addSeries(r->frictionScale > 0.0 ? "with rib-joint friction" : "frictionless", r->trace.time, y);
     }
-    figures.push_back({"spine_sway", "Anterior-posterior position of the top thoracic segment during deep breathing, with and without rib-joint friction (Eq. 3), relative to the start.", p});
+    figures.push_back({"spine_sway",
+                       "Anterior-posterior position of the top thoracic segment during deep breathing, with "
+                       "and without rib-joint friction (Eq. 3), relative to the start.",
+                       p});
   }
   if (hasImpact) {
-    viz::Plot p("Gut volume error after a heavy impact (cf. Fig. 4)", "time after impact [s]", "gut volume error [%]");
+    viz::Plot p("Gut volume error after a heavy impact (cf. Fig. 4)", "time after impact [s]",
+                "gut volume error [%]");
     std::vector<double> e;
     for (double v : impact.gutVolumeError) e.push_back(v * 100.0);
     p.addSeries("gut volume error", impact.time, e);
     p.addReferenceLine("+0.5 % (Fig. 4)", 0.5);
     p.addReferenceLine("-0.5 %", -0.5, viz::Color{0.5, 0.5, 0.5});
-    figures.push_back({"impact_gut_volume_error", "Signed gut volume error after " + std::to_string(impact.struckNodes) +
-                                                      " wall nodes around the umbilicus are struck at " +
-                                                      number(settings.impactSpeed) + " m/s.", p});
+    figures.push_back({"impact_gut_volume_error",
+                       "Signed gut volume error after " + std::to_string(impact.struckNodes) +
+                           " wall nodes around the umbilicus are struck at " + number(settings.impactSpeed) +
+                           " m/s.",
+                       p});
   }
   for (const Figure& f : figures) {
     f.plot.writePng(args.out + "/" + f.stem + ".png");
@@ -208,17 +223,25 @@ void runValidate(const ValidateArgs& args) {
   using CheckList = std::pair<const char*, const std::vector<sim::Check>*>;
   for (const auto& [key, list] : {CheckList{"checks", &checks}, CheckList{"physiology", &physiology}})
     for (const sim::Check& c : *list)
-      j[key].push_back({{"id", c.id}, {"what", c.what}, {"target", c.target},
-                        {"measured", std::isfinite(c.measured) ? nlohmann::json(c.measured) : nlohmann::json(nullptr)},
-                        {"unit", c.unit}, {"lower", std::isfinite(c.lower) ? nlohmann::json(c.lower) : nlohmann::json(nullptr)},
-                        {"upper", std::isfinite(c.upper) ? nlohmann::json(c.upper) : nlohmann::json(nullptr)},
-                        {"passed", c.isPassed()}, {"source", c.source}});
+      j[key].push_back(
+          {{"id", c.id},
+           {"what", c.what},
+           {"target", c.target},
+           {"measured", std::isfinite(c.measured) ? nlohmann::json(c.measured) : nlohmann::json(nullptr)},
+           {"unit", c.unit},
+           {"lower", std::isfinite(c.lower) ? nlohmann::json(c.lower) : nlohmann::json(nullptr)},
+           {"upper", std::isfinite(c.upper) ? nlohmann::json(c.upper) : nlohmann::json(nullptr)},
+           {"passed", c.isPassed()},
+           {"source", c.source}});
   j["physiology_within"] = within;
   for (const sim::StyleRun& r : runs) {
     nlohmann::json& style = j["styles"][r.style.name];
     // as in summary.json, the breath figures are null when no full breath was found (a forced exhale)
-    const auto breath = [&](double v) { return r.summary.cycles > 0 ? jsonNumber(v) : nlohmann::json(nullptr); };
-    style = {{"tidal_volume_ml", breath(r.summary.tidalVolume * 1e6)}, {"breaths_per_minute", breath(r.summary.breathsPerMinute)},
+    const auto breath = [&](double v) {
+      return r.summary.cycles > 0 ? jsonNumber(v) : nlohmann::json(nullptr);
+    };
+    style = {{"tidal_volume_ml", breath(r.summary.tidalVolume * 1e6)},
+             {"breaths_per_minute", breath(r.summary.breathsPerMinute)},
              {"end_expiratory_volume_ml", breath(r.summary.endExpiratoryVolume * 1e6)},
              {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
              {"real_time_factor", r.summary.realTimeFactor}};
@@ -229,53 +252,68 @@ void runValidate(const ValidateArgs& args) {
 
   // report.md and report.html share the table rows
   std::ostringstream md, html, table;
-  const std::string verdict = failed == 0 ? "all " + std::to_string(checks.size()) + " checks pass"
-                                          : std::to_string(failed) + " of " + std::to_string(checks.size()) + " checks fail";
+  const std::string verdict =
+      failed == 0 ? "all " + std::to_string(checks.size()) + " checks pass"
+                  : std::to_string(failed) + " of " + std::to_string(checks.size()) + " checks fail";
   md << "# Pneuma validation report\n\nModel `" << modelDir << "` (" << model->name << "), integrator "
      << sim::integratorName(settings.simulation.step.integrator) << (args.isQuick ? ", quick settings" : "")
      << ", pneuma " << PNEUMA_VERSION << ". Result: **" << verdict << "**.\n\n"
      << "| check | what | target | measured | result | source |\n|---|---|---|---|---|---|\n";
   for (const sim::Check& c : checks) {
-    md << "| " << c.id << " | " << c.what << " | " << c.target << " | " << number(c.measured) << " " << c.unit << " | "
-       << (c.isPassed() ? "pass" : "**FAIL**") << " | " << c.source << " |\n";
-    table << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id) << "</td><td>"
-          << htmlEscape(c.what) << "</td><td>" << htmlEscape(c.target) << "</td><td>" << number(c.measured) << " "
-          << htmlEscape(c.unit) << "</td><td>" << (c.isPassed() ? "pass" : "FAIL") << "</td><td>" << htmlEscape(c.source)
-          << "</td></tr>\n";
+    md << "| " << c.id << " | " << c.what << " | " << c.target << " | " << number(c.measured) << " " << c.unit
+       << " | " << (c.isPassed() ? "pass" : "**FAIL**") << " | " << c.source << " |\n";
+    table << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id)
+          << "</td><td>" << htmlEscape(c.what) << "</td><td>" << htmlEscape(c.target) << "</td><td>"
+          << number(c.measured) << " " << htmlEscape(c.unit) << "</td><td>"
+          << (c.isPassed() ? "pass" : "FAIL") << "</td><td>" << htmlEscape(c.source) << "</td></tr>\n";
   }
   md << "\n";
 
   // physiology: the motion next to published ranges
   std::ostringstream physMd, physHtml;
   for (const sim::Check& c : physiology) {
-    const std::string verdictText = !std::isfinite(c.measured) ? "n/a" : c.isPassed() ? "within" : "**outside**";
-    physMd << "| " << c.id << " | " << c.what << " | " << number(c.measured) << " " << c.unit << " | " << c.target << " | "
-           << verdictText << " | " << c.source << " |\n";
-    physHtml << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id) << "</td><td>"
-             << htmlEscape(c.what) << "</td><td>" << number(c.measured) << " " << htmlEscape(c.unit) << "</td><td>"
-             << htmlEscape(c.target) << "</td><td>" << (c.isPassed() ? "within" : "outside") << "</td><td>"
-             << htmlEscape(c.source) << "</td></tr>\n";
+    const std::string verdictText = !std::isfinite(c.measured) ? "n/a"
+                                    : c.isPassed()             ? "within"
+                                                               : "**outside**";
+    physMd << "| " << c.id << " | " << c.what << " | " << number(c.measured) << " " << c.unit << " | "
+           << c.target << " | " << verdictText << " | " << c.source << " |\n";
+    physHtml << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id)
+             << "</td><td>" << htmlEscape(c.what) << "</td><td>" << number(c.measured) << " "
+             << htmlEscape(c.unit) << "</td><td>" << htmlEscape(c.target) << "</td><td>"
+             << (c.isPassed() ? "within" : "outside") << "</td><td>" << htmlEscape(c.source)
+             << "</td></tr>\n";
   }
-  const std::string physIntro = "The breath's motion in anatomical axes (summary.json's motion fields) next to published "
-                                "physiology: " + std::to_string(within) + " of " + std::to_string(physiology.size()) +
-                                " within range. Reported beside the papers' checks; not part of the exit status.";
-  md << "## Physiology\n\n" << physIntro << "\n\n| check | what | measured | published | | source |\n|---|---|---|---|---|---|\n"
+  const std::string physIntro =
+      "The breath's motion in anatomical axes (summary.json's motion fields) next to published "
+      "physiology: " +
+      std::to_string(within) + " of " + std::to_string(physiology.size()) +
+      " within range. Reported beside the papers' checks; not part of the exit status.";
+  md << "## Physiology\n\n"
+     << physIntro << "\n\n| check | what | measured | published | | source |\n|---|---|---|---|---|---|\n"
      << physMd.str() << "\n";
-  for (const Figure& f : figures) md << "![" << f.caption << "](" << f.stem << ".png)\n\n" << f.caption << "\n\n";
-  html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Pneuma validation report</title>\n<style>"
-       << "body{font-family:sans-serif;max-width:1000px;margin:2em auto}table{border-collapse:collapse;font-size:14px}"
+  for (const Figure& f : figures)
+    md << "![" << f.caption << "](" << f.stem << ".png)\n\n" << f.caption << "\n\n";
+  html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Pneuma validation "
+          "report</title>\n<style>"
+       << "body{font-family:sans-serif;max-width:1000px;margin:2em "
+          "auto}table{border-collapse:collapse;font-size:14px}"
        << "td,th{border:1px solid #ccc;padding:4px 8px;text-align:left}tr.pass td:nth-child(5){color:#1a7f37}"
        << "tr.fail td:nth-child(5){color:#c00;font-weight:bold}img{max-width:100%}</style></head><body>\n"
-       << "<h1>Pneuma validation report</h1>\n<p>Model <code>" << htmlEscape(modelDir) << "</code> (" << htmlEscape(model->name)
-       << "), integrator " << sim::integratorName(settings.simulation.step.integrator) << (args.isQuick ? ", quick settings" : "")
+       << "<h1>Pneuma validation report</h1>\n<p>Model <code>" << htmlEscape(modelDir) << "</code> ("
+       << htmlEscape(model->name) << "), integrator "
+       << sim::integratorName(settings.simulation.step.integrator) << (args.isQuick ? ", quick settings" : "")
        << ", pneuma " << PNEUMA_VERSION << ". Result: <b>" << verdict << "</b>.</p>\n"
-       << "<table><tr><th>check</th><th>what</th><th>target</th><th>measured</th><th>result</th><th>source</th></tr>\n"
+       << "<table><tr><th>check</th><th>what</th><th>target</th><th>measured</th><th>result</th><th>source</"
+          "th></tr>\n"
        << table.str() << "</table>\n"
-       << "<h2>Physiology</h2>\n<p>" << htmlEscape(physIntro) << "</p>\n<table><tr><th>check</th><th>what</th><th>measured</th>"
-       << "<th>published</th><th></th><th>source</th></tr>\n" << physHtml.str() << "</table>\n";
+       << "<h2>Physiology</h2>\n<p>" << htmlEscape(physIntro)
+       << "</p>\n<table><tr><th>check</th><th>what</th><th>measured</th>"
+       << "<th>published</th><th></th><th>source</th></tr>\n"
+       << physHtml.str() << "</table>\n";
   for (const Figure& f : figures)
-    html << "<figure><img alt=\"" << htmlEscape(f.stem) << "\" src=\"data:image/png;base64," << base64(f.plot.toPng())
-         << "\"><figcaption>" << htmlEscape(f.caption) << "</figcaption></figure>\n";
+    html << "<figure><img alt=\"" << htmlEscape(f.stem) << "\" src=\"data:image/png;base64,"
+         << base64(f.plot.toPng()) << "\"><figcaption>" << htmlEscape(f.caption)
+         << "</figcaption></figure>\n";
   html << "</body></html>\n";
   viz::writeFileAtomically(args.out + "/report.md", md.str());
   viz::writeFileAtomically(args.out + "/report.html", html.str());
@@ -283,15 +321,16 @@ void runValidate(const ValidateArgs& args) {
   // the table on stdout
   std::printf("%-32s %-8s %-14s %s\n", "check", "result", "measured", "target");
   for (const sim::Check& c : checks)
-    std::printf("%-32s %-8s %-14s %s\n", c.id.c_str(), c.isPassed() ? "pass" : "FAIL", (number(c.measured) + " " + c.unit).c_str(),
-                c.target.c_str());
+    std::printf("%-32s %-8s %-14s %s\n", c.id.c_str(), c.isPassed() ? "pass" : "FAIL",
+                (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
   for (const sim::Check& c : blowUps) std::printf("  %s: %s\n", c.id.c_str(), c.what.c_str());
   std::printf("\n%-36s %-8s %-14s %s\n", "physiology", "range", "measured", "published");
   for (const sim::Check& c : physiology)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("physiology."), c.isPassed() ? "within" : "OUTSIDE",
-                (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
-  std::printf("%s; physiology: %d of %zu within published ranges; report: %s/report.html (%.0f s)\n", verdict.c_str(), within,
-              physiology.size(), args.out.c_str(), wallSeconds);
+    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("physiology."),
+                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
+                c.target.c_str());
+  std::printf("%s; physiology: %d of %zu within published ranges; report: %s/report.html (%.0f s)\n",
+              verdict.c_str(), within, physiology.size(), args.out.c_str(), wallSeconds);
   if (failed > 0) throw CLI::RuntimeError(kExitFailed);
 }
 
@@ -299,7 +338,8 @@ void runValidate(const ValidateArgs& args) {
 
 void addValidateCommand(CLI::App& app) {
   auto args = std::make_shared<ValidateArgs>();
-  CLI::App* cmd = app.add_subcommand("validate", "Rerun the papers' experiments; write report.html, report.md, report.json");
+  CLI::App* cmd = app.add_subcommand(
+      "validate", "Rerun the papers' experiments; write report.html, report.md, report.json");
   addModelOption(*cmd, args->model);
   cmd->add_option("--out", args->out, "Output directory (default: ./validation; created if missing)");
   cmd->add_flag("--force", args->force, "Replace an earlier report in --out");

@@ -4,14 +4,13 @@
 /// Exit codes: 0 success, 1 a check or run failed (e.g. `validate` with a failing check),
 /// 2 bad usage or bad input (unknown option, missing model, unwritable output, invalid scenario).
 
-#include "Commands.h"
-#include "ModelCommand.h"
-
 #include <CLI/CLI.hpp>
-
 #include <iostream>
 #include <memory>
 #include <string>
+
+#include "Commands.h"
+#include "ModelCommand.h"
 
 namespace {
 
@@ -38,7 +37,8 @@ int usageError(const CLI::App& app, const std::string& message) {
 int main(int argc, char** argv) {
   CLI::App app{"Pneuma headless: simulate breathing, export data and plots, validate against the papers.",
                "pneuma-cli"};
-  app.set_version_flag("--version", std::string("pneuma-cli ") + PNEUMA_VERSION, "Print the version and exit");
+  app.set_version_flag("--version", std::string("pneuma-cli ") + PNEUMA_VERSION,
+                       "Print the version and exit");
   pneuma::app::addSimulateCommand(app);
   pneuma::app::addScenarioCommand(app);
   pneuma::app::addValidateCommand(app);
@@ -58,4 +58,4 @@ int main(int argc, char** argv) {
   }
   if (app.get_subcommands().empty()) return usageError(app, "a subcommand is required");
   return 0;
-} 
+}

@@ -1,19 +1,20 @@
 #include "gui/DocumentController.h"
 
+#include <QDir>
+#include <QFileInfo>
+
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
 #include "viz/AtomicFile.h"
 
-#include <QDir>
-#include <QFileInfo>
-
 namespace pneuma::app {
 
 QString DocumentController::defaultModelDir() { return QString::fromStdString(sim::defaultModelDir()); }
 
-DocumentController::OpenedModel DocumentController::readModel(const QString& dir, const RunSettings& settings) {
+DocumentController::OpenedModel DocumentController::readModel(const QString& dir,
+                                                              const RunSettings& settings) {
   OpenedModel opened;
   opened.model = std::make_shared<const sim::Model>(sim::loadModel(dir.toStdString()));
   opened.simulation = std::make_unique<sim::Simulation>(
@@ -22,7 +23,8 @@ DocumentController::OpenedModel DocumentController::readModel(const QString& dir
   return opened;
 }
 
-DocumentController::OpenedScenario DocumentController::readScenario(const QString& path, const RunSettings& current) {
+DocumentController::OpenedScenario DocumentController::readScenario(const QString& path,
+                                                                    const RunSettings& current) {
   const sim::Scenario scenario = sim::loadScenario(path.toStdString());
   if (scenario.controller != sim::ControllerKind::Style)
     throw sim::Error(std::string("controller: the app plays breath styles; '") +

@@ -1,15 +1,15 @@
 #pragma once
 /// @file DocumentController.h
-/// What the window shows, as files: the open model (its directory) and the run settings' scenario files. Reading
-/// checks everything before anything changes: a model is loaded and a simulation of it made with the settings, a
-/// scenario's style and options are read, and only then does the caller adopt them. Saving writes a scenario that
-/// names an unedited style preset, or an edited style as its own preset file beside the scenario.
-
-#include "gui/SimWorker.h"
+/// What the window shows, as files: the open model (its directory) and the run settings' scenario files.
+/// Reading checks everything before anything changes: a model is loaded and a simulation of it made with the
+/// settings, a scenario's style and options are read, and only then does the caller adopt them. Saving writes
+/// a scenario that names an unedited style preset, or an edited style as its own preset file beside the
+/// scenario.
 
 #include <QString>
-
 #include <memory>
+
+#include "gui/SimWorker.h"
 
 namespace pneuma::app {
 
@@ -35,7 +35,8 @@ class DocumentController {
   /// Loads the model in `dir` and makes a simulation of it under `settings`.
   /// @throws std::exception naming the problem ("Cannot open model '<dir>': ...").
   static OpenedModel readModel(const QString& dir, const RunSettings& settings);
-  /// Reads the scenario at `path`: its breath style and options (recordSeconds kept from `current`), its model.
+  /// Reads the scenario at `path`: its breath style and options (recordSeconds kept from `current`), its
+  /// model.
   /// @throws std::exception naming the problem; the app plays breath-style scenarios only.
   static OpenedScenario readScenario(const QString& path, const RunSettings& current);
 
@@ -45,8 +46,8 @@ class DocumentController {
   /// Makes `opened` the document's model (its simulation is left to the caller).
   void adopt(const OpenedModel& opened);
 
-  /// Writes `settings` and the model as the scenario `path` (60 s, a breath style); an edited style goes beside
-  /// it as "<stem>.style.json". @throws std::exception naming the file.
+  /// Writes `settings` and the model as the scenario `path` (60 s, a breath style); an edited style goes
+  /// beside it as "<stem>.style.json". @throws std::exception naming the file.
   void saveScenario(const QString& path, const RunSettings& settings) const;
 
  private:

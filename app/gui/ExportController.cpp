@@ -1,10 +1,5 @@
 #include "gui/ExportController.h"
 
-#include "gui/PlotView.h"
-#include "gui/SimWorker.h"
-#include "viz/AtomicFile.h"
-#include "viz/MovieWriter.h"
-
 #include <QEventLoop>
 #include <QFile>
 #include <QFileInfo>
@@ -12,9 +7,13 @@
 #include <QPainter>
 #include <QPdfWriter>
 #include <QSvgRenderer>
-
 #include <cmath>
 #include <stdexcept>
+
+#include "gui/PlotView.h"
+#include "gui/SimWorker.h"
+#include "viz/AtomicFile.h"
+#include "viz/MovieWriter.h"
 
 namespace pneuma::app {
 
@@ -57,7 +56,8 @@ QString ExportController::exportPlot(const PlotView* plot, const QString& path) 
       }
       viz::commitTemporary(temp, path.toStdString());
     } else {
-      throw std::runtime_error("unknown plot format '." + suffix.toStdString() + "' (use .png, .svg, .pdf or .csv)");
+      throw std::runtime_error("unknown plot format '." + suffix.toStdString() +
+                               "' (use .png, .svg, .pdf or .csv)");
     }
   } catch (const std::exception& e) {
     return fail(QString("Cannot export plot to '%1': %2").arg(path, e.what()));
@@ -93,7 +93,8 @@ QString ExportController::exportAnimation(const QString& path, double from, doub
       QByteArray rows(3 * shot.width() * shot.height(), Qt::Uninitialized);
       for (int y = 0; y < shot.height(); ++y)
         std::copy_n(shot.constScanLine(y), 3 * shot.width(), rows.data() + 3 * shot.width() * y);
-      writer.writeFrame(reinterpret_cast<const unsigned char*>(rows.constData()), shot.width(), shot.height());
+      writer.writeFrame(reinterpret_cast<const unsigned char*>(rows.constData()), shot.width(),
+                        shot.height());
     }
     writer.finish();
   } catch (const std::exception& e) {

@@ -1,13 +1,12 @@
 #pragma once
 /// @file ExportController.h
-/// The app's exports: a plot as PNG, SVG, PDF or CSV; the 3D view as PNG; the recording as an Ogg Theora movie or
-/// a PNG sequence (viz::MovieWriter); the run as a ParaView series (written by the SimWorker). Each returns an empty
-/// string on success, else the error, and announces it with failed() or done(); every file is written through a
-/// temporary name, so a failed export leaves nothing.
+/// The app's exports: a plot as PNG, SVG, PDF or CSV; the 3D view as PNG; the recording as an Ogg Theora
+/// movie or a PNG sequence (viz::MovieWriter); the run as a ParaView series (written by the SimWorker). Each
+/// returns an empty string on success, else the error, and announces it with failed() or done(); every file
+/// is written through a temporary name, so a failed export leaves nothing.
 
 #include <QObject>
 #include <QString>
-
 #include <functional>
 
 class QImage;
@@ -21,8 +20,8 @@ class ExportController : public QObject {
   Q_OBJECT
 
  public:
-  /// What the exports need of the window: a grab of the 3D view as shown now, and a scrub of the recording to a
-  /// time [s] that returns once that instant is on screen (false when it did not come).
+  /// What the exports need of the window: a grab of the 3D view as shown now, and a scrub of the recording to
+  /// a time [s] that returns once that instant is on screen (false when it did not come).
   struct View {
     std::function<QImage()> grab;
     std::function<bool(double)> scrubTo;
@@ -36,8 +35,8 @@ class ExportController : public QObject {
   QString exportViewImage(const QString& path);
   /// Renders the recording from `from` to `to` [s] at `fps` [1/s]: an .ogv movie or a PNG sequence.
   QString exportAnimation(const QString& path, double from, double to, double fps);
-  /// Has `worker` write its recording as `pvdPath` plus a folder of .vtp frames (body meshes from `modelDir`);
-  /// blocks, processing events, until it is written.
+  /// Has `worker` write its recording as `pvdPath` plus a folder of .vtp frames (body meshes from
+  /// `modelDir`); blocks, processing events, until it is written.
   QString exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath);
 
  signals:

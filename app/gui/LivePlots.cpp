@@ -1,15 +1,14 @@
 #include "gui/LivePlots.h"
 
-#include "gui/PlotView.h"
-#include "viz/ModelScene.h"
-
 #include <QSplitter>
 #include <QVBoxLayout>
-
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <limits>
+
+#include "gui/PlotView.h"
+#include "viz/ModelScene.h"
 
 namespace pneuma::app {
 
@@ -18,11 +17,12 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kHistorySeconds = 120.0;  // [s] kept for the window and for picked traces
 constexpr double kSegmentSeconds = 6.0;    // [s] of history per segment
-constexpr std::size_t kSegmentBuckets = 512;  // MinMaxSeries buckets per segment: exact up to 512 / 6 s = 85 Hz
-constexpr double kForceRate = 60.0;        // [Hz] most element-force frames kept per simulated second
+constexpr std::size_t kSegmentBuckets =
+    512;                             // MinMaxSeries buckets per segment: exact up to 512 / 6 s = 85 Hz
+constexpr double kForceRate = 60.0;  // [Hz] most element-force frames kept per simulated second
 
-// the columns of a segment: time, lung volume [m^3], target volume [m^3], gut volume error [-], then r, alpha and
-// mean tension [N] of each muscle group
+// the columns of a segment: time, lung volume [m^3], target volume [m^3], gut volume error [-], then r, alpha
+// and mean tension [N] of each muscle group
 enum Column : std::size_t { kTime, kLung, kTarget, kGut, kFirstGroupColumn };
 constexpr std::size_t kColumnsPerGroup = 3;
 
@@ -30,7 +30,8 @@ const std::vector<sim::ElementGroup>& muscleGroups() {
   static const std::vector<sim::ElementGroup> groups = [] {
     std::vector<sim::ElementGroup> g;
     for (int i = 0; i < sim::kElementGroupCount; ++i)
-      if (sim::isMuscleGroup(static_cast<sim::ElementGroup>(i))) g.push_back(static_cast<sim::ElementGroup>(i));
+      if (sim::isMuscleGroup(static_cast<sim::ElementGroup>(i)))
+        g.push_back(static_cast<sim::ElementGroup>(i));
     return g;
   }();
   return groups;
@@ -39,12 +40,18 @@ const std::vector<sim::ElementGroup>& muscleGroups() {
 // short legend names of the muscle groups
 QString shortLabel(sim::ElementGroup g) {
   switch (g) {
-    case sim::ElementGroup::IntercostalExternal: return "ext. intercostals";
-    case sim::ElementGroup::IntercostalInternal: return "int. intercostals";
-    case sim::ElementGroup::Diaphragm: return "diaphragm";
-    case sim::ElementGroup::Rectus: return "rectus";
-    case sim::ElementGroup::TransversusObliques: return "transv./obliques";
-    default: return viz::groupLabel(g);
+    case sim::ElementGroup::IntercostalExternal:
+      return "ext. intercostals";
+    case sim::ElementGroup::IntercostalInternal:
+      return "int. intercostals";
+    case sim::ElementGroup::Diaphragm:
+      return "diaphragm";
+    case sim::ElementGroup::Rectus:
+      return "rectus";
+    case sim::ElementGroup::TransversusObliques:
+      return "transv./obliques";
+    default:
+      return viz::groupLabel(g);
   }
 }
 
@@ -90,12 +97,14 @@ void LivePlots::append(std::vector<PlotSample> samples) {
   m_isDirty = true;
   // forget what lies beyond the history (the newest segment and force frame always stay)
   const double from = m_latest.time - kHistorySeconds;
-  while (m_segments.size() > 1 && m_segments.front().columns[kTime].buckets().back().vMax < from) m_segments.pop_front();
+  while (m_segments.size() > 1 && m_segments.front().columns[kTime].buckets().back().vMax < from)
+    m_segments.pop_front();
   while (m_forces.size() > 1 && m_forces[1].time <= from) m_forces.pop_front();
 }
 
 void LivePlots::appendSample(const PlotSample& s) {
-  if (m_segments.empty() || s.time - m_segments.back().columns[kTime].buckets().front().tMin >= kSegmentSeconds) {
+  if (m_segments.empty() ||
+      s.time - m_segments.back().columns[kTime].buckets().front().tMin >= kSegmentSeconds) {
     const std::size_t columnCount = kFirstGroupColumn + kColumnsPerGroup * muscleGroups().size();
     m_segments.push_back({std::vector<viz::MinMaxSeries>(columnCount, viz::MinMaxSeries(kSegmentBuckets))});
   }
@@ -112,7 +121,8 @@ void LivePlots::appendSample(const PlotSample& s) {
     c[k++].append(s.time, s.groupMeanTension[i]);
   }
   // element forces for the picked traces, at most kForceRate frames per simulated second
-  if (!s.elementForce.empty() && (m_forces.empty() || s.time >= m_forces.back().time + (1.0 - 1e-6) / kForceRate))
+  if (!s.elementForce.empty() &&
+      (m_forces.empty() || s.time >= m_forces.back().time + (1.0 - 1e-6) / kForceRate))
     m_forces.push_back({s.time, s.elementForce});
 }
 
@@ -157,9 +167,10 @@ bool LivePlots::refresh() {
   if (!m_isDirty) return false;
   m_isDirty = false;
 
-  // the shown window as a table: per bucket its first and last sample time, and each column's minimum and maximum
-  // in the order they occurred (a bucket of one sample gives one row)
-  const double from = m_hasLatest && m_window > 0.0 ? m_latest.time - m_window : -std::numeric_limits<double>::infinity();
+  // the shown window as a table: per bucket its first and last sample time, and each column's minimum and
+  // maximum in the order they occurred (a bucket of one sample gives one row)
+  const double from =
+      m_hasLatest && m_window > 0.0 ? m_latest.time - m_window : -std::numeric_limits<double>::infinity();
   std::vector<double> time;
   std::vector<std::vector<double>> columns(m_segments.empty() ? 0 : m_segments.front().columns.size());
   for (const Segment& seg : m_segments) {
@@ -185,7 +196,8 @@ bool LivePlots::refresh() {
   };
 
   // lung volume [mL], with the affect pattern's target when one plays
-  std::vector<PlotView::Series> volume{{"lung volume", QColor(20, 90, 190), false, column(kLung, 1e6), QString()}};
+  std::vector<PlotView::Series> volume{
+      {"lung volume", QColor(20, 90, 190), false, column(kLung, 1e6), QString()}};
   std::vector<double> target = column(kTarget, 1e6);
   if (std::any_of(target.begin(), target.end(), [](double v) { return std::isfinite(v); })) {
     volume[0].legend = "simulated";
@@ -197,13 +209,16 @@ bool LivePlots::refresh() {
   if (n > 0) {
     note = QString("lungs %1 mL").arg(1e6 * m_latest.lungVolume, 0, 'f', 0);
     if (std::isfinite(m_latest.rightLungVolume))
-      note += QString(" (R %1 L %2)").arg(1e6 * m_latest.rightLungVolume, 0, 'f', 0).arg(1e6 * m_latest.leftLungVolume, 0, 'f', 0);
+      note += QString(" (R %1 L %2)")
+                  .arg(1e6 * m_latest.rightLungVolume, 0, 'f', 0)
+                  .arg(1e6 * m_latest.leftLungVolume, 0, 'f', 0);
     note += QString("  VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
   }
   m_plots[0]->setNote(note);
 
   // gut volume error [%]
-  m_plots[1]->setData(time, {{"gut volume error", QColor(120, 40, 160), false, column(kGut, 100.0), QString()}});
+  m_plots[1]->setData(time,
+                      {{"gut volume error", QColor(120, 40, 160), false, column(kGut, 100.0), QString()}});
   if (n > 0) m_plots[1]->setNote(QString("now %1 %").arg(100.0 * m_latest.gutVolumeError, 0, 'f', 3));
 
   // activations r and alpha, and mean tension, of the muscle groups
@@ -224,7 +239,9 @@ bool LivePlots::refresh() {
     std::vector<double> y(n, kNaN);
     auto frame = m_forces.begin();
     for (std::size_t k = 0; k < n; ++k) {
-      while (frame != m_forces.end() && std::next(frame) != m_forces.end() && std::next(frame)->time <= time[k]) ++frame;
+      while (frame != m_forces.end() && std::next(frame) != m_forces.end() &&
+             std::next(frame)->time <= time[k])
+        ++frame;
       if (frame == m_forces.end() || frame->time > time[k]) continue;
       double sum = 0.0;
       for (int e : t.elements)

@@ -4,20 +4,19 @@
 ///  1. lung-cavity volume [mL] with the current tidal volume;
 ///  2. gut volume error [%] with the 0.5 % and 2 % bands;
 ///  3. activations r (solid) and alpha (dashed) per muscle group [-];
-///  4. mean tension per element of each muscle group [N], plus the force trace of each picked element or body.
-/// Memory is bounded whatever the output rate and run length: the last kHistorySeconds are kept in segments whose
-/// quantities are thinned by viz::MinMaxSeries (every peak and trough kept; exact up to kSegmentBuckets samples
-/// per segment, i.e. up to about 85 Hz), and the element forces behind the picked traces at most kForceRate
-/// times per simulated second.
-
-#include "gui/SimWorker.h"
+///  4. mean tension per element of each muscle group [N], plus the force trace of each picked element or
+///  body.
+/// Memory is bounded whatever the output rate and run length: the last kHistorySeconds are kept in segments
+/// whose quantities are thinned by viz::MinMaxSeries (every peak and trough kept; exact up to kSegmentBuckets
+/// samples per segment, i.e. up to about 85 Hz), and the element forces behind the picked traces at most
+/// kForceRate times per simulated second.
 
 #include <QWidget>
-
-#include "viz/MinMaxSeries.h"
-
 #include <deque>
 #include <vector>
+
+#include "gui/SimWorker.h"
+#include "viz/MinMaxSeries.h"
 
 namespace pneuma::app {
 
@@ -74,7 +73,7 @@ class LivePlots : public QWidget {
 
   std::deque<Segment> m_segments;
   std::deque<ForceFrame> m_forces;
-  PlotSample m_latest;          // the newest sample (for the notes)
+  PlotSample m_latest;  // the newest sample (for the notes)
   bool m_hasLatest = false;
   std::vector<PlotView*> m_plots;
   std::vector<Trace> m_traces;

@@ -1,13 +1,8 @@
 #include "gui/MainWindow.h"
 
-#include "gui/DocumentController.h"
-#include "gui/ExportController.h"
-#include "gui/LivePlots.h"
-#include "gui/ParameterPanel.h"
-#include "gui/PlotView.h"
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Resources.h"
-#include "pneuma/sim/pattern/Pattern.h"
+#include <QVTKOpenGLNativeWidget.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkRenderer.h>
 
 #include <QAction>
 #include <QApplication>
@@ -37,12 +32,17 @@
 #include <QTimer>
 #include <QToolBar>
 #include <QVBoxLayout>
-#include <QVTKOpenGLNativeWidget.h>
-#include <vtkGenericOpenGLRenderWindow.h>
-#include <vtkRenderer.h>
-
 #include <cmath>
 #include <cstdio>
+
+#include "gui/DocumentController.h"
+#include "gui/ExportController.h"
+#include "gui/LivePlots.h"
+#include "gui/ParameterPanel.h"
+#include "gui/PlotView.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Resources.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 namespace pneuma::app {
 
@@ -72,16 +72,19 @@ const std::vector<std::pair<const char*, viz::GutColouring>> kGutColourings{
     {"Pressure [Pa]", viz::GutColouring::Pressure},
     {"Displacement [mm]", viz::GutColouring::Displacement}};
 const std::vector<std::pair<const char*, sim::pattern::SwitchMode>> kAffectModes{
-    {"at end of cycle", sim::pattern::SwitchMode::EndOfCycle}, {"immediately", sim::pattern::SwitchMode::Immediate}};
+    {"at end of cycle", sim::pattern::SwitchMode::EndOfCycle},
+    {"immediately", sim::pattern::SwitchMode::Immediate}};
 
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make_unique<viz::ModelScene>()) {
   setWindowTitle("Pneuma");
   resize(1280, 800);
-  m_export = new ExportController({[this] { return grabView(); }, [this](double t) { return scrubTo(t); }}, this);
+  m_export =
+      new ExportController({[this] { return grabView(); }, [this](double t) { return scrubTo(t); }}, this);
   connect(m_export, &ExportController::failed, this, &MainWindow::report);
-  connect(m_export, &ExportController::done, this, [this](const QString& message) { showMessage(message, 5000); });
+  connect(m_export, &ExportController::done, this,
+          [this](const QString& message) { showMessage(message, 5000); });
 
   // centre: the 3D view over the timeline
   auto* centre = new QWidget(this);
@@ -128,8 +131,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
   for (const std::string& s : styles) m_styleCombo->addItem(QString::fromStdString(s));
   m_settings.options.recordSeconds = kRecordSeconds;
   try {
-    m_settings.style = sim::loadBreathStyle(styles.empty() || std::find(styles.begin(), styles.end(), "calm") != styles.end()
-                                                ? "calm" : styles.front());
+    m_settings.style = sim::loadBreathStyle(
+        styles.empty() || std::find(styles.begin(), styles.end(), "calm") != styles.end() ? "calm"
+                                                                                          : styles.front());
   } catch (const sim::Error& e) {
     m_settings.style.name = "default";
     showMessage(QString("Breath-style presets not found (%1); using built-in defaults").arg(e.what()), 10000);
@@ -178,18 +182,26 @@ void MainWindow::buildTimeline(QWidget* centre) {
 void MainWindow::buildActions() {
   // file menu
   QMenu* file = menuBar()->addMenu("&File");
-  file->addAction("&Open model directory\u2026", this, [this] {
-    const QString dir = QFileDialog::getExistingDirectory(this, "Open model directory", m_document.modelDir());
-    if (!dir.isEmpty()) openModel(dir);
-  }, QKeySequence::Open);
+  file->addAction(
+      "&Open model directory\u2026", this,
+      [this] {
+        const QString dir =
+            QFileDialog::getExistingDirectory(this, "Open model directory", m_document.modelDir());
+        if (!dir.isEmpty()) openModel(dir);
+      },
+      QKeySequence::Open);
   file->addAction("Open &scenario\u2026", this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, "Open scenario", QString(), "Scenario (*.json)");
     if (!path.isEmpty()) openScenario(path);
   });
-  file->addAction("Sa&ve scenario\u2026", this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, "Save scenario", "scenario.json", "Scenario (*.json)");
-    if (!path.isEmpty()) saveScenario(path);
-  }, QKeySequence::Save);
+  file->addAction(
+      "Sa&ve scenario\u2026", this,
+      [this] {
+        const QString path =
+            QFileDialog::getSaveFileName(this, "Save scenario", "scenario.json", "Scenario (*.json)");
+        if (!path.isEmpty()) saveScenario(path);
+      },
+      QKeySequence::Save);
   file->addSeparator();
   QMenu* exportMenu = file->addMenu("&Export");
   for (PlotView* plot : m_plots->plots())
@@ -197,7 +209,8 @@ void MainWindow::buildActions() {
                           [this, plot] { exportPlotInteractive(plot); });
   exportMenu->addSeparator();
   exportMenu->addAction("3D view as PNG\u2026", this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, "Export 3D view", "view.png", "PNG image (*.png)");
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Export 3D view", "view.png", "PNG image (*.png)");
     if (!path.isEmpty()) exportViewImage(path);
   });
   exportMenu->addAction("Animation of the recording\u2026", this, [this] {
@@ -249,7 +262,8 @@ void MainWindow::buildActions() {
   tools->addWidget(new QLabel(" Breath style ", this));
   m_styleCombo = new QComboBox(this);
   m_styleCombo->setMinimumWidth(130);
-  connect(m_styleCombo, &QComboBox::textActivated, this, [this](const QString& name) { setBreathStyle(name); });
+  connect(m_styleCombo, &QComboBox::textActivated, this,
+          [this](const QString& name) { setBreathStyle(name); });
   tools->addWidget(m_styleCombo);
   tools->addSeparator();
   tools->addWidget(new QLabel(" Affect ", this));
@@ -257,19 +271,19 @@ void MainWindow::buildActions() {
   m_affectCombo->setToolTip("Respiration pattern of an affective state (de Melo et al. 2010)");
   for (const std::string& a : sim::pattern::listAffects(sim::resourceDir()))
     m_affectCombo->addItem(QString::fromStdString(a));
-  m_affectCombo->setCurrentText("neutral");  // nothing is pushed yet: offer neutral, not the first in the list (anger)
+  m_affectCombo->setCurrentText(
+      "neutral");  // nothing is pushed yet: offer neutral, not the first in the list (anger)
   tools->addWidget(m_affectCombo);
   m_affectMode = new QComboBox(this);
   for (const auto& [label, mode] : kAffectModes) m_affectMode->addItem(label, static_cast<int>(mode));
   tools->addWidget(m_affectMode);
   QAction* push = tools->addAction("Push");
   push->setToolTip("Push the affect's respiration layers onto the pattern stack");
-  connect(push, &QAction::triggered, this,
-          [this] {
-            pushAffect(m_affectCombo->currentText(),
-                       static_cast<sim::pattern::SwitchMode>(m_affectMode->currentData().toInt()) ==
-                           sim::pattern::SwitchMode::Immediate);
-          });
+  connect(push, &QAction::triggered, this, [this] {
+    pushAffect(m_affectCombo->currentText(),
+               static_cast<sim::pattern::SwitchMode>(m_affectMode->currentData().toInt()) ==
+                   sim::pattern::SwitchMode::Immediate);
+  });
   // camera presets: the View menu and the buttons above the display options
   QMenu* view = menuBar()->addMenu("&View");
   for (QPushButton* button : m_cameraButtons) {
@@ -288,7 +302,8 @@ void MainWindow::buildDocks() {
   for (PlotView* plot : m_plots->plots())
     connect(plot, &PlotView::contextMenuRequested, this, [this, plot](const QPoint& at) {
       QMenu menu;
-      menu.addAction("Export plot (PNG, SVG, PDF, CSV)\u2026", this, [this, plot] { exportPlotInteractive(plot); });
+      menu.addAction("Export plot (PNG, SVG, PDF, CSV)\u2026", this,
+                     [this, plot] { exportPlotInteractive(plot); });
       menu.exec(at);
     });
   auto* plotDock = new QDockWidget("Live plots", this);
@@ -322,9 +337,11 @@ void MainWindow::buildDocks() {
   auto* colouring = new QGroupBox("Colouring", display);
   auto* colourForm = new QFormLayout(colouring);
   m_muscleColour = new QComboBox(colouring);
-  for (const auto& [label, colouring] : kMuscleColourings) m_muscleColour->addItem(label, static_cast<int>(colouring));
+  for (const auto& [label, colouring] : kMuscleColourings)
+    m_muscleColour->addItem(label, static_cast<int>(colouring));
   m_gutColour = new QComboBox(colouring);
-  for (const auto& [label, colouring] : kGutColourings) m_gutColour->addItem(label, static_cast<int>(colouring));
+  for (const auto& [label, colouring] : kGutColourings)
+    m_gutColour->addItem(label, static_cast<int>(colouring));
   colourForm->addRow("Muscles", m_muscleColour);
   colourForm->addRow("Gut", m_gutColour);
   displayLayout->addWidget(colouring);
@@ -483,7 +500,8 @@ QString MainWindow::openModel(const QString& dir) {
     connect(&m_thread, &QThread::started, m_worker, &SimWorker::start);
     connect(&m_thread, &QThread::finished, m_worker, &SimWorker::stop);
     connect(&m_thread, &QThread::finished, m_worker, &QObject::deleteLater);
-    connect(m_worker, &SimWorker::status, this, [this](const QString& message) { showMessage(message, 8000); });
+    connect(m_worker, &SimWorker::status, this,
+            [this](const QString& message) { showMessage(message, 8000); });
     connect(m_worker, &SimWorker::failed, this, [this](const QString& message) {
       m_playAction->setChecked(false);
       report("Simulation stopped", message);
@@ -568,9 +586,11 @@ QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
   }
   m_affectCombo->setCurrentText(name);
   if (!m_worker) return "no model is open";
-  m_worker->requestAffect(name.toStdString(),
-                          isImmediate ? sim::pattern::SwitchMode::Immediate : sim::pattern::SwitchMode::EndOfCycle);
-  showMessage(QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"), 5000);
+  m_worker->requestAffect(name.toStdString(), isImmediate ? sim::pattern::SwitchMode::Immediate
+                                                          : sim::pattern::SwitchMode::EndOfCycle);
+  showMessage(
+      QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"),
+      5000);
   return {};
 }
 
@@ -578,8 +598,10 @@ void MainWindow::play() { m_playAction->setChecked(true); }
 
 void MainWindow::setSpeed(double speed) {
   const int i = m_speedCombo->findData(speed);
-  if (i >= 0) m_speedCombo->setCurrentIndex(i);
-  else if (m_worker) m_worker->setSpeed(speed);
+  if (i >= 0)
+    m_speedCombo->setCurrentIndex(i);
+  else if (m_worker)
+    m_worker->setSpeed(speed);
 }
 
 void MainWindow::pause() { m_playAction->setChecked(false); }
@@ -588,7 +610,10 @@ bool MainWindow::runUntil(double time, int timeoutMs) {
   if (!m_worker) return false;
   QEventLoop loop;
   bool isDone = false;
-  auto reached = connect(m_worker, &SimWorker::targetReached, &loop, [&] { isDone = true; loop.quit(); });
+  auto reached = connect(m_worker, &SimWorker::targetReached, &loop, [&] {
+    isDone = true;
+    loop.quit();
+  });
   auto failed = connect(m_worker, &SimWorker::failed, &loop, [&] { loop.quit(); });
   QTimer::singleShot(timeoutMs, &loop, &QEventLoop::quit);
   {
@@ -641,7 +666,8 @@ void MainWindow::refresh() {
     m_plotHz = m_plotFrames / seconds;
     m_framesRendered = m_plotFrames = 0;
     m_fpsWindowStart = now;
-    m_statusFps->setText(QString("  3D %1 fps \u00b7 plots %2 Hz  ").arg(m_fps, 0, 'f', 0).arg(m_plotHz, 0, 'f', 0));
+    m_statusFps->setText(
+        QString("  3D %1 fps \u00b7 plots %2 Hz  ").arg(m_fps, 0, 'f', 0).arg(m_plotHz, 0, 'f', 0));
   }
 }
 
@@ -657,7 +683,8 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   ++m_framesRendered;
 
   m_plots->setCursor(s.isScrubbed ? s.metrics.time : std::numeric_limits<double>::quiet_NaN());
-  m_statusTime->setText(QString("  t = %1 s%2  ").arg(s.state.time, 0, 'f', 2).arg(s.isScrubbed ? " (recorded)" : ""));
+  m_statusTime->setText(
+      QString("  t = %1 s%2  ").arg(s.state.time, 0, 'f', 2).arg(s.isScrubbed ? " (recorded)" : ""));
   m_statusRtf->setText(s.isRunning ? QString("  Real-time factor %1  ").arg(s.realTimeFactor, 0, 'f', 2)
                                    : QString("  Paused  "));
   if (s.isRunning != m_playAction->isChecked() && !s.isRunning && !s.isScrubbed) {
@@ -677,9 +704,11 @@ void MainWindow::updateTimeline() {
   const double span = s.recordedTo - s.recordedFrom;
   if (!m_timeline->isSliderDown()) {
     const QSignalBlocker block(m_timeline);
-    m_timeline->setValue(span > 0.0 ? static_cast<int>(std::lround(1000.0 * (s.metrics.time - s.recordedFrom) / span)) : 1000);
+    m_timeline->setValue(
+        span > 0.0 ? static_cast<int>(std::lround(1000.0 * (s.metrics.time - s.recordedFrom) / span)) : 1000);
   }
-  m_timeLabel->setText(QString("t = %1 s of %2 s").arg(s.metrics.time, 0, 'f', 2).arg(s.recordedTo, 0, 'f', 2));
+  m_timeLabel->setText(
+      QString("t = %1 s of %2 s").arg(s.metrics.time, 0, 'f', 2).arg(s.recordedTo, 0, 'f', 2));
 }
 
 void MainWindow::select(const viz::Pick& pick) {
@@ -698,16 +727,20 @@ void MainWindow::select(const viz::Pick& pick) {
   } else {
     const sim::Elements& e = m_document.model()->elements;
     for (int i = 0; i < e.size(); ++i)
-      if (e.endA.body[static_cast<std::size_t>(i)] == pick.index || e.endB.body[static_cast<std::size_t>(i)] == pick.index)
+      if (e.endA.body[static_cast<std::size_t>(i)] == pick.index ||
+          e.endB.body[static_cast<std::size_t>(i)] == pick.index)
         trace.elements.push_back(i);
   }
   double tension = 0.0;
   const Eigen::VectorXd& f = m_shown->metrics.elementForce;
   for (int i : trace.elements)
     if (i < f.size()) tension += std::max(0.0, -f(i));
-  const QString what = pick.kind == viz::Pick::Kind::Element
-                           ? (tension > 0.0 ? QString("tension %1 N").arg(tension, 0, 'f', 2) : QString("slack (0 N)"))
-                           : QString("attached muscle tension %1 N (%2 elements)").arg(tension, 0, 'f', 2).arg(trace.elements.size());
+  const QString what =
+      pick.kind == viz::Pick::Kind::Element
+          ? (tension > 0.0 ? QString("tension %1 N").arg(tension, 0, 'f', 2) : QString("slack (0 N)"))
+          : QString("attached muscle tension %1 N (%2 elements)")
+                .arg(tension, 0, 'f', 2)
+                .arg(trace.elements.size());
   m_selection->setText(QString("<b>%1</b><br>%2").arg(trace.name, what));
   if (isNewSelection) {
     m_plots->addTrace(trace);
@@ -730,7 +763,8 @@ bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
       m_pressPos = static_cast<QMouseEvent*>(event)->pos();
     } else if (event->type() == QEvent::MouseButtonRelease) {
       const auto* mouse = static_cast<QMouseEvent*>(event);
-      if (mouse->button() == Qt::LeftButton && (mouse->pos() - m_pressPos).manhattanLength() < 4) pickAt(mouse->pos());
+      if (mouse->button() == Qt::LeftButton && (mouse->pos() - m_pressPos).manhattanLength() < 4)
+        pickAt(mouse->pos());
     }
   }
   return QMainWindow::eventFilter(watched, event);
@@ -745,12 +779,15 @@ void MainWindow::closeEvent(QCloseEvent* event) {
 
 void MainWindow::exportPlotInteractive(const PlotView* plot) {
   const QString path = QFileDialog::getSaveFileName(
-      this, QString("Export plot \u201c%1\u201d").arg(plot->title()), plot->title().toLower().replace(' ', '-') + ".png",
+      this, QString("Export plot \u201c%1\u201d").arg(plot->title()),
+      plot->title().toLower().replace(' ', '-') + ".png",
       "PNG image (*.png);;SVG vector image (*.svg);;PDF document (*.pdf);;CSV data (*.csv)");
   if (!path.isEmpty()) exportPlot(plot, path);
 }
 
-QString MainWindow::exportPlot(const PlotView* plot, const QString& path) { return m_export->exportPlot(plot, path); }
+QString MainWindow::exportPlot(const PlotView* plot, const QString& path) {
+  return m_export->exportPlot(plot, path);
+}
 
 QString MainWindow::exportViewImage(const QString& path) { return m_export->exportViewImage(path); }
 

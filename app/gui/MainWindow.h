@@ -7,17 +7,16 @@
 /// The simulation runs in a SimWorker on its own QThread; the window only queues edits and draws
 /// the snapshots the worker publishes (refreshed at 30 Hz).
 
-#include "gui/DocumentController.h"
-#include "gui/SimWorker.h"
-#include "viz/ModelScene.h"
-
 #include <QElapsedTimer>
 #include <QMainWindow>
 #include <QThread>
-
 #include <memory>
 #include <utility>
 #include <vector>
+
+#include "gui/DocumentController.h"
+#include "gui/SimWorker.h"
+#include "viz/ModelScene.h"
 
 class QAction;
 class QCheckBox;
@@ -116,7 +115,8 @@ class MainWindow : public QMainWindow {
   void buildDocks();
   void buildTimeline(QWidget* centre);
   void syncDisplayWidgets();
-  void startRun(std::shared_ptr<const sim::Model> model, const QString& modelDir, const RunSettings& settings);
+  void startRun(std::shared_ptr<const sim::Model> model, const QString& modelDir,
+                const RunSettings& settings);
   void refresh();
   void showSnapshot(std::shared_ptr<const Snapshot> snapshot);
   void report(const QString& title, const QString& message);
@@ -135,7 +135,7 @@ class MainWindow : public QMainWindow {
   LivePlots* m_plots = nullptr;
   ParameterPanel* m_params = nullptr;
 
-  DocumentController m_document;  // the open model and its directory; scenario files
+  DocumentController m_document;         // the open model and its directory; scenario files
   ExportController* m_export = nullptr;  // plots, the 3D view, movies and ParaView series
   RunSettings m_settings;
   QThread m_thread;

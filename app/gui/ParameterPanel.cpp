@@ -1,13 +1,13 @@
 #include "gui/ParameterPanel.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
 #include <QLabel>
 #include <QLineEdit>
 #include <QVBoxLayout>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::app {
 
@@ -28,34 +28,45 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
   form->setFieldGrowthPolicy(QFormLayout::ExpandingFieldsGrow);
   layout->addLayout(form);
 
-  addField("Frequency", "breaths/min", "Breathing rate of the breath style (Table 2)",
-           [](const RunSettings& s) { return s.style.breathsPerMinute; },
-           [](RunSettings& s, double v) { s.style.breathsPerMinute = v; });
-  addField("Diaphragm r", "-", "Diaphragm contraction ratio during inhale (Eq. 2)",
-           [](const RunSettings& s) { return s.style.diaphragmR; },
-           [](RunSettings& s, double v) { s.style.diaphragmR = v; });
-  addField("Intercostal r mean", "-", "Mean contraction ratio of the intercostal sinusoids",
-           [](const RunSettings& s) { return s.style.intercostalMean; },
-           [](RunSettings& s, double v) { s.style.intercostalMean = v; });
-  addField("Intercostal r \u00b1", "-", "Amplitude of the intercostal sinusoids (Table 2)",
-           [](const RunSettings& s) { return s.style.intercostalAmplitude; },
-           [](RunSettings& s, double v) { s.style.intercostalAmplitude = v; });
-  addField("Active gain k_ac \u00d7", "-", "Scale of every muscle's active gain",
-           [](const RunSettings& s) { return muscleScale(s.options.step.activeGainScale); },
-           [](RunSettings& s, double v) { setMuscleScale(s.options.step.activeGainScale, v); });
-  addField("Passive gain k_pe \u00d7", "-", "Scale of every muscle's passive gain and damping",
-           [](const RunSettings& s) { return muscleScale(s.options.step.passiveGainScale); },
-           [](RunSettings& s, double v) { setMuscleScale(s.options.step.passiveGainScale, v); });
-  addField("Gut \u03ba", "kPa", "Bulk modulus of the gut, P = \u03ba (V0/V - 1) (Eq. 4)",
-           [this](const RunSettings& s) { return m_model ? 1e-3 * sim::resolveOptions(*m_model, s.options).kappa : 0.0; },
-           [](RunSettings& s, double v) { s.options.step.kappa = 1e3 * v; });
-  addField("Joint friction \u03bc \u00d7", "-", "Scale of every joint's friction (Eq. 3)",
-           [](const RunSettings& s) { return s.options.step.jointFrictionScale; },
-           [](RunSettings& s, double v) { s.options.step.jointFrictionScale = v; });
-  addField("Visceral drag \u03b2 \u00d7", "-",
-           "Scale of the gut's visceral drag (model gut.drag); 0 lets the gut bounce after each inhale",
-           [](const RunSettings& s) { return s.options.step.gutDragScale; },
-           [](RunSettings& s, double v) { s.options.step.gutDragScale = v; });
+  addField(
+      "Frequency", "breaths/min", "Breathing rate of the breath style (Table 2)",
+      [](const RunSettings& s) { return s.style.breathsPerMinute; },
+      [](RunSettings& s, double v) { s.style.breathsPerMinute = v; });
+  addField(
+      "Diaphragm r", "-", "Diaphragm contraction ratio during inhale (Eq. 2)",
+      [](const RunSettings& s) { return s.style.diaphragmR; },
+      [](RunSettings& s, double v) { s.style.diaphragmR = v; });
+  addField(
+      "Intercostal r mean", "-", "Mean contraction ratio of the intercostal sinusoids",
+      [](const RunSettings& s) { return s.style.intercostalMean; },
+      [](RunSettings& s, double v) { s.style.intercostalMean = v; });
+  addField(
+      "Intercostal r \u00b1", "-", "Amplitude of the intercostal sinusoids (Table 2)",
+      [](const RunSettings& s) { return s.style.intercostalAmplitude; },
+      [](RunSettings& s, double v) { s.style.intercostalAmplitude = v; });
+  addField(
+      "Active gain k_ac \u00d7", "-", "Scale of every muscle's active gain",
+      [](const RunSettings& s) { return muscleScale(s.options.step.activeGainScale); },
+      [](RunSettings& s, double v) { setMuscleScale(s.options.step.activeGainScale, v); });
+  addField(
+      "Passive gain k_pe \u00d7", "-", "Scale of every muscle's passive gain and damping",
+      [](const RunSettings& s) { return muscleScale(s.options.step.passiveGainScale); },
+      [](RunSettings& s, double v) { setMuscleScale(s.options.step.passiveGainScale, v); });
+  addField(
+      "Gut \u03ba", "kPa", "Bulk modulus of the gut, P = \u03ba (V0/V - 1) (Eq. 4)",
+      [this](const RunSettings& s) {
+        return m_model ? 1e-3 * sim::resolveOptions(*m_model, s.options).kappa : 0.0;
+      },
+      [](RunSettings& s, double v) { s.options.step.kappa = 1e3 * v; });
+  addField(
+      "Joint friction \u03bc \u00d7", "-", "Scale of every joint's friction (Eq. 3)",
+      [](const RunSettings& s) { return s.options.step.jointFrictionScale; },
+      [](RunSettings& s, double v) { s.options.step.jointFrictionScale = v; });
+  addField(
+      "Visceral drag \u03b2 \u00d7", "-",
+      "Scale of the gut's visceral drag (model gut.drag); 0 lets the gut bounce after each inhale",
+      [](const RunSettings& s) { return s.options.step.gutDragScale; },
+      [](RunSettings& s, double v) { s.options.step.gutDragScale = v; });
   for (const Field& f : m_fields) {
     auto* label = new QLabel(f.edit->property("label").toString());
     label->setToolTip(f.edit->toolTip());

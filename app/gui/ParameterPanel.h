@@ -5,13 +5,12 @@
 /// sim's own validators before anything is applied; an invalid value stays in its field, marked red, with the
 /// validator's reason shown under the panel.
 
-#include "gui/SimWorker.h"
-
 #include <QWidget>
-
 #include <functional>
 #include <memory>
 #include <vector>
+
+#include "gui/SimWorker.h"
 
 class QCheckBox;
 class QComboBox;

@@ -1,15 +1,14 @@
 #include "gui/PlotView.h"
 
-#include "viz/PlotLayout.h"
-
 #include <QContextMenuEvent>
 #include <QPainter>
 #include <QPainterPath>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "viz/PlotLayout.h"
 
 namespace pneuma::app {
 
@@ -218,7 +217,8 @@ void PlotView::paintEvent(QPaintEvent*) {
     p.drawLine(QPointF(area.left(), L.mapY(r.y[0])), QPointF(area.right(), L.mapY(r.y[0])));
   }
   for (const viz::Plot::Series& s : plot.series()) {
-    // at most the first, lowest, highest and last sample per pixel column: the same picture, far fewer segments
+    // at most the first, lowest, highest and last sample per pixel column: the same picture, far fewer
+    // segments
     QPainterPath path;
     bool isDrawing = false;
     auto add = [&](std::size_t i) {

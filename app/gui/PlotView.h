@@ -6,14 +6,13 @@
 /// viz::Plot, the same content and function the PNG/SVG/PDF export uses (at a larger scale), so an export
 /// has the screen's ranges, ticks and legend; the CSV export holds exactly the plotted data.
 
-#include "viz/Plot.h"
-#include "viz/PlotLayout.h"
-
 #include <QColor>
 #include <QString>
 #include <QWidget>
-
 #include <vector>
+
+#include "viz/Plot.h"
+#include "viz/PlotLayout.h"
 
 namespace pneuma::app {
 

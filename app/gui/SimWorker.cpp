@@ -1,14 +1,13 @@
 #include "gui/SimWorker.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Resources.h"
-#include "viz/VtkSeriesWriter.h"
-
 #include <QTimer>
-
 #include <algorithm>
 #include <filesystem>
 #include <limits>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Resources.h"
+#include "viz/VtkSeriesWriter.h"
 
 namespace pneuma::app {
 
@@ -55,8 +54,8 @@ void SimWorker::requestSettings(const RunSettings& settings) {
   m_pending.settings = settings;
 }
 
-void SimWorker::requestSimulation(std::shared_ptr<const sim::Model> model, std::unique_ptr<sim::Simulation> simulation,
-                                  const RunSettings& settings) {
+void SimWorker::requestSimulation(std::shared_ptr<const sim::Model> model,
+                                  std::unique_ptr<sim::Simulation> simulation, const RunSettings& settings) {
   std::lock_guard lock(m_pendingMutex);
   m_pending.model = std::move(model);
   m_pending.simulation = std::move(simulation);
@@ -80,7 +79,8 @@ void SimWorker::requestAffect(const std::string& name, sim::pattern::SwitchMode 
   m_pending.affect = std::make_pair(name, mode);
 }
 
-void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName) {
+void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir,
+                                 const std::string& baseName) {
   std::lock_guard lock(m_pendingMutex);
   m_pending.exportRun = std::array<std::string, 3>{modelDir, outDir, baseName};
 }

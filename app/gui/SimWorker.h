@@ -4,21 +4,20 @@
 /// it queues edits (MuJoCo simulate's `pending_`), which the worker applies at one sync point
 /// before each batch of steps, and it reads immutable snapshots the worker publishes after each batch.
 
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Metrics.h"
-#include "pneuma/sim/Simulation.h"
-#include "pneuma/sim/State.h"
-#include "pneuma/sim/pattern/PatternController.h"
-
 #include <QObject>
 #include <QString>
-
 #include <chrono>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <vector>
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/State.h"
+#include "pneuma/sim/pattern/PatternController.h"
 
 class QTimer;
 
@@ -33,15 +32,16 @@ struct RunSettings {
 
 /// One output frame for the live plots (a slim copy of sim::Metrics).
 struct PlotSample {
-  double time = 0.0;                      ///< [s]
-  double lungVolume = 0.0;                ///< [m^3] the two lungs (sim::Metrics::lungVolume)
-  double rightLungVolume = 0.0;           ///< [m^3] NaN for a model without lung surfaces
-  double leftLungVolume = 0.0;            ///< [m^3] NaN for a model without lung surfaces
-  double gutVolumeError = 0.0;            ///< [-] signed (V - V0) / V0
-  double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung volume; NaN without one
-  sim::Activations activations{};         ///< r and alpha per group
+  double time = 0.0;             ///< [s]
+  double lungVolume = 0.0;       ///< [m^3] the two lungs (sim::Metrics::lungVolume)
+  double rightLungVolume = 0.0;  ///< [m^3] NaN for a model without lung surfaces
+  double leftLungVolume = 0.0;   ///< [m^3] NaN for a model without lung surfaces
+  double gutVolumeError = 0.0;   ///< [-] signed (V - V0) / V0
+  double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung
+                                                                   ///< volume; NaN without one
+  sim::Activations activations{};                                  ///< r and alpha per group
   std::array<double, sim::kElementGroupCount> groupMeanTension{};  ///< [N] sim::Metrics::groupMeanTension
-  std::vector<float> elementForce;        ///< [N] signed, per element (#E)
+  std::vector<float> elementForce;                                 ///< [N] signed, per element (#E)
 };
 
 /// What the GUI draws at one instant, copied out of the simulation.
@@ -49,12 +49,12 @@ struct Snapshot {
   std::shared_ptr<const sim::Model> model;  ///< the model the state belongs to
   sim::State state;
   sim::Metrics metrics;
-  double realTimeFactor = 0.0;      ///< [-] simulated seconds per wall-clock second, last batch
+  double realTimeFactor = 0.0;  ///< [-] simulated seconds per wall-clock second, last batch
   bool isRunning = false;
-  bool isScrubbed = false;          ///< the state was restored from the recording (timeline)
-  double recordedFrom = 0.0;        ///< [s] oldest recorded frame
-  double recordedTo = 0.0;          ///< [s] newest recorded frame
-  long long generation = 0;         ///< increments on reset and model change: plots restart
+  bool isScrubbed = false;    ///< the state was restored from the recording (timeline)
+  double recordedFrom = 0.0;  ///< [s] oldest recorded frame
+  double recordedTo = 0.0;    ///< [s] newest recorded frame
+  long long generation = 0;   ///< increments on reset and model change: plots restart
 };
 
 /// What the GUI takes from the worker at each display refresh.
@@ -151,14 +151,14 @@ class SimWorker : public QObject {
 
   // worker-thread state
   bool m_isRunning = false;
-  double m_speed = 1.0;                 // [-] simulated / wall seconds, 0 = max
-  double m_runUntil = -1.0;             // [s] < 0: none
-  double m_scrubTime = 0.0;             // [s] time of the shown recorded frame
-  double m_debt = 0.0;                  // [s] simulated time owed to real-time pacing
-  double m_rtf = 0.0;                   // [-]
+  double m_speed = 1.0;      // [-] simulated / wall seconds, 0 = max
+  double m_runUntil = -1.0;  // [s] < 0: none
+  double m_scrubTime = 0.0;  // [s] time of the shown recorded frame
+  double m_debt = 0.0;       // [s] simulated time owed to real-time pacing
+  double m_rtf = 0.0;        // [-]
   long long m_generation = 0;
   std::chrono::steady_clock::time_point m_lastTick;
-  std::vector<PlotSample> m_samples;    // collected since the last publish
+  std::vector<PlotSample> m_samples;  // collected since the last publish
 
   std::mutex m_outboxMutex;
   Frame m_outbox;

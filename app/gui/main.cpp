@@ -1,15 +1,13 @@
 // pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--model DIR]`
 // starts, simulates for the given time, saves a grab of the whole window and exits.
 
-#include "gui/MainWindow.h"
+#include <QVTKOpenGLNativeWidget.h>
 
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QImage>
 #include <QSurfaceFormat>
 #include <QTimer>
-#include <QVTKOpenGLNativeWidget.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +15,8 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "gui/MainWindow.h"
 
 int main(int argc, char** argv) {
   // our --style names a breath style: parse the full command line ourselves and keep Qt from
@@ -71,23 +71,25 @@ int main(int argc, char** argv) {
       "model", "Model directory (default: $PNEUMA_MODEL_DIR or <bindir>/../share/pneuma/models/default).",
       "DIR");
   const QCommandLineOption style("style", "Breath style: calm, deep, panting or forced-exhale.", "NAME");
-  const QCommandLineOption affect("affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).",
-                                  "NAME");
+  const QCommandLineOption affect(
+      "affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).", "NAME");
   const QCommandLineOption posture(
       "posture",
       QString::fromStdString("Gravity relative to the body: " + pneuma::sim::postureNames() + " (default " +
                              pneuma::sim::postureName(pneuma::sim::StepOptions{}.posture) + ")."),
       "NAME");
-  const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.", "FILE");
+  const QCommandLineOption screenshot("screenshot", "Save a grab of the whole window to FILE (PNG) and exit.",
+                                      "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
-  const QCommandLineOption camera("camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME",
-                                  "oblique");
-  const QCommandLineOption labels("labels", "Show the anatomical labels and the lung cavity (teaching view).");
-  const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X", "1");
-  const QCommandLineOption measure("measure",
-                                   "Run for SECONDS of wall time, print render fps and real-time factor, exit.",
-                                   "SECONDS");
+  const QCommandLineOption camera(
+      "camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME", "oblique");
+  const QCommandLineOption labels("labels",
+                                  "Show the anatomical labels and the lung cavity (teaching view).");
+  const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X",
+                                 "1");
+  const QCommandLineOption measure(
+      "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
   parser.addOptions({model, style, affect, posture, camera, labels, speed, screenshot, after, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
@@ -97,14 +99,15 @@ int main(int argc, char** argv) {
   if (parser.isSet("version")) parser.showVersion();
   if (isInfoOnly) parser.showHelp(2);  // "--help" was an option's value: no widgets without a QApplication
   if (!parser.positionalArguments().isEmpty()) {
-    std::fprintf(stderr, "pneuma: unexpected argument '%s'\n%s", qPrintable(parser.positionalArguments().first()),
-                 qPrintable(parser.helpText()));
+    std::fprintf(stderr, "pneuma: unexpected argument '%s'\n%s",
+                 qPrintable(parser.positionalArguments().first()), qPrintable(parser.helpText()));
     return 2;
   }
   bool isNumber = false;
   const double afterSeconds = parser.value(after).toDouble(&isNumber);
   if (!isNumber || !(afterSeconds >= 0.0)) {
-    std::fprintf(stderr, "pneuma: --after: expected seconds >= 0, got '%s'\n", qPrintable(parser.value(after)));
+    std::fprintf(stderr, "pneuma: --after: expected seconds >= 0, got '%s'\n",
+                 qPrintable(parser.value(after)));
     return 2;
   }
 
@@ -116,17 +119,20 @@ int main(int argc, char** argv) {
   }
   const double measureSeconds = parser.isSet(measure) ? parser.value(measure).toDouble(&isNumber) : 0.0;
   if (parser.isSet(measure) && (!isNumber || !(measureSeconds > 0.0))) {
-    std::fprintf(stderr, "pneuma: --measure: expected seconds > 0, got '%s'\n", qPrintable(parser.value(measure)));
+    std::fprintf(stderr, "pneuma: --measure: expected seconds > 0, got '%s'\n",
+                 qPrintable(parser.value(measure)));
     return 2;
   }
 
-  const std::map<QString, pneuma::viz::CameraPreset> presets{{"anterior", pneuma::viz::CameraPreset::Anterior},
-                                                             {"lateral", pneuma::viz::CameraPreset::Lateral},
-                                                             {"superior", pneuma::viz::CameraPreset::Superior},
-                                                             {"oblique", pneuma::viz::CameraPreset::Oblique}};
+  const std::map<QString, pneuma::viz::CameraPreset> presets{
+      {"anterior", pneuma::viz::CameraPreset::Anterior},
+      {"lateral", pneuma::viz::CameraPreset::Lateral},
+      {"superior", pneuma::viz::CameraPreset::Superior},
+      {"oblique", pneuma::viz::CameraPreset::Oblique}};
   const auto preset = presets.find(parser.value(camera));
   if (preset == presets.end()) {
-    std::fprintf(stderr, "pneuma: --camera: unknown preset '%s' (valid: anterior, lateral, superior, oblique)\n",
+    std::fprintf(stderr,
+                 "pneuma: --camera: unknown preset '%s' (valid: anterior, lateral, superior, oblique)\n",
                  qPrintable(parser.value(camera)));
     return 2;
   }
@@ -138,7 +144,8 @@ int main(int argc, char** argv) {
   const bool isScripted = parser.isSet(screenshot);
   if (parser.isSet(style) && !window.setBreathStyle(parser.value(style)).isEmpty() && isScripted) return 2;
   if (parser.isSet(posture) && !window.setPosture(parser.value(posture)).isEmpty() && isScripted) return 2;
-  const QString modelDir = parser.isSet(model) ? parser.value(model) : pneuma::app::MainWindow::defaultModelDir();
+  const QString modelDir =
+      parser.isSet(model) ? parser.value(model) : pneuma::app::MainWindow::defaultModelDir();
   const bool hasModel = window.openModel(modelDir).isEmpty();
   if (hasModel && parser.isSet(affect)) {
     // an unknown name is reported by the window (dialog, or stderr when scripted)
@@ -173,9 +180,10 @@ int main(int argc, char** argv) {
     // report what the status bar shows after the given wall time
     QTimer::singleShot(static_cast<int>(1000.0 * measureSeconds), &window, [&window] {
       const auto* shown = window.shown();
-      std::printf("3D view %.1f fps (%.1f ms per render), plots %.1f Hz, real-time factor %.2f, simulated %.2f s\n",
-                  window.renderFps(), window.renderMilliseconds(), window.plotRate(),
-                  shown ? shown->realTimeFactor : 0.0, shown ? shown->state.time : 0.0);
+      std::printf(
+          "3D view %.1f fps (%.1f ms per render), plots %.1f Hz, real-time factor %.2f, simulated %.2f s\n",
+          window.renderFps(), window.renderMilliseconds(), window.plotRate(),
+          shown ? shown->realTimeFactor : 0.0, shown ? shown->state.time : 0.0);
       QApplication::exit(shown ? 0 : 1);
     });
   }

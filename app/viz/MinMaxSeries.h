@@ -26,8 +26,8 @@ class MinMaxSeries {
   struct Bucket {
     double tMin, vMin, tMax, vMax;
   };
-  /// The buckets in time order. Which samples share a bucket depends only on how many were appended, so series
-  /// fed the same samples (the columns of one table) have buckets that span the same samples.
+  /// The buckets in time order. Which samples share a bucket depends only on how many were appended, so
+  /// series fed the same samples (the columns of one table) have buckets that span the same samples.
   const std::vector<Bucket>& buckets() const { return m_buckets; }
 
  private:

@@ -1,7 +1,5 @@
 #include "viz/ModelScene.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <vtkActor.h>
 #include <vtkAxesActor.h>
 #include <vtkCamera.h>
@@ -20,9 +18,9 @@
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkPolyDataNormals.h>
+#include <vtkPropCollection.h>
 #include <vtkProperty.h>
 #include <vtkProperty2D.h>
-#include <vtkPropCollection.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
@@ -36,6 +34,8 @@
 #include <filesystem>
 #include <initializer_list>
 #include <limits>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::viz {
 
@@ -103,7 +103,6 @@ double niceCeil(double v) {
   return 10.0 * p;
 }
 
-
 // a teaching label: a caption drawn over the scene (never hidden by it) with a leader to its point
 vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
   auto label = vtkSmartPointer<vtkCaptionActor2D>::New();
@@ -145,26 +144,40 @@ vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::st
 
 const char* groupLabel(sim::ElementGroup g) {
   switch (g) {
-    case sim::ElementGroup::IntercostalExternal: return "External intercostals";
-    case sim::ElementGroup::IntercostalInternal: return "Internal intercostals";
-    case sim::ElementGroup::Diaphragm: return "Diaphragm";
-    case sim::ElementGroup::Rectus: return "Rectus abdominis";
-    case sim::ElementGroup::TransversusObliques: return "Transversus / obliques";
-    case sim::ElementGroup::Cartilage: return "Costal cartilage";
-    case sim::ElementGroup::Count: break;
+    case sim::ElementGroup::IntercostalExternal:
+      return "External intercostals";
+    case sim::ElementGroup::IntercostalInternal:
+      return "Internal intercostals";
+    case sim::ElementGroup::Diaphragm:
+      return "Diaphragm";
+    case sim::ElementGroup::Rectus:
+      return "Rectus abdominis";
+    case sim::ElementGroup::TransversusObliques:
+      return "Transversus / obliques";
+    case sim::ElementGroup::Cartilage:
+      return "Costal cartilage";
+    case sim::ElementGroup::Count:
+      break;
   }
   return "?";
 }
 
 std::array<double, 3> groupColour(sim::ElementGroup g) {
   switch (g) {
-    case sim::ElementGroup::IntercostalExternal: return {0.30, 0.78, 0.36};
-    case sim::ElementGroup::IntercostalInternal: return {0.62, 0.42, 0.86};
-    case sim::ElementGroup::Diaphragm: return {0.78, 0.36, 0.18};   // rust
-    case sim::ElementGroup::Rectus: return {0.96, 0.62, 0.72};      // pink
-    case sim::ElementGroup::TransversusObliques: return {0.33, 0.52, 0.93};  // blue
-    case sim::ElementGroup::Cartilage: return {0.86, 0.86, 0.78};
-    case sim::ElementGroup::Count: break;
+    case sim::ElementGroup::IntercostalExternal:
+      return {0.30, 0.78, 0.36};
+    case sim::ElementGroup::IntercostalInternal:
+      return {0.62, 0.42, 0.86};
+    case sim::ElementGroup::Diaphragm:
+      return {0.78, 0.36, 0.18};  // rust
+    case sim::ElementGroup::Rectus:
+      return {0.96, 0.62, 0.72};  // pink
+    case sim::ElementGroup::TransversusObliques:
+      return {0.33, 0.52, 0.93};  // blue
+    case sim::ElementGroup::Cartilage:
+      return {0.86, 0.86, 0.78};
+    case sim::ElementGroup::Count:
+      break;
   }
   return {1.0, 1.0, 1.0};
 }
@@ -179,7 +192,7 @@ struct ModelScene::Impl {
   DisplayOptions options;
 
   sim::Model model;
-  double maxForceSeen = 0.0;  // [N]
+  double maxForceSeen = 0.0;         // [N]
   double maxDisplacementSeen = 0.0;  // [m] of the current frame
   double maxPressureSeen = 0.0;      // [Pa] largest |P| since the model was set
 
@@ -276,7 +289,8 @@ struct ModelScene::Impl {
   }
 
   // body meshes in body-frame coordinates; a small sphere for bodies without one
-  static std::vector<vtkSmartPointer<vtkPolyData>> readBodyMeshes(const sim::Model& model, const std::string& modelDir) {
+  static std::vector<vtkSmartPointer<vtkPolyData>> readBodyMeshes(const sim::Model& model,
+                                                                  const std::string& modelDir) {
     std::vector<vtkSmartPointer<vtkPolyData>> meshes;
     for (int b = 0; b < model.bodies.size(); ++b) {
       const std::string& file = model.bodies.mesh[static_cast<std::size_t>(b)];
@@ -298,8 +312,10 @@ struct ModelScene::Impl {
     for (int b = 0; b < model.bodies.size(); ++b) {
       auto actor = actorFor(meshes[static_cast<std::size_t>(b)]);
       const bool isFixed = model.bodies.isFixed[static_cast<std::size_t>(b)] != 0;
-      if (isFixed) actor->GetProperty()->SetColor(0.50, 0.49, 0.47);  // fixed bodies are dark (Figure 2)
-      else actor->GetProperty()->SetColor(0.93, 0.90, 0.82);
+      if (isFixed)
+        actor->GetProperty()->SetColor(0.50, 0.49, 0.47);  // fixed bodies are dark (Figure 2)
+      else
+        actor->GetProperty()->SetColor(0.93, 0.90, 0.82);
       actor->GetProperty()->SetSpecular(0.25);
       actor->GetProperty()->SetSpecularPower(20.0);
       auto pose = vtkSmartPointer<vtkMatrix4x4>::New();
@@ -310,7 +326,8 @@ struct ModelScene::Impl {
 
     // muscle elements by group
     for (int e = 0; e < model.elements.size(); ++e)
-      groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(e);
+      groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(
+          e);
     for (int gi = 0; gi < kGroups; ++gi) {
       Group& g = groups[static_cast<std::size_t>(gi)];
       const int n = static_cast<int>(g.element.size());
@@ -333,7 +350,8 @@ struct ModelScene::Impl {
       g.actor->GetMapper()->SetLookupTable(forceTable);
       g.actor->GetMapper()->SetScalarModeToUseCellData();
       g.actor->GetMapper()->UseLookupTableScalarRangeOn();
-      g.actor->GetProperty()->SetLineWidth(gi == static_cast<int>(sim::ElementGroup::Cartilage) ? 3.0f : 2.5f);
+      g.actor->GetProperty()->SetLineWidth(gi == static_cast<int>(sim::ElementGroup::Cartilage) ? 3.0f
+                                                                                                : 2.5f);
       g.actor->GetProperty()->SetRenderLinesAsTubes(true);
     }
 
@@ -452,7 +470,7 @@ struct ModelScene::Impl {
       gutActor->GetMapper()->SetScalarVisibility(coloured);
       gutActor->GetProperty()->SetColor(0.72, 0.58, 0.82);
       gutBar->SetTitle(options.gutColouring == GutColouring::Pressure ? "Gut\npressure [Pa]"
-                                                                       : "Gut\ndisplacement\n[mm]");
+                                                                      : "Gut\ndisplacement\n[mm]");
       gutBar->SetVisibility(options.showGut && coloured);
     }
     if (cavityActor) cavityActor->SetVisibility(options.showCavity);
@@ -460,9 +478,9 @@ struct ModelScene::Impl {
       if (a) a->SetVisibility(options.showLungs);
     if (landmarkActor) landmarkActor->SetVisibility(options.showLandmarks);
     for (const Label& l : labels) {
-      const bool relevant = l.group >= 0 ? options.showGroup[static_cast<std::size_t>(l.group)]
-                          : l.landmark >= 0 ? options.showLandmarks
-                                            : options.showBones;
+      const bool relevant = l.group >= 0      ? options.showGroup[static_cast<std::size_t>(l.group)]
+                            : l.landmark >= 0 ? options.showLandmarks
+                                              : options.showBones;
       l.actor->SetVisibility(options.showLabels && relevant);
     }
   }
@@ -490,8 +508,8 @@ void ModelScene::installOrientationMarker(vtkRenderWindowInteractor* interactor)
   axes->SetXAxisLabelText("R");
   axes->SetYAxisLabelText("A");
   axes->SetZAxisLabelText("S");
-  for (vtkCaptionActor2D* caption : {axes->GetXAxisCaptionActor2D(), axes->GetYAxisCaptionActor2D(),
-                                     axes->GetZAxisCaptionActor2D()}) {
+  for (vtkCaptionActor2D* caption :
+       {axes->GetXAxisCaptionActor2D(), axes->GetYAxisCaptionActor2D(), axes->GetZAxisCaptionActor2D()}) {
     caption->GetCaptionTextProperty()->SetFontSize(14);
     caption->GetCaptionTextProperty()->ShadowOff();
     caption->GetCaptionTextProperty()->ItalicOff();
@@ -550,10 +568,10 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
       points->SetPoint(id, s.endA(0, e), s.endA(1, e), s.endA(2, e));
       points->SetPoint(id + 1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
       const double tension = hasForces ? std::max(0.0, -metrics.elementForce(e)) : 0.0;
-      const bool isSlack = !(tension > 0.0) ||
-                           (static_cast<std::size_t>(e) < metrics.isSlack.size() && metrics.isSlack[static_cast<std::size_t>(e)]);
-      g.force->SetValue(static_cast<vtkIdType>(k), isSlack ? std::numeric_limits<float>::quiet_NaN()
-                                                           : static_cast<float>(tension));
+      const bool isSlack = !(tension > 0.0) || (static_cast<std::size_t>(e) < metrics.isSlack.size() &&
+                                                metrics.isSlack[static_cast<std::size_t>(e)]);
+      g.force->SetValue(static_cast<vtkIdType>(k),
+                        isSlack ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(tension));
       if (!isSlack && sim::isMuscleGroup(model.elements.group[static_cast<std::size_t>(e)]))
         maxForce = std::max(maxForce, tension);
     }
@@ -571,7 +589,8 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     for (int n = 0; n < model.nodes.size(); ++n) {
       const double d = (state.nodePosition.col(n) - model.nodes.rest.col(n)).norm();
       maxDisp = std::max(maxDisp, d);
-      const double value = s.options.gutColouring == GutColouring::Pressure ? metrics.gutPressure : 1000.0 * d;
+      const double value =
+          s.options.gutColouring == GutColouring::Pressure ? metrics.gutPressure : 1000.0 * d;
       s.gutScalar->SetValue(n, static_cast<float>(value));
     }
     s.gutScalar->Modified();
@@ -644,10 +663,19 @@ void ModelScene::setCamera(CameraPreset preset) {
   Eigen::Vector3d dir(0.0, 1.0, 0.0);  // from the camera's side toward... the camera (RAS)
   Eigen::Vector3d up(0.0, 0.0, 1.0);
   switch (preset) {
-    case CameraPreset::Anterior: dir = {0.0, 1.0, 0.0}; break;
-    case CameraPreset::Lateral: dir = {1.0, 0.0, 0.0}; break;
-    case CameraPreset::Superior: dir = {0.0, 0.0, 1.0}; up = {0.0, 1.0, 0.0}; break;
-    case CameraPreset::Oblique: dir = Eigen::Vector3d(0.8, 1.0, 0.45).normalized(); break;
+    case CameraPreset::Anterior:
+      dir = {0.0, 1.0, 0.0};
+      break;
+    case CameraPreset::Lateral:
+      dir = {1.0, 0.0, 0.0};
+      break;
+    case CameraPreset::Superior:
+      dir = {0.0, 0.0, 1.0};
+      up = {0.0, 1.0, 0.0};
+      break;
+    case CameraPreset::Oblique:
+      dir = Eigen::Vector3d(0.8, 1.0, 0.45).normalized();
+      break;
   }
   vtkCamera* camera = m_impl->renderer->GetActiveCamera();
   camera->SetFocalPoint(0.0, 0.0, 0.0);
@@ -677,8 +705,10 @@ void ModelScene::setHighlight(const Pick& pick) {
   // restore the previous body colour, then mark the new selection
   if (s.highlight.kind == Pick::Kind::Body) {
     const bool isFixed = s.model.bodies.isFixed[static_cast<std::size_t>(s.highlight.index)] != 0;
-    if (isFixed) s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.50, 0.49, 0.47);
-    else s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.93, 0.90, 0.82);
+    if (isFixed)
+      s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.50, 0.49, 0.47);
+    else
+      s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.93, 0.90, 0.82);
   }
   s.highlight = pick;
   if (!s.highlightActor) return;

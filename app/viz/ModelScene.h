@@ -6,15 +6,15 @@
 /// on a ParaView-like backdrop with an RAS orientation marker. Qt-free: the GUI puts renderer() into a
 /// QVTKOpenGLNativeWidget, the CLI into an off-screen window.
 
-#include "pneuma/sim/Metrics.h"
-#include "pneuma/sim/Model.h"
-#include "pneuma/sim/State.h"
-
 #include <vtkSmartPointer.h>
 
 #include <array>
 #include <memory>
 #include <string>
+
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Model.h"
+#include "pneuma/sim/State.h"
 
 class vtkPolyData;
 class vtkRenderer;
@@ -46,7 +46,7 @@ struct DisplayOptions {
   bool showBones = true;
   bool showGut = true;
   bool showCavity = false;
-  bool showLungs = true;   ///< the right and left lungs, translucent (Model::lungs)
+  bool showLungs = true;  ///< the right and left lungs, translucent (Model::lungs)
   bool showLandmarks = true;
   bool showLabels = false;
   std::array<bool, sim::kElementGroupCount> showGroup{true, true, true, true, true, true};

@@ -1,7 +1,5 @@
 #include "viz/MovieWriter.h"
 
-#include "viz/AtomicFile.h"
-
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkOggTheoraWriter.h>
@@ -13,6 +11,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+
+#include "viz/AtomicFile.h"
 
 namespace pneuma::viz {
 
@@ -45,7 +45,8 @@ MovieWriter::MovieWriter(std::string path, double fps) : m_impl(std::make_unique
   m_impl->path = std::move(path);
   m_impl->fps = fps;
   std::string suffix = fs::path(m_impl->path).extension().string();
-  std::transform(suffix.begin(), suffix.end(), suffix.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(suffix.begin(), suffix.end(), suffix.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   m_impl->isMovie = suffix == ".ogv";
 }
 
@@ -81,7 +82,8 @@ void MovieWriter::writeFrame(const unsigned char* rgb, int width, int height) {
       s.movie->SetQuality(2);
     }
     if (width < s.movieWidth || height < s.movieHeight)
-      throw std::runtime_error("cannot write " + s.path + ": frame " + std::to_string(s.frames) + " is smaller than the first");
+      throw std::runtime_error("cannot write " + s.path + ": frame " + std::to_string(s.frames) +
+                               " is smaller than the first");
     s.load(rgb, stride, s.movieWidth, s.movieHeight);
     if (s.frames == 0) s.movie->Start();
     s.movie->Write();
@@ -107,7 +109,8 @@ void MovieWriter::finish() {
     s.movie->End();
     commitTemporary(s.temporaries.front(), s.path);
   } else {
-    for (int k = 0; k < s.frames; ++k) commitTemporary(s.temporaries[static_cast<std::size_t>(k)], framePath(k));
+    for (int k = 0; k < s.frames; ++k)
+      commitTemporary(s.temporaries[static_cast<std::size_t>(k)], framePath(k));
   }
   s.isFinished = true;
 }

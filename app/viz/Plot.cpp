@@ -1,8 +1,5 @@
 #include "viz/Plot.h"
 
-#include "viz/AtomicFile.h"
-#include "viz/PlotLayout.h"
-
 #include <vtkFreeTypeTools.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
@@ -21,6 +18,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "viz/AtomicFile.h"
+#include "viz/PlotLayout.h"
+
 namespace pneuma::viz {
 
 /// One drawing instruction in pixel coordinates (origin top-left, y down).
@@ -38,7 +38,7 @@ struct Plot::Primitive {
   double fontSize = 15.0;     // [px]
   bool isBold = false;        // title
   Anchor anchor = Anchor::Start;
-  bool isVertical = false;    // text rotated by -90 degrees (reads bottom to top)
+  bool isVertical = false;  // text rotated by -90 degrees (reads bottom to top)
 };
 
 namespace {
@@ -87,18 +87,28 @@ double textWidth(const std::string& text, double fontSize, bool isBold) {
 
 std::string svgColor(const Color& c) {
   auto to8 = [](double v) { return static_cast<int>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
-  return "rgb(" + std::to_string(to8(c.r)) + "," + std::to_string(to8(c.g)) + "," + std::to_string(to8(c.b)) + ")";
+  return "rgb(" + std::to_string(to8(c.r)) + "," + std::to_string(to8(c.g)) + "," + std::to_string(to8(c.b)) +
+         ")";
 }
 
 std::string xmlEscape(const std::string& s) {
   std::string out;
   for (char ch : s) {
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += ch;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += ch;
     }
   }
   return out;
@@ -113,7 +123,11 @@ std::string num(double v) {
 /// A float RGB canvas with coverage-based anti-aliased drawing.
 class Canvas {
  public:
-  Canvas(int w, int h) : m_w(w), m_h(h), m_rgb(static_cast<std::size_t>(3 * w * h), 1.0), m_cover(static_cast<std::size_t>(w * h), 0.0f) {}
+  Canvas(int w, int h)
+      : m_w(w),
+        m_h(h),
+        m_rgb(static_cast<std::size_t>(3 * w * h), 1.0),
+        m_cover(static_cast<std::size_t>(w * h), 0.0f) {}
 
   /// Strokes a polyline of width `width` [px]: coverage of each pixel centre is the max over segments,
   /// so joints are not blended twice.
@@ -136,8 +150,8 @@ class Canvas {
           const double e = std::min(len, s + rest);
           if (phase < kDashOn) {
             const double t0 = s / len, t1 = e / len;
-            coverSegment(ax + t0 * (bx - ax), ay + t0 * (by - ay), ax + t1 * (bx - ax), ay + t1 * (by - ay), width,
-                         x0, y0, x1, y1);
+            coverSegment(ax + t0 * (bx - ax), ay + t0 * (by - ay), ax + t1 * (bx - ax), ay + t1 * (by - ay),
+                         width, x0, y0, x1, y1);
           }
           s = e;
         }
@@ -154,8 +168,10 @@ class Canvas {
   }
 
   void fillRect(double x, double y, double w, double h, const Color& c) {
-    for (int py = std::max(0, static_cast<int>(std::floor(y))); py < std::min(m_h, static_cast<int>(std::ceil(y + h))); ++py)
-      for (int px = std::max(0, static_cast<int>(std::floor(x))); px < std::min(m_w, static_cast<int>(std::ceil(x + w))); ++px) {
+    for (int py = std::max(0, static_cast<int>(std::floor(y)));
+         py < std::min(m_h, static_cast<int>(std::ceil(y + h))); ++py)
+      for (int px = std::max(0, static_cast<int>(std::floor(x)));
+           px < std::min(m_w, static_cast<int>(std::ceil(x + w))); ++px) {
         // fractional coverage at the rectangle's edges
         const double cx = std::max(0.0, std::min(px + 1.0, x + w) - std::max(px + 0.0, x));
         const double cy = std::max(0.0, std::min(py + 1.0, y + h) - std::max(py + 0.0, y));
@@ -199,15 +215,18 @@ class Canvas {
       for (int x = 0; x < m_w; ++x) {
         auto* px = static_cast<unsigned char*>(img->GetScalarPointer(x, m_h - 1 - y, 0));
         for (int k = 0; k < 3; ++k)
-          px[k] = static_cast<unsigned char>(std::lround(std::clamp(m_rgb[static_cast<std::size_t>(3 * (y * m_w + x) + k)], 0.0, 1.0) * 255.0));
+          px[k] = static_cast<unsigned char>(std::lround(
+              std::clamp(m_rgb[static_cast<std::size_t>(3 * (y * m_w + x) + k)], 0.0, 1.0) * 255.0));
       }
     vtkNew<vtkPNGWriter> writer;
     writer->SetInputData(img);
     writer->WriteToMemoryOn();
     writer->Write();
     vtkUnsignedCharArray* result = writer->GetResult();
-    if (result == nullptr || result->GetNumberOfValues() == 0) throw std::runtime_error("PNG encoding failed");
-    return std::vector<unsigned char>(result->GetPointer(0), result->GetPointer(0) + result->GetNumberOfValues());
+    if (result == nullptr || result->GetNumberOfValues() == 0)
+      throw std::runtime_error("PNG encoding failed");
+    return std::vector<unsigned char>(result->GetPointer(0),
+                                      result->GetPointer(0) + result->GetNumberOfValues());
   }
 
  private:
@@ -220,7 +239,8 @@ class Canvas {
   }
 
   /// Coverage of pixel centres by a segment of width `w` with round caps: clamp(w/2 + 1/2 - distance, 0, 1).
-  void coverSegment(double ax, double ay, double bx, double by, double w, int& x0, int& y0, int& x1, int& y1) {
+  void coverSegment(double ax, double ay, double bx, double by, double w, int& x0, int& y0, int& x1,
+                    int& y1) {
     const double r = w / 2.0 + 0.5;
     const int lx = std::max(0, static_cast<int>(std::floor(std::min(ax, bx) - r)));
     const int hx = std::min(m_w - 1, static_cast<int>(std::ceil(std::max(ax, bx) + r)));
@@ -261,8 +281,9 @@ void Plot::addSeries(const std::string& label, std::vector<double> x, std::vecto
 
 void Plot::addSeries(Series series) {
   if (series.x.size() != series.y.size())
-    throw std::invalid_argument("Plot series '" + series.label + "': x has " + std::to_string(series.x.size()) +
-                                " values but y has " + std::to_string(series.y.size()));
+    throw std::invalid_argument("Plot series '" + series.label + "': x has " +
+                                std::to_string(series.x.size()) + " values but y has " +
+                                std::to_string(series.y.size()));
   m_series.push_back(std::move(series));
 }
 
@@ -277,8 +298,8 @@ void Plot::addReferenceLine(const std::string& label, double y, Color color) {
 
 void Plot::setSize(int widthPx, int heightPx) {
   if (widthPx < 200 || heightPx < 150)
-    throw std::invalid_argument("Plot size must be at least 200 x 150 px, got " + std::to_string(widthPx) + " x " +
-                                std::to_string(heightPx));
+    throw std::invalid_argument("Plot size must be at least 200 x 150 px, got " + std::to_string(widthPx) +
+                                " x " + std::to_string(heightPx));
   m_width = widthPx;
   m_height = heightPx;
 }
@@ -411,26 +432,30 @@ std::string Plot::toSvg() const {
   std::ostringstream svg;
   svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << m_width << "\" height=\"" << m_height
-      << "\" viewBox=\"0 0 " << m_width << " " << m_height << "\" font-family=\"DejaVu Sans, Verdana, Arial, sans-serif\">\n"
+      << "\" viewBox=\"0 0 " << m_width << " " << m_height
+      << "\" font-family=\"DejaVu Sans, Verdana, Arial, sans-serif\">\n"
       << "<rect x=\"0\" y=\"0\" width=\"" << m_width << "\" height=\"" << m_height << "\" fill=\"white\"/>\n";
   for (const P& p : primitives()) {
     switch (p.kind) {
       case P::Kind::Polyline: {
-        svg << "<polyline fill=\"none\" stroke=\"" << svgColor(p.color) << "\" stroke-width=\"" << num(p.width)
-            << "\" stroke-linejoin=\"round\" stroke-linecap=\"round\"";
+        svg << "<polyline fill=\"none\" stroke=\"" << svgColor(p.color) << "\" stroke-width=\""
+            << num(p.width) << "\" stroke-linejoin=\"round\" stroke-linecap=\"round\"";
         if (p.isDashed) svg << " stroke-dasharray=\"" << kDashOn << " " << kDashOff << "\"";
         svg << " points=\"";
-        for (std::size_t i = 0; i + 1 < p.xy.size(); i += 2) svg << (i ? " " : "") << num(p.xy[i]) << "," << num(p.xy[i + 1]);
+        for (std::size_t i = 0; i + 1 < p.xy.size(); i += 2)
+          svg << (i ? " " : "") << num(p.xy[i]) << "," << num(p.xy[i + 1]);
         svg << "\"/>\n";
         break;
       }
       case P::Kind::Rect:
         svg << "<rect x=\"" << num(p.xy[0]) << "\" y=\"" << num(p.xy[1]) << "\" width=\"" << num(p.xy[2])
-            << "\" height=\"" << num(p.xy[3]) << "\" fill=\"" << (p.hasFill ? svgColor(p.fill) : "none") << "\" stroke=\""
-            << svgColor(p.color) << "\" stroke-width=\"" << num(p.width) << "\"/>\n";
+            << "\" height=\"" << num(p.xy[3]) << "\" fill=\"" << (p.hasFill ? svgColor(p.fill) : "none")
+            << "\" stroke=\"" << svgColor(p.color) << "\" stroke-width=\"" << num(p.width) << "\"/>\n";
         break;
       case P::Kind::Text: {
-        const char* anchor = p.anchor == P::Anchor::Start ? "start" : p.anchor == P::Anchor::Middle ? "middle" : "end";
+        const char* anchor = p.anchor == P::Anchor::Start    ? "start"
+                             : p.anchor == P::Anchor::Middle ? "middle"
+                                                             : "end";
         svg << "<text x=\"" << num(p.xy[0]) << "\" y=\"" << num(p.xy[1]) << "\" font-size=\""
             << num(p.fontSize) << "\" text-anchor=\"" << anchor << "\" fill=\"" << svgColor(p.color) << "\"";
         if (p.isBold) svg << " font-weight=\"bold\"";
@@ -449,7 +474,9 @@ std::vector<unsigned char> Plot::toPng() const {
   Canvas canvas(m_width, m_height);
   for (const P& p : primitives()) {
     switch (p.kind) {
-      case P::Kind::Polyline: canvas.strokePolyline(p.xy, p.width, p.color, p.isDashed); break;
+      case P::Kind::Polyline:
+        canvas.strokePolyline(p.xy, p.width, p.color, p.isDashed);
+        break;
       case P::Kind::Rect: {
         const double x = p.xy[0], y = p.xy[1], w = p.xy[2], h = p.xy[3];
         if (p.hasFill) canvas.fillRect(x, y, w, h, p.fill);

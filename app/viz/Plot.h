@@ -26,11 +26,11 @@ class Plot {
  public:
   /// One polyline. Non-finite y values break the line.
   struct Series {
-    std::string label;        ///< legend text; empty hides it from the legend
-    std::vector<double> x;    ///< abscissae in the x axis unit (#S)
-    std::vector<double> y;    ///< ordinates in the y axis unit (#S)
-    Color color;              ///< line colour
-    bool isDashed = false;    ///< dashed line (reference curves)
+    std::string label;      ///< legend text; empty hides it from the legend
+    std::vector<double> x;  ///< abscissae in the x axis unit (#S)
+    std::vector<double> y;  ///< ordinates in the y axis unit (#S)
+    Color color;            ///< line colour
+    bool isDashed = false;  ///< dashed line (reference curves)
   };
 
   /// @param title   headline above the chart
@@ -81,9 +81,11 @@ class Plot {
   /// The chart as the bytes of a PNG file (8-bit RGB).
   std::vector<unsigned char> toPng() const;
 
-  /// Writes toSvg() to `path` through a temporary file and a rename. @throws std::runtime_error on I/O failure.
+  /// Writes toSvg() to `path` through a temporary file and a rename. @throws std::runtime_error on I/O
+  /// failure.
   void writeSvg(const std::string& path) const;
-  /// Writes toPng() to `path` through a temporary file and a rename. @throws std::runtime_error on I/O failure.
+  /// Writes toPng() to `path` through a temporary file and a rename. @throws std::runtime_error on I/O
+  /// failure.
   void writePng(const std::string& path) const;
 
  private:

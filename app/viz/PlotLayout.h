@@ -9,12 +9,12 @@
 /// The tick density follows the canvas size measured in text lines, so a chart drawn at twice the size with
 /// twice the font (an export of a screen plot) has the same ticks.
 
-#include "viz/Plot.h"
-
 #include <cstddef>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "viz/Plot.h"
 
 namespace pneuma::viz {
 

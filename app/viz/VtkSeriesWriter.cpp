@@ -1,10 +1,5 @@
 #include "viz/VtkSeriesWriter.h"
 
-#include "viz/AtomicFile.h"
-#include "viz/ModelScene.h"
-
-#include "pneuma/sim/Error.h"
-
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
@@ -24,6 +19,10 @@
 #include <sstream>
 #include <stdexcept>
 #include <vector>
+
+#include "pneuma/sim/Error.h"
+#include "viz/AtomicFile.h"
+#include "viz/ModelScene.h"
 
 namespace pneuma::viz {
 
@@ -72,17 +71,19 @@ struct VtkSeriesWriter::Impl {
   std::string outDir;
   std::string baseName;
   // bones: all body meshes appended, in body-frame coordinates, with the body of every point
-  Eigen::Matrix3Xd boneLocal;         // [m] (3 x #points)
-  std::vector<int> bonePointBody;     // (#points)
+  Eigen::Matrix3Xd boneLocal;      // [m] (3 x #points)
+  std::vector<int> bonePointBody;  // (#points)
   vtkSmartPointer<vtkCellArray> bonePolys, boneVerts;
   vtkSmartPointer<vtkIntArray> boneBodyId;  // per cell: vertices first, then polygons (VTK's cell order)
-  std::vector<double> frameTimes;     // [s]
+  std::vector<double> frameTimes;           // [s]
 
   Impl(const sim::Model& m, const std::string& modelDir, std::string dir, std::string base)
       : model(m), outDir(std::move(dir)), baseName(std::move(base)) {
     std::error_code ec;
     fs::create_directories(fs::path(outDir) / baseName, ec);
-    if (ec) throw std::runtime_error("cannot create " + (fs::path(outDir) / baseName).string() + ": " + ec.message());
+    if (ec)
+      throw std::runtime_error("cannot create " + (fs::path(outDir) / baseName).string() + ": " +
+                               ec.message());
     bonePolys = vtkSmartPointer<vtkCellArray>::New();
     boneVerts = vtkSmartPointer<vtkCellArray>::New();
     std::vector<int> vertBody, polyBody;
@@ -99,7 +100,8 @@ struct VtkSeriesWriter::Impl {
         continue;
       }
       const std::string path = (fs::path(modelDir) / file).string();
-      const vtkSmartPointer<vtkPolyData> mesh = readBodyMesh(path, model.bodies.name[static_cast<std::size_t>(b)]);
+      const vtkSmartPointer<vtkPolyData> mesh =
+          readBodyMesh(path, model.bodies.name[static_cast<std::size_t>(b)]);
       for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p) {
         double q[3];
         mesh->GetPoint(p, q);
@@ -111,7 +113,8 @@ struct VtkSeriesWriter::Impl {
       vtkNew<vtkIdList> ids;
       while (polys->GetNextCell(ids)) {
         std::vector<vtkIdType> shifted(static_cast<std::size_t>(ids->GetNumberOfIds()));
-        for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) shifted[static_cast<std::size_t>(k)] = ids->GetId(k) + base0;
+        for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+          shifted[static_cast<std::size_t>(k)] = ids->GetId(k) + base0;
         bonePolys->InsertNextCell(static_cast<vtkIdType>(shifted.size()), shifted.data());
         polyBody.push_back(b);
       }
@@ -147,7 +150,8 @@ struct VtkSeriesWriter::Impl {
     Eigen::Matrix3Xd x(3, boneLocal.cols());
     for (Eigen::Index i = 0; i < boneLocal.cols(); ++i) {
       const std::size_t b = static_cast<std::size_t>(bonePointBody[static_cast<std::size_t>(i)]);
-      x.col(i) = state.bodyOrientation[b] * boneLocal.col(i) + state.bodyPosition.col(static_cast<Eigen::Index>(b));
+      x.col(i) =
+          state.bodyOrientation[b] * boneLocal.col(i) + state.bodyPosition.col(static_cast<Eigen::Index>(b));
     }
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     setPoints(pd, x);
@@ -179,7 +183,9 @@ struct VtkSeriesWriter::Impl {
       force->SetValue(e, f);
       tension->SetValue(e, f < 0.0 ? -f : 0.0);
       group->InsertNextValue(static_cast<int>(el.group[static_cast<std::size_t>(e)]));
-      slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size() ? metrics.isSlack[static_cast<std::size_t>(e)] : 0);
+      slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size()
+                                 ? metrics.isSlack[static_cast<std::size_t>(e)]
+                                 : 0);
     }
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     setPoints(pd, x);
@@ -217,7 +223,8 @@ struct VtkSeriesWriter::Impl {
     return pd;
   }
 
-  // both lungs in one polydata, the right lung's vertices and triangles first; cell data side: 0 right, 1 left
+  // both lungs in one polydata, the right lung's vertices and triangles first; cell data side: 0 right, 1
+  // left
   vtkSmartPointer<vtkPolyData> lungs(const sim::State& state, const sim::Metrics& metrics) const {
     const sim::LungSurface& right = model.lungs.right;
     const sim::LungSurface& left = model.lungs.left;
@@ -243,8 +250,8 @@ struct VtkSeriesWriter::Impl {
   }
 };
 
-VtkSeriesWriter::VtkSeriesWriter(const sim::Model& model, const std::string& modelDir, const std::string& outDir,
-                                 const std::string& baseName)
+VtkSeriesWriter::VtkSeriesWriter(const sim::Model& model, const std::string& modelDir,
+                                 const std::string& outDir, const std::string& baseName)
     : m_impl(std::make_unique<Impl>(model, modelDir, outDir, baseName)) {}
 
 VtkSeriesWriter::~VtkSeriesWriter() = default;
@@ -262,12 +269,14 @@ void VtkSeriesWriter::writeFrame(const sim::State& state, const sim::Metrics& me
 std::string VtkSeriesWriter::finish() {
   std::ostringstream pvd;
   pvd.precision(9);
-  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
+         "byte_order=\"LittleEndian\">\n"
       << "  <Collection>\n";
   for (std::size_t f = 0; f < m_impl->frameTimes.size(); ++f)
     for (int part = 0; part < kPartCount; ++part)
-      pvd << "    <DataSet timestep=\"" << m_impl->frameTimes[f] << "\" group=\"\" part=\"" << part << "\" name=\""
-          << kPartNames[part] << "\" file=\"" << m_impl->partPath(part, static_cast<int>(f)) << "\"/>\n";
+      pvd << "    <DataSet timestep=\"" << m_impl->frameTimes[f] << "\" group=\"\" part=\"" << part
+          << "\" name=\"" << kPartNames[part] << "\" file=\"" << m_impl->partPath(part, static_cast<int>(f))
+          << "\"/>\n";
   pvd << "  </Collection>\n</VTKFile>\n";
   const std::string name = m_impl->baseName + ".pvd";
   writeFileAtomically((fs::path(m_impl->outDir) / name).string(), pvd.str());

@@ -7,16 +7,17 @@
 ///                   group (ElementGroup index), is_slack
 ///   part 2 gut      the gut surface [m]; point data displacement_m (3), field data pressure_Pa
 ///   part 3 cavity   the lung-cavity surface [m]; field data thoracic_cavity_volume_m3, lung_volume_m3
-///   part 4 lungs    the right and the left lung surfaces [m] (empty for a model without them); cell data side
+///   part 4 lungs    the right and the left lung surfaces [m] (empty for a model without them); cell data
+///   side
 ///                   (0 right, 1 left), field data right_lung_volume_m3, left_lung_volume_m3, lung_volume_m3
 /// Every file is written to a temporary name and renamed; the .pvd is written by finish().
+
+#include <memory>
+#include <string>
 
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/State.h"
-
-#include <memory>
-#include <string>
 
 namespace pneuma::viz {
 

@@ -1,19 +1,19 @@
 #include "pneuma/meshing/AnatomyParams.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/JsonReader.h"
-
 #include <cmath>
 #include <fstream>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
 
 namespace pneuma::meshing {
 
 namespace {
 
-constexpr double kMm = 1e-3;                 // [m/mm]
+constexpr double kMm = 1e-3;                             // [m/mm]
 constexpr double kDeg = 3.14159265358979323846 / 180.0;  // [rad/deg]
-constexpr double kPaPerCmH2O = 98.0665;  // [Pa/cmH2O]
+constexpr double kPaPerCmH2O = 98.0665;                  // [Pa/cmH2O]
 
 using Reader = sim::JsonReader;
 
@@ -35,8 +35,8 @@ int count(const Reader& v, int lo, int hi) { return static_cast<int>(v.integerIn
 std::string readText(const std::string& path) { return sim::readInputFile(path); }
 
 RibLevel readRib(const Reader& r, std::size_t i) {
-  r.allowKeys({"level", "arc_length_mm", "posterior_ratio", "anterior_ratio", "end_angle_deg", "inclination_deg",
-               "lateral_tilt_deg", "height_mm", "thickness_mm", "neck_axis_deg"});
+  r.allowKeys({"level", "arc_length_mm", "posterior_ratio", "anterior_ratio", "end_angle_deg",
+               "inclination_deg", "lateral_tilt_deg", "height_mm", "thickness_mm", "neck_axis_deg"});
   if (r.has("level") && r.at("level").integerIn(1, 12) != static_cast<std::int64_t>(i + 1))
     r.at("level").fail("must be " + std::to_string(i + 1) + " (the ribs are listed in order)");
   RibLevel rib;
@@ -55,8 +55,8 @@ RibLevel readRib(const Reader& r, std::size_t i) {
 
 SpineParams readSpine(const Reader& r) {
   r.allowKeys({"lumbar_body_heights_mm", "thoracic_body_heights_mm", "lumbar_disc_mm", "thoracic_disc_mm",
-               "lumbar_body_width_depth_mm", "t1_body_width_depth_mm", "t12_body_width_depth_mm", "kyphosis_mm",
-               "spinous_process_mm", "thoracic_segments"});
+               "lumbar_body_width_depth_mm", "t1_body_width_depth_mm", "t12_body_width_depth_mm",
+               "kyphosis_mm", "spinous_process_mm", "thoracic_segments"});
   SpineParams s;
   s.lumbarHeights = lengthsMm(r.at("lumbar_body_heights_mm"), 5, 5.0, 60.0);
   s.thoracicHeights = lengthsMm(r.at("thoracic_body_heights_mm"), 12, 4.0, 40.0);
@@ -75,7 +75,8 @@ SpineParams readSpine(const Reader& r) {
     if (!seg.isArray() || seg.size() != 2) seg.fail("must be [first, last] vertebra numbers");
     const int first = count(seg[0], 1, 12);
     const int last = count(seg[1], 1, 12);
-    if (first != expected || last < first) seg.fail("must continue at T" + std::to_string(expected) + " and end at or before T12");
+    if (first != expected || last < first)
+      seg.fail("must continue at T" + std::to_string(expected) + " and end at or before T12");
     s.thoracicSegments.push_back({first, last});
     expected = last + 1;
   }
@@ -84,8 +85,9 @@ SpineParams readSpine(const Reader& r) {
 }
 
 SternumParams readSternum(const Reader& r) {
-  r.allowKeys({"manubrium_length_mm", "body_length_mm", "xiphoid_length_mm", "manubrium_width_mm", "body_width_mm",
-               "thickness_mm", "jugular_notch_vertebra", "jugular_notch_depth_mm", "inclination_deg"});
+  r.allowKeys({"manubrium_length_mm", "body_length_mm", "xiphoid_length_mm", "manubrium_width_mm",
+               "body_width_mm", "thickness_mm", "jugular_notch_vertebra", "jugular_notch_depth_mm",
+               "inclination_deg"});
   SternumParams s;
   s.manubriumLength = mm(r.at("manubrium_length_mm"), 10.0, 120.0);
   s.bodyLength = mm(r.at("body_length_mm"), 20.0, 200.0);
@@ -109,8 +111,8 @@ PelvisParams readPelvis(const Reader& r) {
 }
 
 AbdomenParams readAbdomen(const Reader& r) {
-  r.allowKeys({"pelvic_floor_z_mm", "inner_width_mm", "anterior_depth_mm", "posterior_depth_mm", "dome_height_mm",
-               "central_tendon_fraction", "umbilicus_z_mm"});
+  r.allowKeys({"pelvic_floor_z_mm", "inner_width_mm", "anterior_depth_mm", "posterior_depth_mm",
+               "dome_height_mm", "central_tendon_fraction", "umbilicus_z_mm"});
   AbdomenParams a;
   a.floorLevel = r.at("pelvic_floor_z_mm").numberIn(-300.0, 0.0) * kMm;
   a.width = mm(r.at("inner_width_mm"), 60.0, 600.0);
@@ -123,7 +125,8 @@ AbdomenParams readAbdomen(const Reader& r) {
 }
 
 Resolution readResolution(const Reader& r) {
-  r.allowKeys({"bone_edge_mm", "wall_rings", "ring_nodes", "dome_rings", "dome_rim_nodes", "intercostal_samples"});
+  r.allowKeys(
+      {"bone_edge_mm", "wall_rings", "ring_nodes", "dome_rings", "dome_rim_nodes", "intercostal_samples"});
   Resolution res;
   res.boneEdge = r.at("bone_edge_mm").numberIn(1.0, 30.0) * kMm;
   res.wallRings = count(r.at("wall_rings"), 3, 40);
@@ -135,9 +138,9 @@ Resolution readResolution(const Reader& r) {
 }
 
 Gains readGains(const Reader& r) {
-  r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
-               "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
-               "diaphragm_mass_kg", "joints"});
+  r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s",
+               "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o", "apposition_stiffness_fraction",
+               "intercostal_external_space_scale", "gut_wall_mass_kg", "diaphragm_mass_kg", "joints"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -171,7 +174,8 @@ Gains readGains(const Reader& r) {
   g.wallMass = r.at("gut_wall_mass_kg").positiveAtMost(100.0);
   g.diaphragmMass = r.at("diaphragm_mass_kg").positiveAtMost(10.0);
   const Reader joints = r.at("joints");
-  joints.allowKeys({"costovertebral_friction", "costovertebral_stiffness", "costotransverse_stiffness", "spine_friction", "spine_stiffness"});
+  joints.allowKeys({"costovertebral_friction", "costovertebral_stiffness", "costotransverse_stiffness",
+                    "spine_friction", "spine_stiffness"});
   g.costovertebralFriction = joints.at("costovertebral_friction").numberIn(0.0, 1e6);
   g.costovertebralStiffness = joints.at("costovertebral_stiffness").numberIn(0.0, 1e6);
   g.costotransverseStiffness = joints.at("costotransverse_stiffness").numberIn(0.0, 1e6);

@@ -15,7 +15,9 @@ struct Endpoint {
   Eigen::Vector3d weights{0, 0, 0};
 
   static Endpoint onBody(int b, const Eigen::Vector3d& p) { return {b, p, {-1, -1, -1}, {0, 0, 0}}; }
-  static Endpoint atNode(int n, const Eigen::Matrix3Xd& rest) { return {-1, rest.col(n), {n, -1, -1}, {1, 0, 0}}; }
+  static Endpoint atNode(int n, const Eigen::Matrix3Xd& rest) {
+    return {-1, rest.col(n), {n, -1, -1}, {1, 0, 0}};
+  }
 };
 
 /// Appends `e` to `set`; body points are stored in the body frame (world - com, axes world-parallel at rest).

@@ -1,20 +1,21 @@
 #include "GutSurface.h"
 
-#include "pneuma/meshing/TriangleMesh.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 
 namespace {
 
-constexpr double kSquareness = 2.4;          // superellipse exponent of the cavity cross-section
-constexpr double kBackHalfAngle = 55.0 * M_PI / 180.0;  // fixed back: within this angle of the posterior midline
-constexpr double kSpineNotchWidth = 0.40;    // [rad] angular width of the indentation around the spine
-constexpr double kNotchDepthFraction = 0.35; // [-] the spine notch reaches at most this far into the section
-constexpr int kFloorCapRings = 2;            // rings of the fixed floor cap between its centre and the wall
-constexpr double kStarMargin = 0.04;         // [m] cap and dome centres lie this far in front of the spine notch
+constexpr double kSquareness = 2.4;  // superellipse exponent of the cavity cross-section
+constexpr double kBackHalfAngle =
+    55.0 * M_PI / 180.0;                      // fixed back: within this angle of the posterior midline
+constexpr double kSpineNotchWidth = 0.40;     // [rad] angular width of the indentation around the spine
+constexpr double kNotchDepthFraction = 0.35;  // [-] the spine notch reaches at most this far into the section
+constexpr int kFloorCapRings = 2;             // rings of the fixed floor cap between its centre and the wall
+constexpr double kStarMargin = 0.04;  // [m] cap and dome centres lie this far in front of the spine notch
 
 double superPow(double u) { return std::copysign(std::pow(std::abs(u), 2.0 / kSquareness), u); }
 
@@ -68,7 +69,8 @@ class GutShape {
     const double c = std::cos(phi);
     double y = (c > 0 ? s.anterior : s.posterior) * superPow(c);
     // the lumbar spine bulges into the cavity on the posterior midline (at most a third of the depth)
-    const double notchY = std::min(m_spineFront, -s.posterior + kNotchDepthFraction * (s.anterior + s.posterior));
+    const double notchY =
+        std::min(m_spineFront, -s.posterior + kNotchDepthFraction * (s.anterior + s.posterior));
     const double d = std::remainder(phi - M_PI, 2.0 * M_PI);
     y += (notchY + s.posterior) * std::exp(-d * d / (kSpineNotchWidth * kSpineNotchWidth));
     return {s.lateral * superPow(std::sin(phi)), y, z};
@@ -82,7 +84,8 @@ class GutShape {
 double ringAngle(int j, int n) { return 2.0 * M_PI * j / n; }
 
 /// Triangles between two closed rings (node indices, angles 2 pi j / n), merged by angle.
-void zipRings(const std::vector<int>& lower, const std::vector<int>& upper, std::vector<Eigen::Vector3i>& tris) {
+void zipRings(const std::vector<int>& lower, const std::vector<int>& upper,
+              std::vector<Eigen::Vector3i>& tris) {
   const long na = static_cast<long>(lower.size());
   const long nb = static_cast<long>(upper.size());
   long i = 0, j = 0;
@@ -90,12 +93,16 @@ void zipRings(const std::vector<int>& lower, const std::vector<int>& upper, std:
     // advance on the ring whose next node comes first (exact integer comparison of (i+1)/na and (j+1)/nb)
     const bool stepLower = j == nb || (i < na && (i + 1) * nb <= (j + 1) * na);
     if (stepLower) {
-      if (na > 1) tris.emplace_back(lower[static_cast<std::size_t>(i % na)], lower[static_cast<std::size_t>((i + 1) % na)],
-                                    upper[static_cast<std::size_t>(j % nb)]);
+      if (na > 1)
+        tris.emplace_back(lower[static_cast<std::size_t>(i % na)],
+                          lower[static_cast<std::size_t>((i + 1) % na)],
+                          upper[static_cast<std::size_t>(j % nb)]);
       ++i;
     } else {
-      if (nb > 1) tris.emplace_back(lower[static_cast<std::size_t>(i % na)], upper[static_cast<std::size_t>((j + 1) % nb)],
-                                    upper[static_cast<std::size_t>(j % nb)]);
+      if (nb > 1)
+        tris.emplace_back(lower[static_cast<std::size_t>(i % na)],
+                          upper[static_cast<std::size_t>((j + 1) % nb)],
+                          upper[static_cast<std::size_t>(j % nb)]);
       ++j;
     }
   }
@@ -142,7 +149,8 @@ GutSurface buildGut(const AnatomyParams& a, const Skeleton& sk) {
     for (int j = 0; j < res.ringNodes; ++j) {
       const double phi = ringAngle(j, res.ringNodes);
       const bool isBack = std::abs(std::remainder(phi - M_PI, 2.0 * M_PI)) <= kBackHalfAngle + 1e-9;
-      ring.push_back(addNode(shape.wall(phi, t), k == 0 || isBack ? sim::NodeRegion::Fixed : sim::NodeRegion::Wall));
+      ring.push_back(
+          addNode(shape.wall(phi, t), k == 0 || isBack ? sim::NodeRegion::Fixed : sim::NodeRegion::Wall));
     }
     g.wallRing.push_back(ring);
     rings.push_back(ring);
@@ -162,7 +170,8 @@ GutSurface buildGut(const AnatomyParams& a, const Skeleton& sk) {
   const double apexZ = rimMeanZ + a.abdomen.domeHeight;
   for (int r = 0; r < res.domeRings; ++r) {
     const double s = 1.0 - static_cast<double>(r) / res.domeRings;  // radius fraction
-    const int n = r == 0 ? res.domeRimNodes : std::max(6, static_cast<int>(std::lround(res.domeRimNodes * s)));
+    const int n =
+        r == 0 ? res.domeRimNodes : std::max(6, static_cast<int>(std::lround(res.domeRimNodes * s)));
     std::vector<int> ring;
     for (int j = 0; j < n; ++j) {
       const double phi = ringAngle(j, n);

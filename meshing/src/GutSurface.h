@@ -3,23 +3,23 @@
 /// The sealed gut surface of Section 6: a stack of node rings from the pelvic floor to the costal
 /// margin (the abdominal wall), closed below by a fixed floor cap and above by the diaphragm dome.
 
-#include "Skeleton.h"
-
-#include "pneuma/sim/Model.h"
-
 #include <vector>
+
+#include "Skeleton.h"
+#include "pneuma/sim/Model.h"
 
 namespace pneuma::meshing {
 
 /// Gut nodes and their ring structure. Ring node j sits at angle 2 pi j / n around the vertical axis,
 /// j = 0 on the anterior midline, increasing toward the right side.
 struct GutSurface {
-  Eigen::Matrix3Xd rest;                  ///< [m] node rest positions (3 x #N)
-  std::vector<sim::NodeRegion> region;    ///< (#N)
-  Eigen::Matrix3Xi triangles;             ///< outward (3 x #F)
-  std::vector<std::vector<int>> wallRing; ///< node indices of the wall rings, floor (0) to just below the rim
-  std::vector<std::vector<int>> domeRing; ///< node indices of the dome rings, rim (0) to the innermost ring
-  int apex = -1;                          ///< the dome's apex node
+  Eigen::Matrix3Xd rest;                ///< [m] node rest positions (3 x #N)
+  std::vector<sim::NodeRegion> region;  ///< (#N)
+  Eigen::Matrix3Xi triangles;           ///< outward (3 x #F)
+  std::vector<std::vector<int>>
+      wallRing;  ///< node indices of the wall rings, floor (0) to just below the rim
+  std::vector<std::vector<int>> domeRing;  ///< node indices of the dome rings, rim (0) to the innermost ring
+  int apex = -1;                           ///< the dome's apex node
 };
 
 /// Builds the gut surface of `a` fitted to the skeleton `sk`.

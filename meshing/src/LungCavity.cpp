@@ -1,13 +1,6 @@
 #include "LungCavity.h"
 
-#include "Anchors.h"
-
-#include "pneuma/meshing/MeshTools.h"
-#include "pneuma/meshing/Sweep.h"
-#include "pneuma/sim/Error.h"
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +8,11 @@
 #include <map>
 #include <numeric>
 #include <string>
+
+#include "Anchors.h"
+#include "pneuma/meshing/MeshTools.h"
+#include "pneuma/meshing/Sweep.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 
@@ -28,8 +26,8 @@ std::array<long long, 3> gridKey(const Eigen::Vector3d& p) {
 }
 
 /// Barycentric coordinates of the point of triangle (a, b, c) closest to p, and its distance [m].
-Eigen::Vector3d closestBarycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                   const Eigen::Vector3d& c, double& distance) {
+Eigen::Vector3d closestBarycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                   const Eigen::Vector3d& b, const Eigen::Vector3d& c, double& distance) {
   // project onto the plane, then clamp to the triangle by checking the edges (Ericson 2005, 5.1.5)
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
@@ -60,34 +58,34 @@ Eigen::Vector3d closestBarycentric(const Eigen::Vector3d& p, const Eigen::Vector
   return w;
 }
 
-
 // ---- the two lungs: the cavity minus the mediastinum, split at the midline
 
 /// Proportions of the mediastinum, as fractions of the cavity's rest extent (W lateral, D anteroposterior,
-/// H craniocaudal). The central block (trachea, oesophagus, great vessels, the vertebral bodies' bulge) runs the
-/// cavity's full depth and height; the heart is an ellipsoid that sits on the diaphragm's central tendon, left of
-/// the block's centre and anterior (adult heart about 12 x 8.5 x 6 cm). The whole mediastinum's lateral offset
-/// from the cavity's midline is solved for the right/left split.
-constexpr double kBlockHalfWidth = 0.075;   // [-] of W: a 3.5-4.5 cm wide central mediastinum
-constexpr double kHeartHalfWidth = 0.23;    // [-] of W (lateral semi-axis, about 6 cm)
-constexpr double kHeartHalfDepth = 0.24;    // [-] of D (anteroposterior semi-axis, about 4.5 cm)
-constexpr double kHeartHalfHeight = 0.24;   // [-] of H (craniocaudal semi-axis, about 5.5 cm)
-constexpr double kHeartCentreX = -0.08;     // [-] of W from the block's centre: to the left
-constexpr double kHeartCentreY = 0.58;      // [-] of D from the back: anterior of the middle
-constexpr double kHeartSink = 0.05;         // [-] of the vertical semi-axis below the floor under its centre
-/// Right lung's share of the two lungs' volume: 53.5 % (upright and supine CT, Yamada et al. 2020, Respiration
-/// 99:598, Table 3: standing 53.3 +/- 1.3 %, supine 53.6 +/- 1.5 %).
+/// H craniocaudal). The central block (trachea, oesophagus, great vessels, the vertebral bodies' bulge) runs
+/// the cavity's full depth and height; the heart is an ellipsoid that sits on the diaphragm's central tendon,
+/// left of the block's centre and anterior (adult heart about 12 x 8.5 x 6 cm). The whole mediastinum's
+/// lateral offset from the cavity's midline is solved for the right/left split.
+constexpr double kBlockHalfWidth = 0.075;  // [-] of W: a 3.5-4.5 cm wide central mediastinum
+constexpr double kHeartHalfWidth = 0.23;   // [-] of W (lateral semi-axis, about 6 cm)
+constexpr double kHeartHalfDepth = 0.24;   // [-] of D (anteroposterior semi-axis, about 4.5 cm)
+constexpr double kHeartHalfHeight = 0.24;  // [-] of H (craniocaudal semi-axis, about 5.5 cm)
+constexpr double kHeartCentreX = -0.08;    // [-] of W from the block's centre: to the left
+constexpr double kHeartCentreY = 0.58;     // [-] of D from the back: anterior of the middle
+constexpr double kHeartSink = 0.05;        // [-] of the vertical semi-axis below the floor under its centre
+/// Right lung's share of the two lungs' volume: 53.5 % (upright and supine CT, Yamada et al. 2020,
+/// Respiration 99:598, Table 3: standing 53.3 +/- 1.3 %, supine 53.6 +/- 1.5 %).
 constexpr double kRightShare = 0.535;
-constexpr double kOnSurface = 1e-7;         // [m] a lung vertex this close to a cavity triangle lies on it
+constexpr double kOnSurface = 1e-7;  // [m] a lung vertex this close to a cavity triangle lies on it
 
 TriangleMesh box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   TriangleMesh m;
   m.vertices.resize(3, 8);
   for (int i = 0; i < 8; ++i)
-    m.vertices.col(i) = Eigen::Vector3d((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(), (i & 4) ? hi.z() : lo.z());
+    m.vertices.col(i) =
+        Eigen::Vector3d((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(), (i & 4) ? hi.z() : lo.z());
   m.triangles.resize(3, 12);
   m.triangles << 0, 0, 4, 4, 0, 0, 2, 2, 0, 0, 1, 1,  //
-      2, 3, 5, 7, 1, 5, 6, 7, 4, 6, 3, 7,              //
+      2, 3, 5, 7, 1, 5, 6, 7, 4, 6, 3, 7,             //
       3, 1, 7, 6, 5, 4, 7, 3, 6, 2, 7, 5;
   return m;
 }
@@ -104,8 +102,8 @@ TriangleMesh ellipsoid(const Eigen::Vector3d& c, const Eigen::Vector3d& r) {
   return sweepTube(st, 24, false);
 }
 
-/// z [m] of the first cavity surface point straight above (`up`) or below `p`, with its triangle and barycentric
-/// weights; false when the vertical line misses.
+/// z [m] of the first cavity surface point straight above (`up`) or below `p`, with its triangle and
+/// barycentric weights; false when the vertical line misses.
 bool verticalHit(const TriangleMesh& cavity, const Eigen::Vector3d& p, bool up, int& face, Eigen::Vector3d& w,
                  double& z) {
   double best = std::numeric_limits<double>::infinity();
@@ -131,8 +129,8 @@ bool verticalHit(const TriangleMesh& cavity, const Eigen::Vector3d& p, bool up, 
   return std::isfinite(best);
 }
 
-/// Binds each vertex of `lung` to the cavity (sim::LungSurface): a cavity vertex itself, the cavity triangle it
-/// lies on, or the cavity points straight above and below it.
+/// Binds each vertex of `lung` to the cavity (sim::LungSurface): a cavity vertex itself, the cavity triangle
+/// it lies on, or the cavity points straight above and below it.
 sim::LungSurface embed(const TriangleMesh& lung, const TriangleMesh& cavity, const std::string& part) {
   std::map<std::array<long long, 3>, int> cavityVertex;
   for (int v = 0; v < cavity.vertexCount(); ++v) cavityVertex.emplace(gridKey(cavity.vertices.col(v)), v);
@@ -182,11 +180,14 @@ std::vector<TriangleMesh> components(const TriangleMesh& m) {
   std::vector<int> parent(static_cast<std::size_t>(m.vertexCount()));
   std::iota(parent.begin(), parent.end(), 0);
   auto root = [&](int v) {
-    while (parent[static_cast<std::size_t>(v)] != v) v = parent[static_cast<std::size_t>(v)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
+    while (parent[static_cast<std::size_t>(v)] != v)
+      v = parent[static_cast<std::size_t>(v)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
     return v;
   };
   for (int f = 0; f < m.triangleCount(); ++f)
-    for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(root(m.triangles(k, f)))] = root(m.triangles(0, f));
+    for (int k = 1; k < 3; ++k)
+      parent[static_cast<std::size_t>(root(m.triangles(k, f)))] = root(m.triangles(0, f));
   std::map<int, int> index;  // root -> component
   std::vector<TriangleMesh> out;
   std::vector<std::map<int, int>> local;
@@ -219,20 +220,23 @@ struct LungMeshes {
 /// The cavity minus the mediastinum shifted `shift` [m] from the cavity's midline (x > 0: right).
 LungMeshes carveLungs(const TriangleMesh& cavity, double shift) {
   const Eigen::Vector3d lo = cavity.vertices.rowwise().minCoeff(), hi = cavity.vertices.rowwise().maxCoeff();
-  const Eigen::Vector3d size = hi - lo, pad(0.0, 0.02, 0.02);  // [m] the block overhangs front, back, top, bottom
+  const Eigen::Vector3d size = hi - lo,
+                        pad(0.0, 0.02, 0.02);  // [m] the block overhangs front, back, top, bottom
   const double midX = 0.5 * (lo.x() + hi.x()) + shift;
   const TriangleMesh block = box(Eigen::Vector3d(midX - kBlockHalfWidth * size.x(), lo.y(), lo.z()) - pad,
                                  Eigen::Vector3d(midX + kBlockHalfWidth * size.x(), hi.y(), hi.z()) + pad);
   // the heart rests on the floor under its centre
-  const Eigen::Vector3d r(kHeartHalfWidth * size.x(), kHeartHalfDepth * size.y(), kHeartHalfHeight * size.z());
+  const Eigen::Vector3d r(kHeartHalfWidth * size.x(), kHeartHalfDepth * size.y(),
+                          kHeartHalfHeight * size.z());
   Eigen::Vector3d c(midX + kHeartCentreX * size.x(), lo.y() + kHeartCentreY * size.y(), hi.z());
   int face = -1;
   Eigen::Vector3d w;
   double floorZ = lo.z();
-  if (!verticalHit(cavity, c, false, face, w, floorZ)) throw sim::Error("lungs: no cavity floor under the heart");
+  if (!verticalHit(cavity, c, false, face, w, floorZ))
+    throw sim::Error("lungs: no cavity floor under the heart");
   c.z() = floorZ + (1.0 - kHeartSink) * r.z();
-  const TriangleMesh carved = subtract(subtract(cavity, block, kGrid, "lungs (central mediastinum)"), ellipsoid(c, r),
-                                       kGrid, "lungs (heart)");
+  const TriangleMesh carved = subtract(subtract(cavity, block, kGrid, "lungs (central mediastinum)"),
+                                       ellipsoid(c, r), kGrid, "lungs (heart)");
   // each component to the side of its centroid; the right lung lies at x > 0 (world RAS)
   LungMeshes out;
   for (const TriangleMesh& part : components(carved)) {
@@ -247,7 +251,8 @@ LungMeshes carveLungs(const TriangleMesh& cavity, double shift) {
 }  // namespace
 
 void buildLungs(const TriangleMesh& cavity, sim::Model& model) {
-  // solve the mediastinum's lateral offset for the right lung's share (secant; the share falls as it moves right)
+  // solve the mediastinum's lateral offset for the right lung's share (secant; the share falls as it moves
+  // right)
   const double width = cavity.vertices.row(0).maxCoeff() - cavity.vertices.row(0).minCoeff();
   auto share = [&](const LungMeshes& l) {
     const double r = enclosedVolume(l.right.vertices, l.right.triangles);
@@ -295,7 +300,8 @@ double buildCavity(const Skeleton& sk, const GutSurface& gut, sim::Model& model)
   std::vector<int> source;
   const TriangleMesh hull = convexHull(hullInput, source);
   std::map<std::array<long long, 3>, int> hullVertex;
-  for (int v = 0; v < hull.vertexCount(); ++v) hullVertex.emplace(gridKey(hull.vertices.col(v)), source[static_cast<std::size_t>(v)]);
+  for (int v = 0; v < hull.vertexCount(); ++v)
+    hullVertex.emplace(gridKey(hull.vertices.col(v)), source[static_cast<std::size_t>(v)]);
   TriangleMesh gutMesh;
   gutMesh.vertices = gut.rest;
   gutMesh.triangles = gut.triangles;
@@ -316,7 +322,8 @@ double buildCavity(const Skeleton& sk, const GutSurface& gut, sim::Model& model)
     for (int f = 0; f < gut.triangles.cols(); ++f) {
       double d = 0.0;
       const Eigen::Vector3i t = gut.triangles.col(f);
-      const Eigen::Vector3d w = closestBarycentric(p, gut.rest.col(t(0)), gut.rest.col(t(1)), gut.rest.col(t(2)), d);
+      const Eigen::Vector3d w =
+          closestBarycentric(p, gut.rest.col(t(0)), gut.rest.col(t(1)), gut.rest.col(t(2)), d);
       if (d < best) {
         best = d;
         e = Endpoint{-1, p, t, w};

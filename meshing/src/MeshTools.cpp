@@ -1,8 +1,6 @@
 // All CGAL code of pneuma::meshing (kept in one translation unit: CGAL dominates compile time).
 #include "pneuma/meshing/MeshTools.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
@@ -13,6 +11,8 @@
 
 #include <array>
 #include <map>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 

@@ -1,20 +1,19 @@
 #include "pneuma/meshing/ModelBuilder.h"
 
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
 #include "Anchors.h"
 #include "GutSurface.h"
 #include "LungCavity.h"
 #include "MuscleNetwork.h"
 #include "Skeleton.h"
-
 #include "pneuma/meshing/MeshTools.h"
 #include "pneuma/meshing/Tetrahedralizer.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
-
-#include <algorithm>
-#include <cmath>
-#include <map>
-#include <sstream>
 
 namespace pneuma::meshing {
 
@@ -35,8 +34,9 @@ void buildBodies(const AnatomyParams& a, const Skeleton& sk, BuiltModel& out) {
   for (int i = 0; i < n; ++i) {
     const Bone& bone = sk.bones[static_cast<std::size_t>(i)];
     auto m = mirrorOf.find(i);
-    world[static_cast<std::size_t>(i)] = m != mirrorOf.end() ? world[static_cast<std::size_t>(m->second)].mirroredX()
-                                                              : remeshIsotropic(bone.mesh, a.resolution.boneEdge, bone.name);
+    world[static_cast<std::size_t>(i)] = m != mirrorOf.end()
+                                             ? world[static_cast<std::size_t>(m->second)].mirroredX()
+                                             : remeshIsotropic(bone.mesh, a.resolution.boneEdge, bone.name);
     const MassProperties mp = massProperties(world[static_cast<std::size_t>(i)], a.boneDensity);
     b.name.push_back(bone.name);
     b.isFixed.push_back(bone.isFixed ? 1 : 0);
@@ -75,12 +75,15 @@ void buildGutNodes(const AnatomyParams& a, const GutSurface& g, BuiltModel& out)
   sim::Model& m = out.model;
   m.nodes.rest = g.rest;
   m.nodes.region = g.region;
-  const auto count = [&](sim::NodeRegion region) { return std::count(g.region.begin(), g.region.end(), region); };
+  const auto count = [&](sim::NodeRegion region) {
+    return std::count(g.region.begin(), g.region.end(), region);
+  };
   const double wallNode = a.gains.wallMass / static_cast<double>(count(sim::NodeRegion::Wall));
   const double domeNode = a.gains.diaphragmMass / static_cast<double>(count(sim::NodeRegion::Diaphragm));
   m.nodes.mass.resize(g.rest.cols());
   for (Eigen::Index i = 0; i < g.rest.cols(); ++i) {
-    m.nodes.mass(i) = g.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Diaphragm ? domeNode : wallNode;
+    m.nodes.mass(i) =
+        g.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Diaphragm ? domeNode : wallNode;
   }
   m.gut.triangles = g.triangles;
   m.gut.kappa = a.gains.gutKappa;
@@ -90,15 +93,17 @@ void buildGutNodes(const AnatomyParams& a, const GutSurface& g, BuiltModel& out)
   TriangleMesh surface{g.rest, g.triangles};
   const MeshCheck check = checkMesh(surface);
   if (!check.isValid()) {
-    throw sim::Error(std::string("gut: surface is not sealed: manifold ") + (check.isManifold ? "yes" : "no") +
-                     ", closed " + (check.isClosed ? "yes" : "no") + ", self-intersecting " +
-                     (check.isSelfIntersecting ? "yes" : "no") + ", outward " + (check.isOutward ? "yes" : "no"));
+    throw sim::Error(std::string("gut: surface is not sealed: manifold ") +
+                     (check.isManifold ? "yes" : "no") + ", closed " + (check.isClosed ? "yes" : "no") +
+                     ", self-intersecting " + (check.isSelfIntersecting ? "yes" : "no") + ", outward " +
+                     (check.isOutward ? "yes" : "no"));
   }
   const TetMesh tets = tetrahedralize(surface, "gut");
   const double v = enclosedVolume(g.rest, g.triangles);
   if (std::abs(tets.volume - v) > kTetVolumeTolerance * v) {
     std::ostringstream s;
-    s << "gut: TetGen volume " << tets.volume * 1e6 << " mL differs from the surface volume " << v * 1e6 << " mL";
+    s << "gut: TetGen volume " << tets.volume * 1e6 << " mL differs from the surface volume " << v * 1e6
+      << " mL";
     throw sim::Error(s.str());
   }
   out.report.tetrahedra = static_cast<int>(tets.tets.cols());
@@ -127,7 +132,9 @@ void buildLandmarks(const AnatomyParams& a, const Skeleton& sk, const GutSurface
   int navel = g.wallRing.front().front();
   for (const auto& ring : g.wallRing) {
     const int n = ring.front();
-    if (std::abs(g.rest(2, n) - a.abdomen.umbilicusLevel) < std::abs(g.rest(2, navel) - a.abdomen.umbilicusLevel)) navel = n;
+    if (std::abs(g.rest(2, n) - a.abdomen.umbilicusLevel) <
+        std::abs(g.rest(2, navel) - a.abdomen.umbilicusLevel))
+      navel = n;
   }
   add("umbilicus", Endpoint::atNode(navel, g.rest));
   add("diaphragm_apex", Endpoint::atNode(g.apex, g.rest));

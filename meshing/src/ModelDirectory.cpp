@@ -1,13 +1,11 @@
-#include "pneuma/meshing/ModelBuilder.h"
-
-#include "VtpWriter.h"
-
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/ModelIO.h"
-
 #include <unistd.h>
 
 #include <filesystem>
+
+#include "VtpWriter.h"
+#include "pneuma/meshing/ModelBuilder.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
 
 namespace pneuma::meshing {
 
@@ -18,7 +16,8 @@ namespace {
 // a sibling "<target>.<tag>-<pid>-<n>" that does not exist yet, so that nothing of anyone else's is touched
 fs::path freshSibling(const fs::path& target, const char* tag) {
   for (int n = 0;; ++n) {
-    const fs::path p = target.string() + "." + tag + "-" + std::to_string(static_cast<long>(::getpid())) + "-" + std::to_string(n);
+    const fs::path p = target.string() + "." + tag + "-" + std::to_string(static_cast<long>(::getpid())) +
+                       "-" + std::to_string(n);
     if (!fs::exists(fs::symlink_status(p))) return p;
   }
 }
@@ -45,7 +44,8 @@ void writeModelDirectory(const BuiltModel& built, const std::string& dir) {
     fs::create_directories(tmp / "meshes");
     const sim::Bodies& b = built.model.bodies;
     for (int i = 0; i < b.size(); ++i) {
-      writeVtp(built.bodyMeshes[static_cast<std::size_t>(i)], (tmp / b.mesh[static_cast<std::size_t>(i)]).string());
+      writeVtp(built.bodyMeshes[static_cast<std::size_t>(i)],
+               (tmp / b.mesh[static_cast<std::size_t>(i)]).string());
     }
     sim::saveModel(built.model, tmp.string());
 

@@ -1,11 +1,10 @@
 #include "pneuma/meshing/ModelSummary.h"
 
-#include "pneuma/meshing/TriangleMesh.h"
-
-#include <nlohmann/json.hpp>
-
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 
@@ -42,7 +41,8 @@ ModelSummary summarizeModel(const sim::Model& m) {
   s.nodes = m.nodes.size();
   for (int i = 0; i < s.nodes; ++i) {
     if (m.nodes.isFixed(i)) ++s.fixedNodes;
-    if (m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Wall) s.gutWallMass += m.nodes.mass(i);
+    if (m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Wall)
+      s.gutWallMass += m.nodes.mass(i);
   }
   for (sim::ElementGroup g : m.elements.group) ++s.elements[static_cast<std::size_t>(g)];
   s.gutVolume = enclosedVolume(m.nodes.rest, m.gut.triangles);
@@ -76,8 +76,8 @@ std::string summaryText(const ModelSummary& s) {
     << "nodes:           " << s.nodes << " (" << s.fixedNodes << " fixed)\n"
     << "elements:\n";
   for (int g = 0; g < sim::kElementGroupCount; ++g) {
-    o << "  " << sim::groupName(static_cast<sim::ElementGroup>(g)) << ": " << s.elements[static_cast<std::size_t>(g)]
-      << "\n";
+    o << "  " << sim::groupName(static_cast<sim::ElementGroup>(g)) << ": "
+      << s.elements[static_cast<std::size_t>(g)] << "\n";
   }
   o.setf(std::ios::fixed);
   o.precision(1);

@@ -1,14 +1,12 @@
 #include "MuscleNetwork.h"
 
-#include "Anchors.h"
-
-#include "pneuma/sim/Error.h"
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <tuple>
+
+#include "Anchors.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 
@@ -18,10 +16,11 @@ using sim::ElementGroup;
 
 constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib that makes intercostals oblique
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
-constexpr double kAppositionReach = 0.04;  // [m] farthest rib point an apposed dome node is tied to
+constexpr double kAppositionReach = 0.04;    // [m] farthest rib point an apposed dome node is tied to
 constexpr std::size_t kAppositionRings = 3;  // [-] dome rings inside the rim that lie on the rib cage
-// [m] how far beyond the rib point an apposition spring is anchored (in the rib's frame), along the line from the
-// dome node: a spring this long holds the node at its distance from the rib face and lets it slide along the face
+// [m] how far beyond the rib point an apposition spring is anchored (in the rib's frame), along the line from
+// the dome node: a spring this long holds the node at its distance from the rib face and lets it slide along
+// the face
 constexpr double kAppositionSlide = 0.2;
 constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
 constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
@@ -33,7 +32,8 @@ class ElementSink {
   ElementSink(const Gains& gains, sim::Model& model) : m_gains(gains), m_model(model) {}
 
   /// Adds one element; `active` [-] scales kac (0: a passive element), `stiffness` [-] scales kpe and b.
-  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, double active = 1.0, double stiffness = 1.0) {
+  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, double active = 1.0,
+           double stiffness = 1.0) {
     const double l0 = (a.world - b.world).norm();
     if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
     sim::Elements& e = m_model.elements;
@@ -57,14 +57,18 @@ class ElementSink {
 
 /// Angle of `p` round the ribcage's vertical axis through (0, axisY), from the posterior midline
 /// toward the sternum on either side [rad].
-double aroundAxis(const Eigen::Vector3d& p, double axisY) { return std::atan2(std::abs(p.x()), axisY - p.y()); }
+double aroundAxis(const Eigen::Vector3d& p, double axisY) {
+  return std::atan2(std::abs(p.x()), axisY - p.y());
+}
 
 /// Arc length of the point of `c` at the same angle round the ribcage axis as `p`.
 double sameAngleArc(const RibCurve& c, const Eigen::Vector3d& p, double axisY) {
   const double target = aroundAxis(p, axisY);
   std::size_t best = 0;
   for (std::size_t i = 1; i < c.centre.size(); ++i) {
-    if (std::abs(aroundAxis(c.centre[i], axisY) - target) < std::abs(aroundAxis(c.centre[best], axisY) - target)) best = i;
+    if (std::abs(aroundAxis(c.centre[i], axisY) - target) <
+        std::abs(aroundAxis(c.centre[best], axisY) - target))
+      best = i;
   }
   return c.arc[best];
 }
@@ -100,9 +104,10 @@ void addIntercostals(const AnatomyParams& a, const Skeleton& sk, ElementSink& si
           // the lower rib's point straight below, shifted forward (external) or backward (internal) along it
           const double sLow = sameAngleArc(low, top, axisY);
           if ((low.at(sLow) - top).norm() > kMaxIntercostalGap) continue;
-          sink.add(group, Endpoint::onBody(bUp, top),
-                   Endpoint::onBody(bLow, low.at(sLow + shift, 0.5 * inward * low.thickness, 0.5 * low.height)),
-                   group == ElementGroup::IntercostalExternal ? externalScale : 1.0);
+          sink.add(
+              group, Endpoint::onBody(bUp, top),
+              Endpoint::onBody(bLow, low.at(sLow + shift, 0.5 * inward * low.thickness, 0.5 * low.height)),
+              group == ElementGroup::IntercostalExternal ? externalScale : 1.0);
         }
       }
     }
@@ -143,9 +148,11 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
     const bool isLast = r + 1 == gut.domeRing.size();
     const std::size_t nIn = isLast ? 1 : gut.domeRing[r + 1].size();
     for (std::size_t j = 0; j < outer.size(); ++j) {
-      const std::size_t jIn = static_cast<std::size_t>(std::lround(static_cast<double>(j) * nIn / outer.size())) % nIn;
+      const std::size_t jIn =
+          static_cast<std::size_t>(std::lround(static_cast<double>(j) * nIn / outer.size())) % nIn;
       const int inner = isLast ? gut.apex : gut.domeRing[r + 1][jIn];
-      sink.add(ElementGroup::Diaphragm, Endpoint::atNode(outer[j], gut.rest), Endpoint::atNode(inner, gut.rest));
+      sink.add(ElementGroup::Diaphragm, Endpoint::atNode(outer[j], gut.rest),
+               Endpoint::atNode(inner, gut.rest));
     }
   }
   // passive hoops round every inner ring keep neighbouring strands together (connective tissue, kac = 0)
@@ -163,16 +170,16 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
   }
 }
 
-/// Apposition: the outer dome lies on the inner face of the lower rib cage (the zone of apposition), held there by
-/// the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs rather than
-/// bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer & Wilson 2016, J Appl
-/// Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide along them: the apposed
-/// dome shortens and descends like a piston while the ribs rise past it. Each node of the first kAppositionRings
-/// rings inside the rim gets a two-sided spring (Cartilage group) toward the nearest point of the inner face of
-/// ribs 6-12 within kAppositionReach, anchored kAppositionSlide beyond that point on the same line: a long spring
-/// resists a change of the node's distance to the face and hardly a slide across it (a slide s lengthens it by about
-/// s^2 / 2 l). Its stiffness and damping along the line are those of a spring reaching only the rib point, the
-/// cartilage group's times `fraction`.
+/// Apposition: the outer dome lies on the inner face of the lower rib cage (the zone of apposition), held
+/// there by the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs
+/// rather than bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer &
+/// Wilson 2016, J Appl Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide
+/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. Each node of
+/// the first kAppositionRings rings inside the rim gets a two-sided spring (Cartilage group) toward the
+/// nearest point of the inner face of ribs 6-12 within kAppositionReach, anchored kAppositionSlide beyond
+/// that point on the same line: a long spring resists a change of the node's distance to the face and hardly
+/// a slide across it (a slide s lengthens it by about s^2 / 2 l). Its stiffness and damping along the line
+/// are those of a spring reaching only the rib point, the cartilage group's times `fraction`.
 void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, ElementSink& sink) {
   if (fraction <= 0.0) return;
   std::vector<Endpoint> face;
@@ -180,7 +187,8 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
     for (int side : {kRight, kLeft}) {
       const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
       const int b = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
-      for (double s = 0.0; s <= r.length(); s += kCostalSample) face.push_back(Endpoint::onBody(b, r.at(s, 0.5 * r.thickness)));
+      for (double s = 0.0; s <= r.length(); s += kCostalSample)
+        face.push_back(Endpoint::onBody(b, r.at(s, 0.5 * r.thickness)));
     }
   }
   for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
@@ -189,7 +197,8 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
       const Endpoint& rib = nearest(face, p);
       const double reach = (rib.world - p).norm();
       if (reach > kAppositionReach || reach < 1e-6) continue;
-      const Endpoint anchor = Endpoint::onBody(rib.body, rib.world + kAppositionSlide * (rib.world - p) / reach);
+      const Endpoint anchor =
+          Endpoint::onBody(rib.body, rib.world + kAppositionSlide * (rib.world - p) / reach);
       sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), anchor, 0.0,
                fraction * (reach + kAppositionSlide) / reach);
     }
@@ -222,7 +231,9 @@ void addRectus(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
 /// costal margin); only where the wall moves.
 void addTransversusObliques(const GutSurface& gut, ElementSink& sink) {
   const int m = static_cast<int>(gut.wallRing.front().size());
-  auto moving = [&](int node) { return gut.region[static_cast<std::size_t>(node)] != sim::NodeRegion::Fixed; };
+  auto moving = [&](int node) {
+    return gut.region[static_cast<std::size_t>(node)] != sim::NodeRegion::Fixed;
+  };
   auto node = [&](std::size_t k, int j) { return gut.wallRing[k][static_cast<std::size_t>((j + m) % m)]; };
   for (std::size_t k = 1; k < gut.wallRing.size(); ++k) {
     for (int j = 0; j < m; ++j) {
@@ -242,7 +253,8 @@ void addTransversusObliques(const GutSurface& gut, ElementSink& sink) {
       const bool lowerIsAtJ = isRight == isExternal;
       const int upper = lowerIsAtJ ? q[3] : q[2];
       const int lower = lowerIsAtJ ? q[0] : q[1];
-      sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(upper, gut.rest), Endpoint::atNode(lower, gut.rest));
+      sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(upper, gut.rest),
+               Endpoint::atNode(lower, gut.rest));
     }
   }
   const std::vector<int>& rim = gut.domeRing.front();
@@ -251,12 +263,14 @@ void addTransversusObliques(const GutSurface& gut, ElementSink& sink) {
     const int top = node(gut.wallRing.size() - 1, j);
     if (!moving(top)) continue;
     const std::size_t jRim = static_cast<std::size_t>(std::lround(static_cast<double>(j) * nRim / m)) % nRim;
-    sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(top, gut.rest), Endpoint::atNode(rim[jRim], gut.rest));
+    sink.add(ElementGroup::TransversusObliques, Endpoint::atNode(top, gut.rest),
+             Endpoint::atNode(rim[jRim], gut.rest));
   }
 }
 
 /// Three attachment points around `p`: above and below along `up`, and one `back` from it.
-std::array<Eigen::Vector3d, 3> triad(const Eigen::Vector3d& p, const Eigen::Vector3d& up, const Eigen::Vector3d& back) {
+std::array<Eigen::Vector3d, 3> triad(const Eigen::Vector3d& p, const Eigen::Vector3d& up,
+                                     const Eigen::Vector3d& back) {
   return {p + 0.007 * up, p - 0.007 * up, p + 0.008 * back};
 }
 
@@ -272,10 +286,12 @@ void addCartilage(const Skeleton& sk, ElementSink& sink) {
       int other = sk.sternum;
       std::array<Eigen::Vector3d, 3> otherPts;
       if (level <= 7) {
-        const Eigen::Vector3d notch = sk.costalNotch[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+        const Eigen::Vector3d notch =
+            sk.costalNotch[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
         otherPts = triad(notch, -sk.sternumAxis, sk.sternumAxis.cross(Eigen::Vector3d::UnitX()).normalized());
       } else {
-        const RibCurve& above = sk.ribCurve[static_cast<std::size_t>(level - 2)][static_cast<std::size_t>(side)];
+        const RibCurve& above =
+            sk.ribCurve[static_cast<std::size_t>(level - 2)][static_cast<std::size_t>(side)];
         other = sk.rib[static_cast<std::size_t>(level - 2)][static_cast<std::size_t>(side)];
         const double sa = above.length() - 0.01;
         otherPts = triad(above.at(sa), above.normal.back(), -above.tangent(sa));
@@ -300,7 +316,8 @@ void addScalenes(const Skeleton& sk, ElementSink& sink) {
     const int b = sk.rib[0][static_cast<std::size_t>(side)];
     for (double f : {0.3, 0.5, 0.7}) {
       const Eigen::Vector3d p = r.at(f * r.length());
-      sink.add(ElementGroup::Cartilage, Endpoint::onBody(sk.lumbar, p + kScaleneLength * Eigen::Vector3d::UnitZ()),
+      sink.add(ElementGroup::Cartilage,
+               Endpoint::onBody(sk.lumbar, p + kScaleneLength * Eigen::Vector3d::UnitZ()),
                Endpoint::onBody(b, p));
     }
   }

@@ -4,7 +4,6 @@
 
 #include "GutSurface.h"
 #include "Skeleton.h"
-
 #include "pneuma/sim/Model.h"
 
 namespace pneuma::meshing {

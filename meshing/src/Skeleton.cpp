@@ -1,13 +1,12 @@
 #include "Skeleton.h"
 
-#include "pneuma/meshing/Sweep.h"
-#include "pneuma/sim/Error.h"
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "pneuma/meshing/Sweep.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 
@@ -82,7 +81,8 @@ RibCurve ribCurve(const RibLevel& r, const Eigen::Vector3d& head) {
   constexpr int kFine = 2000;
   double unitLength = 0.0;
   for (int i = 0; i < kFine; ++i) {
-    unitLength += (ribPlanar(r, 1.0, r.endAngle * (i + 1) / kFine) - ribPlanar(r, 1.0, r.endAngle * i / kFine)).norm();
+    unitLength +=
+        (ribPlanar(r, 1.0, r.endAngle * (i + 1) / kFine) - ribPlanar(r, 1.0, r.endAngle * i / kFine)).norm();
   }
   const double lateral = r.arcLength / unitLength;
 
@@ -103,10 +103,13 @@ RibCurve ribCurve(const RibLevel& r, const Eigen::Vector3d& head) {
   }
   c.arc.push_back(0.0);
   for (int i = 1; i < kRibStations; ++i) {
-    c.arc.push_back(c.arc.back() + (c.centre[static_cast<std::size_t>(i)] - c.centre[static_cast<std::size_t>(i - 1)]).norm());
+    c.arc.push_back(
+        c.arc.back() +
+        (c.centre[static_cast<std::size_t>(i)] - c.centre[static_cast<std::size_t>(i - 1)]).norm());
   }
   // the curve turns counter-clockwise about the plane normal: inward = normal x tangent
-  for (int i = 0; i < kRibStations; ++i) c.inward.push_back(normal.cross(c.tangent(c.arc[static_cast<std::size_t>(i)])).normalized());
+  for (int i = 0; i < kRibStations; ++i)
+    c.inward.push_back(normal.cross(c.tangent(c.arc[static_cast<std::size_t>(i)])).normalized());
   return c;
 }
 
@@ -141,8 +144,8 @@ double centrelineDistance(const RibCurve& a, const RibCurve& b) {
 
 Eigen::Vector3d RibCurve::at(double s, double offsetIn, double offsetUp) const {
   s = std::clamp(s, 0.0, length());
-  const std::size_t i = static_cast<std::size_t>(
-      std::clamp<long>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin() - 1, 0, static_cast<long>(arc.size()) - 2));
+  const std::size_t i = static_cast<std::size_t>(std::clamp<long>(
+      std::upper_bound(arc.begin(), arc.end(), s) - arc.begin() - 1, 0, static_cast<long>(arc.size()) - 2));
   const double f = (s - arc[i]) / (arc[i + 1] - arc[i]);
   const Eigen::Vector3d p = (1 - f) * centre[i] + f * centre[i + 1];
   const Eigen::Vector3d in = ((1 - f) * inward[i] + f * inward[i + 1]).normalized();
@@ -152,15 +155,17 @@ Eigen::Vector3d RibCurve::at(double s, double offsetIn, double offsetUp) const {
 Eigen::Vector3d RibCurve::tangent(double s) const {
   const double h = 0.25 * length() / static_cast<double>(centre.size());
   const double a = std::clamp(s - h, 0.0, length() - 2 * h);
-  const std::size_t i = static_cast<std::size_t>(
-      std::clamp<long>(std::upper_bound(arc.begin(), arc.end(), a) - arc.begin() - 1, 0, static_cast<long>(arc.size()) - 2));
+  const std::size_t i = static_cast<std::size_t>(std::clamp<long>(
+      std::upper_bound(arc.begin(), arc.end(), a) - arc.begin() - 1, 0, static_cast<long>(arc.size()) - 2));
   return (centre[i + 1] - centre[i]).normalized();
 }
 
 Skeleton buildSkeleton(const AnatomyParams& a) {
   Skeleton sk;
   const std::vector<Vertebra> vert = stackVertebrae(a.spine);
-  auto thoracic = [&](int t) -> const Vertebra& { return vert[static_cast<std::size_t>(4 + 13 - t)]; };  // T1..T12
+  auto thoracic = [&](int t) -> const Vertebra& {
+    return vert[static_cast<std::size_t>(4 + 13 - t)];
+  };  // T1..T12
   auto addBone = [&](const std::string& name, bool isFixed, TriangleMesh mesh) {
     sk.bones.push_back({name, isFixed, std::move(mesh)});
     return static_cast<int>(sk.bones.size()) - 1;
@@ -168,7 +173,8 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
 
   // fixed lumbar spine L5..L1
   TriangleMesh lumbar;
-  for (int i = 0; i < 5; ++i) lumbar.append(vertebraMesh(vert[static_cast<std::size_t>(i)], a.spine.spinousLength));
+  for (int i = 0; i < 5; ++i)
+    lumbar.append(vertebraMesh(vert[static_cast<std::size_t>(i)], a.spine.spinousLength));
   sk.lumbar = addBone("lumbar_spine", true, lumbar);
   for (int i = 4; i >= 2; --i) {
     const Vertebra& v = vert[static_cast<std::size_t>(i)];
@@ -183,8 +189,8 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     std::vector<SweepStation> wing;
     for (int i = 0; i <= 12; ++i) {
       const double t = M_PI * i / 12.0;  // sacroiliac joint (t = 0) to anterior superior iliac spine (t = pi)
-      const Eigen::Vector3d c(0.055 + (0.5 * p.width - 0.07) * std::sin(t), -0.04 + 0.5 * (p.depth + 0.04) * (1 - std::cos(t)),
-                              zc - 0.02 * std::sin(t));
+      const Eigen::Vector3d c(0.055 + (0.5 * p.width - 0.07) * std::sin(t),
+                              -0.04 + 0.5 * (p.depth + 0.04) * (1 - std::cos(t)), zc - 0.02 * std::sin(t));
       const Eigen::Vector3d up = Eigen::Vector3d(0.35 * std::sin(t), 0, 1).normalized();  // flared outward
       wing.push_back({c, up, 0.5 * p.height * (0.6 + 0.4 * std::sin(t)), 0.006});
     }
@@ -194,14 +200,16 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     std::vector<SweepStation> sacrum;
     for (int i = 0; i <= 4; ++i) {
       const double f = i / 4.0;
-      sacrum.push_back({Eigen::Vector3d(0, -0.015 - 0.05 * f * f, -0.012 - 0.10 * f), Eigen::Vector3d::UnitX(),
-                        0.05 * (1 - 0.7 * f), 0.012});
+      sacrum.push_back({Eigen::Vector3d(0, -0.015 - 0.05 * f * f, -0.012 - 0.10 * f),
+                        Eigen::Vector3d::UnitX(), 0.05 * (1 - 0.7 * f), 0.012});
     }
     pelvis.append(sweepTube(sacrum, kAround, false));
     std::vector<SweepStation> pubis;
     for (int i = 0; i <= 8; ++i) {
-      const double t = -0.5 * M_PI + M_PI * i / 8.0;  // from the left ramus round the symphysis to the right one
-      pubis.push_back({Eigen::Vector3d(0.09 * std::sin(t), p.depth - 0.03 + 0.03 * std::cos(t), a.abdomen.floorLevel - 0.01 + 0.03 * std::abs(std::sin(t))),
+      const double t =
+          -0.5 * M_PI + M_PI * i / 8.0;  // from the left ramus round the symphysis to the right one
+      pubis.push_back({Eigen::Vector3d(0.09 * std::sin(t), p.depth - 0.03 + 0.03 * std::cos(t),
+                                       a.abdomen.floorLevel - 0.01 + 0.03 * std::abs(std::sin(t))),
                        Eigen::Vector3d::UnitZ(), 0.012, 0.008});
     }
     pelvis.append(sweepTube(pubis, kAround, false));
@@ -229,7 +237,8 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     const int parent = last == 12 ? sk.lumbar : sk.thoracicSegment[static_cast<std::size_t>(last)];
     const int child = sk.thoracicSegment[static_cast<std::size_t>(last - 1)];
     sk.joints.push_back({"spine_" + sk.bones[static_cast<std::size_t>(child)].name, parent, child,
-                         Eigen::Vector3d(0, 0.5 * (below.y + above.y), 0.5 * (below.zTop + above.zBottom)), true});
+                         Eigen::Vector3d(0, 0.5 * (below.y + above.y), 0.5 * (below.zTop + above.zBottom)),
+                         true});
   }
 
   // sternum: manubrium, body and xiphoid swept down and forward from the jugular notch
@@ -243,7 +252,8 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     sk.sternumAxis = Eigen::Vector3d(0, std::sin(s.inclination), -std::cos(s.inclination));
     const double total = s.manubriumLength + s.bodyLength + s.xiphoidLength;
     auto widthAt = [&](double d) {
-      if (d < s.manubriumLength) return s.manubriumWidth + (s.bodyWidth - s.manubriumWidth) * d / s.manubriumLength;
+      if (d < s.manubriumLength)
+        return s.manubriumWidth + (s.bodyWidth - s.manubriumWidth) * d / s.manubriumLength;
       if (d < s.manubriumLength + s.bodyLength) return s.bodyWidth;
       return s.bodyWidth * (0.55 - 0.35 * (d - s.manubriumLength - s.bodyLength) / s.xiphoidLength);
     };
@@ -259,10 +269,10 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     sk.sternum = addBone("sternum", false, sweepTube(st, kAround, false));
     sk.xiphoidTip = notch + total * sk.sternumAxis;
     sk.jugularNotch = notch;
-    // costal notches: rib 1 on the manubrium, rib 2 at the sternal angle, 3-6 along the body, 7 at the xiphisternal joint
+    // costal notches: rib 1 on the manubrium, rib 2 at the sternal angle, 3-6 along the body, 7 at the
+    // xiphisternal joint
     for (int r = 1; r <= 7; ++r) {
-      const double d = r == 1 ? 0.35 * s.manubriumLength
-                              : s.manubriumLength + s.bodyLength * (r - 2) / 5.0;
+      const double d = r == 1 ? 0.35 * s.manubriumLength : s.manubriumLength + s.bodyLength * (r - 2) / 5.0;
       const Eigen::Vector3d c = notch + d * sk.sternumAxis;
       const double half = 0.5 * widthAt(d);
       sk.costalNotch.push_back({c + Eigen::Vector3d(half, 0, 0), c - Eigen::Vector3d(half, 0, 0)});
@@ -285,10 +295,13 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     if (!isFixed) {
       // the rib-neck axis runs from the head laterally and backward to the tubercle
       const double phi = a.ribs[static_cast<std::size_t>(level - 1)].neckAxis;
-      const Eigen::Vector3d axisRight(std::cos(phi), -std::sin(phi), 0.0), axisLeft(-std::cos(phi), -std::sin(phi), 0.0);
+      const Eigen::Vector3d axisRight(std::cos(phi), -std::sin(phi), 0.0),
+          axisLeft(-std::cos(phi), -std::sin(phi), 0.0);
       const int parent = sk.thoracicSegment[static_cast<std::size_t>(level - 1)];
-      sk.joints.push_back({"costovertebral_" + n + "_right", parent, br, right.centre.front(), false, axisRight});
-      sk.joints.push_back({"costovertebral_" + n + "_left", parent, bl, left.centre.front(), false, axisLeft});
+      sk.joints.push_back(
+          {"costovertebral_" + n + "_right", parent, br, right.centre.front(), false, axisRight});
+      sk.joints.push_back(
+          {"costovertebral_" + n + "_left", parent, bl, left.centre.front(), false, axisLeft});
     }
   }
 
@@ -300,8 +313,9 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     const double need = 0.5 * (up.height + down.height);
     if (gap < need) {
       std::ostringstream s;
-      s << a.source << ": ribs[" << level - 1 << "] and ribs[" << level << "] overlap: their centrelines come within "
-        << gap * 1e3 << " mm, less than the mean rib height " << need * 1e3 << " mm";
+      s << a.source << ": ribs[" << level - 1 << "] and ribs[" << level
+        << "] overlap: their centrelines come within " << gap * 1e3 << " mm, less than the mean rib height "
+        << need * 1e3 << " mm";
       throw sim::Error(s.str());
     }
   }

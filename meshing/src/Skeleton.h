@@ -2,12 +2,12 @@
 /// @file Skeleton.h
 /// Procedural bones of the torso (world frame, rest pose) before remeshing and mass properties.
 
-#include "pneuma/meshing/AnatomyParams.h"
-#include "pneuma/meshing/TriangleMesh.h"
-
 #include <array>
 #include <string>
 #include <vector>
+
+#include "pneuma/meshing/AnatomyParams.h"
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 
@@ -22,7 +22,8 @@ struct RibCurve {
   std::vector<double> arc;              ///< [m] cumulative arc length at each point
   double height = 0.0;                  ///< [m] cross-section height
   double thickness = 0.0;               ///< [m] cross-section thickness
-  /// Point at arc length `s` [m] (clamped), linear between samples; `offsetIn` [m] inward, `offsetUp` [m] upward.
+  /// Point at arc length `s` [m] (clamped), linear between samples; `offsetIn` [m] inward, `offsetUp` [m]
+  /// upward.
   Eigen::Vector3d at(double s, double offsetIn = 0.0, double offsetUp = 0.0) const;
   /// Unit tangent (head to tip) at arc length `s`.
   Eigen::Vector3d tangent(double s) const;
@@ -50,20 +51,20 @@ struct JointSpec {
 struct Skeleton {
   std::vector<Bone> bones;
   std::vector<JointSpec> joints;
-  int lumbar = -1;                       ///< bone index of the fixed lumbar spine
-  int pelvis = -1;                       ///< bone index of the fixed pelvis
-  int sternum = -1;                      ///< bone index of the sternum
-  std::vector<int> thoracicSegment;      ///< bone index of the segment holding vertebra T1..T12 (index 0 = T1)
-  std::vector<std::array<int, 2>> rib;   ///< bone index of rib level 1..12 (index 0 = rib 1), [kRight, kLeft]
-  std::vector<std::array<RibCurve, 2>> ribCurve;  ///< centrelines, same indexing
+  int lumbar = -1;                      ///< bone index of the fixed lumbar spine
+  int pelvis = -1;                      ///< bone index of the fixed pelvis
+  int sternum = -1;                     ///< bone index of the sternum
+  std::vector<int> thoracicSegment;     ///< bone index of the segment holding vertebra T1..T12 (index 0 = T1)
+  std::vector<std::array<int, 2>> rib;  ///< bone index of rib level 1..12 (index 0 = rib 1), [kRight, kLeft]
+  std::vector<std::array<RibCurve, 2>> ribCurve;            ///< centrelines, same indexing
   std::vector<std::array<Eigen::Vector3d, 2>> costalNotch;  ///< [m] sternal attachment of ribs 1..7
-  Eigen::Vector3d sternumAxis{0, 0, -1};  ///< unit direction down the sternum
-  Eigen::Vector3d xiphoidTip{0, 0, 0};    ///< [m] lower end of the sternum
-  Eigen::Vector3d jugularNotch{0, 0, 0};  ///< [m] upper end of the manubrium (suprasternal notch)
+  Eigen::Vector3d sternumAxis{0, 0, -1};                    ///< unit direction down the sternum
+  Eigen::Vector3d xiphoidTip{0, 0, 0};                      ///< [m] lower end of the sternum
+  Eigen::Vector3d jugularNotch{0, 0, 0};      ///< [m] upper end of the manubrium (suprasternal notch)
   std::vector<Eigen::Vector3d> sternumInner;  ///< [m] points on the sternum's posterior face
   std::vector<Eigen::Vector3d> lumbarFront;   ///< [m] anterior points of L1..L3 (crura), top down
-  std::vector<double> vertebraTop;        ///< [m] z of the top of T1..T12
-  std::vector<double> vertebraCentreY;    ///< [m] y of the body centre of T1..T12
+  std::vector<double> vertebraTop;            ///< [m] z of the top of T1..T12
+  std::vector<double> vertebraCentreY;        ///< [m] y of the body centre of T1..T12
 };
 
 /// Builds the bones and joints of `a`. @throws sim::Error when ribs overlap (naming the rib levels).

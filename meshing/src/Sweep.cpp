@@ -1,10 +1,9 @@
 #include "pneuma/meshing/Sweep.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <Eigen/Geometry>
-
 #include <cmath>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 
@@ -22,12 +21,14 @@ TriangleMesh sweepTube(const std::vector<SweepStation>& stations, int around, bo
     const int prev = isLoop ? (i + n - 1) % n : std::max(i - 1, 0);
     const int next = isLoop ? (i + 1) % n : std::min(i + 1, n - 1);
     const Eigen::Vector3d t =
-        (stations[static_cast<std::size_t>(next)].centre - stations[static_cast<std::size_t>(prev)].centre).normalized();
+        (stations[static_cast<std::size_t>(next)].centre - stations[static_cast<std::size_t>(prev)].centre)
+            .normalized();
     const Eigen::Vector3d u = (s.up - s.up.dot(t) * t).normalized();
     const Eigen::Vector3d w = t.cross(u);
     for (int k = 0; k < around; ++k) {
       const double a = 2.0 * M_PI * k / around;
-      m.vertices.col(i * around + k) = s.centre + s.halfHeight * std::cos(a) * u + s.halfWidth * std::sin(a) * w;
+      m.vertices.col(i * around + k) =
+          s.centre + s.halfHeight * std::cos(a) * u + s.halfWidth * std::sin(a) * w;
     }
   }
 

@@ -1,14 +1,13 @@
 // All TetGen code of pneuma::meshing.
 #include "pneuma/meshing/Tetrahedralizer.h"
 
-#include "pneuma/sim/Error.h"
-
-#include <Eigen/Geometry>
-
 #include <tetgen.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 
@@ -58,7 +57,8 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
   try {
     ::tetrahedralize(switches, &in, &out);
   } catch (int code) {
-    throw sim::Error(part + ": TetGen failed to tetrahedralise the surface (error " + std::to_string(code) + ")");
+    throw sim::Error(part + ": TetGen failed to tetrahedralise the surface (error " + std::to_string(code) +
+                     ")");
   }
 
   // copy the result and sum the tetrahedra volumes
@@ -71,9 +71,10 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
   for (int e = 0; e < out.numberoftetrahedra; ++e) {
     for (int k = 0; k < 4; ++k) t.tets(k, e) = out.tetrahedronlist[e * out.numberofcorners + k];
     const Eigen::Vector3d a = t.vertices.col(t.tets(0, e));
-    t.volume += std::abs((t.vertices.col(t.tets(1, e)) - a)
-                             .dot((t.vertices.col(t.tets(2, e)) - a).cross(t.vertices.col(t.tets(3, e)) - a))) /
-                6.0;
+    t.volume +=
+        std::abs((t.vertices.col(t.tets(1, e)) - a)
+                     .dot((t.vertices.col(t.tets(2, e)) - a).cross(t.vertices.col(t.tets(3, e)) - a))) /
+        6.0;
   }
   t.boundaryTriangles = out.numberoftrifaces;
   if (out.numberoftetrahedra == 0) throw sim::Error(part + ": TetGen produced no tetrahedra");

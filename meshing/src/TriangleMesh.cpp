@@ -1,7 +1,6 @@
 #include "pneuma/meshing/TriangleMesh.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -39,17 +38,22 @@ TriangleMesh TriangleMesh::canonical(double grid) const {
   const int n = vertexCount();
   std::vector<std::array<long long, 3>> key(static_cast<std::size_t>(n));
   for (int v = 0; v < n; ++v) {
-    for (int k = 0; k < 3; ++k) key[static_cast<std::size_t>(v)][static_cast<std::size_t>(k)] = std::llround(vertices(k, v) / grid);
+    for (int k = 0; k < 3; ++k)
+      key[static_cast<std::size_t>(v)][static_cast<std::size_t>(k)] = std::llround(vertices(k, v) / grid);
   }
   std::vector<int> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key[static_cast<std::size_t>(a)] < key[static_cast<std::size_t>(b)]; });
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return key[static_cast<std::size_t>(a)] < key[static_cast<std::size_t>(b)];
+  });
   std::vector<int> newIndex(static_cast<std::size_t>(n));
   TriangleMesh m;
   m.vertices.resize(3, n);
   for (int i = 0; i < n; ++i) {
     const auto& k = key[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
-    m.vertices.col(i) = Eigen::Vector3d(static_cast<double>(k[0]), static_cast<double>(k[1]), static_cast<double>(k[2])) * grid;
+    m.vertices.col(i) =
+        Eigen::Vector3d(static_cast<double>(k[0]), static_cast<double>(k[1]), static_cast<double>(k[2])) *
+        grid;
     newIndex[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = i;
   }
 
@@ -57,7 +61,8 @@ TriangleMesh TriangleMesh::canonical(double grid) const {
   std::vector<std::array<int, 3>> tris;
   for (int f = 0; f < triangleCount(); ++f) {
     std::array<int, 3> t{};
-    for (int k = 0; k < 3; ++k) t[static_cast<std::size_t>(k)] = newIndex[static_cast<std::size_t>(triangles(k, f))];
+    for (int k = 0; k < 3; ++k)
+      t[static_cast<std::size_t>(k)] = newIndex[static_cast<std::size_t>(triangles(k, f))];
     while (t[0] > t[1] || t[0] > t[2]) t = {t[1], t[2], t[0]};
     tris.push_back(t);
   }

@@ -1,9 +1,9 @@
 #include "VtpWriter.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <cstdio>
 #include <fstream>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 
@@ -19,7 +19,8 @@ void writeVtp(const TriangleMesh& mesh, const std::string& path) {
       << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   char buf[96];
   for (int v = 0; v < mesh.vertexCount(); ++v) {
-    std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", mesh.vertices(0, v), mesh.vertices(1, v), mesh.vertices(2, v));
+    std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", mesh.vertices(0, v), mesh.vertices(1, v),
+                  mesh.vertices(2, v));
     out << buf;
   }
   out << "        </DataArray>\n      </Points>\n      <Polys>\n"

@@ -3,9 +3,9 @@
 /// A minimal writer of VTK XML PolyData (.vtp, ASCII) for the render meshes of a model directory,
 /// so that meshing needs no VTK. Deterministic text (fixed formatting).
 
-#include "pneuma/meshing/TriangleMesh.h"
-
 #include <string>
+
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 

@@ -3,11 +3,11 @@
 /// built, as in the sanitizer build (CONTRIBUTING.md). The same three calls as `pneuma-cli model build
 /// --no-preview`, so the model is the same; a bad input is one line on stderr and exit 2.
 
-#include "pneuma/meshing/AnatomyParams.h"
-#include "pneuma/meshing/ModelBuilder.h"
-
 #include <exception>
 #include <iostream>
+
+#include "pneuma/meshing/AnatomyParams.h"
+#include "pneuma/meshing/ModelBuilder.h"
 
 int main(int argc, char** argv) {
   if (argc != 3) {
@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    pneuma::meshing::writeModelDirectory(pneuma::meshing::buildModel(pneuma::meshing::loadAnatomy(argv[1])), argv[2]);
+    pneuma::meshing::writeModelDirectory(pneuma::meshing::buildModel(pneuma::meshing::loadAnatomy(argv[1])),
+                                         argv[2]);
   } catch (const std::exception& e) {
     std::cerr << "pneuma-build-model: error: " << e.what() << "\n";
     return 2;

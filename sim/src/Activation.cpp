@@ -1,9 +1,9 @@
 #include "pneuma/sim/Activation.h"
 
-#include "pneuma/sim/Error.h"
-
 #include <cmath>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::sim {
 

@@ -1,11 +1,11 @@
 #include "pneuma/sim/BlockLdlt.h"
 
-#include "BlockLdltKernels.h"
-
 #include <Eigen/LU>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
 #include <algorithm>
+
+#include "BlockLdltKernels.h"
 
 namespace pneuma::sim {
 
@@ -126,10 +126,11 @@ bool BlockLdlt::factorize() {
       m_y[at(i)].setZero();
       const int begin = m_lp[at(i)], end = begin + m_lnz[at(i)];
       if (m_avx2)
-        kernels::subtractProductsAvx2(m_y.data()->data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
-                                      end - begin, yi.data());
+        kernels::subtractProductsAvx2(m_y.data()->data(), m_l.data()->data() + 12 * begin,
+                                      m_li.data() + begin, end - begin, yi.data());
       else
-        for (int p = begin; p < end; ++p) m_y[at(m_li[at(p)])].topRows<3>().noalias() -= m_l[at(p)].topRows<3>() * yi;
+        for (int p = begin; p < end; ++p)
+          m_y[at(m_li[at(p)])].topRows<3>().noalias() -= m_l[at(p)].topRows<3>() * yi;
       // L(k, i) = Y_i^T D_i^-1 = (D_i^-1 Y_i)^T (D_i^-1 is symmetric): column products, no horizontal sums
       const Matrix3d lki = (m_dInverse[at(i)] * yi).transpose();
       d.noalias() -= lki * yi;
@@ -155,10 +156,11 @@ void BlockLdlt::solve(Eigen::VectorXd& x) const {
     const Eigen::Vector3d zi = m_x.segment<3>(3 * i);
     const int begin = m_lp[at(i)], end = m_lp[at(i) + 1];
     if (m_avx2)
-      kernels::forwardColumnAvx2(m_x.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin, end - begin,
-                                 zi.data());
+      kernels::forwardColumnAvx2(m_x.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
+                                 end - begin, zi.data());
     else
-      for (int p = begin; p < end; ++p) m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
+      for (int p = begin; p < end; ++p)
+        m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
   }
   for (int i = 0; i < n; ++i) m_x.segment<3>(3 * i) = m_dInverse[at(i)] * m_x.segment<3>(3 * i).eval();
   // L^T x = z

@@ -1,8 +1,8 @@
 // Compiled with -mavx2 -mfma (sim/CMakeLists.txt) and called only when hasAvx2(). No Eigen in this file: its
 // inline functions must not be compiled for two instruction sets in one program.
-#include "BlockLdltKernels.h"
-
 #include <immintrin.h>
+
+#include "BlockLdltKernels.h"
 
 namespace pneuma::sim::kernels {
 

@@ -1,6 +1,7 @@
 #pragma once
-// The hot loops of BlockLdlt::factorize() and solve() on raw memory, for a build with AVX2 and FMA (BlockLdltAvx2.cpp).
-// Blocks are 3x3 matrices padded to 4 rows (BlockLdlt::Block: column-major, 12 doubles, row 3 zero in l).
+// The hot loops of BlockLdlt::factorize() and solve() on raw memory, for a build with AVX2 and FMA
+// (BlockLdltAvx2.cpp). Blocks are 3x3 matrices padded to 4 rows (BlockLdlt::Block: column-major, 12 doubles,
+// row 3 zero in l).
 
 namespace pneuma::sim::kernels {
 

@@ -1,19 +1,18 @@
 #include "pneuma/sim/BreathStyleController.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Limits.h"
-#include "pneuma/sim/JsonReader.h"
-#include "pneuma/sim/Resources.h"
-
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/Limits.h"
+#include "pneuma/sim/Resources.h"
 
 namespace pneuma::sim {
 
@@ -32,8 +31,8 @@ void requireRange(const std::string& field, double v, double lo, double hi, bool
 
 GroupActivation& slot(Activations& a, ElementGroup g) { return a[static_cast<std::size_t>(g)]; }
 
-constexpr double kExpiratoryRise = 0.3;  // [-] part of the exhale over which the expiratory drive rises
-constexpr double kExpiratoryFall = 0.15; // [-] part at the exhale's end over which it falls back to 0
+constexpr double kExpiratoryRise = 0.3;   // [-] part of the exhale over which the expiratory drive rises
+constexpr double kExpiratoryFall = 0.15;  // [-] part at the exhale's end over which it falls back to 0
 
 // [-] 0 -> 1 as u goes from 0 to `width` (> 0): s(x) = 3x^2 - 2x^3, x = u / width clamped to [0, 1]
 double smoothRise(double u, double width) {
@@ -53,10 +52,10 @@ void validateBreathStyle(const BreathStyle& s) {
   requireRange(p + "internal_intercostal_alpha", s.internalIntercostalAlpha, 0.0, 1.0, false);
   requireRange(p + "intercostal_alpha", s.intercostalAlpha, 0.0, 1.0, true);
   requireRange(p + "intercostal_amplitude", s.intercostalAmplitude, 0.0, 1.5, false);
-  requireRange(p + "intercostal_mean - intercostal_amplitude", s.intercostalMean - s.intercostalAmplitude, 0.0, 1.5,
-               true);
-  requireRange(p + "intercostal_mean + intercostal_amplitude", s.intercostalMean + s.intercostalAmplitude, 0.0, 1.5,
-               true);
+  requireRange(p + "intercostal_mean - intercostal_amplitude", s.intercostalMean - s.intercostalAmplitude,
+               0.0, 1.5, true);
+  requireRange(p + "intercostal_mean + intercostal_amplitude", s.intercostalMean + s.intercostalAmplitude,
+               0.0, 1.5, true);
   requireRange(p + "rectus_r", s.rectusR, 0.0, 1.5, true);
   requireRange(p + "intercostal_lead_s", s.intercostalLead, 0.0, 0.5 * 60.0 / s.breathsPerMinute, false);
   if (s.cycles < 0) throw Error(p + "cycles: must be >= 0, got " + std::to_string(s.cycles));
@@ -84,7 +83,8 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   s.intercostalLead = j.numberOr("intercostal_lead_s", s.intercostalLead);
   s.rectusR = j.numberOr("rectus_r", s.rectusR);
   if (j.has("rectus_active")) s.rectusActive = j.at("rectus_active").boolean();
-  if (j.has("cycles")) s.cycles = static_cast<int>(j.at("cycles").integerIn(0, std::numeric_limits<int>::max()));
+  if (j.has("cycles"))
+    s.cycles = static_cast<int>(j.at("cycles").integerIn(0, std::numeric_limits<int>::max()));
   try {
     validateBreathStyle(s);
   } catch (const Error& e) {
@@ -118,7 +118,8 @@ std::vector<std::string> breathStyleNames(const std::string& presetDir) {
   std::vector<std::string> names;
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(presetDir, ec)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
+    if (entry.is_regular_file() && entry.path().extension() == ".json")
+      names.push_back(entry.path().stem().string());
   }
   std::sort(names.begin(), names.end());
   return names;
@@ -130,7 +131,8 @@ BreathStyle loadBreathStyle(const std::string& nameOrPath, const std::string& pr
   if (!isPath && !std::filesystem::exists(path)) {
     std::string valid;
     for (const std::string& n : breathStyleNames(presetDir)) valid += (valid.empty() ? "" : ", ") + n;
-    throw Error("unknown breath style '" + excerptOf(nameOrPath) + "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
+    throw Error("unknown breath style '" + excerptOf(nameOrPath) +
+                "'; valid: " + (valid.empty() ? "(none in " + presetDir + ")" : valid));
   }
   return parseBreathStyle(readInputFile(path), path);
 }
@@ -163,10 +165,13 @@ Activations BreathStyleController::activations(double t, const Metrics& /*latest
   const double out = isRest ? 0.0 : expiratoryDrive(s, phase);
   Activations a = relaxedActivations();
   // inspiratory muscles: diaphragm and external intercostals share the inspiratory drive
-  slot(a, ElementGroup::Diaphragm) = in > 0.0 ? GroupActivation{s.diaphragmR, in * s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
-  const double ric = s.intercostalMean - s.intercostalAmplitude;  // [-] Table 2's deepest intercostal contraction
+  slot(a, ElementGroup::Diaphragm) =
+      in > 0.0 ? GroupActivation{s.diaphragmR, in * s.diaphragmAlpha} : GroupActivation{1.0, 0.0};
+  const double ric =
+      s.intercostalMean - s.intercostalAmplitude;  // [-] Table 2's deepest intercostal contraction
   // their drive runs intercostalLead ahead, so the rib cage, slowed by the rib friction, moves with the belly
-  const double inLead = isRest ? 0.0 : inspiratoryDrive(s, std::fmod(phase + s.intercostalLead / period, 1.0));
+  const double inLead =
+      isRest ? 0.0 : inspiratoryDrive(s, std::fmod(phase + s.intercostalLead / period, 1.0));
   slot(a, ElementGroup::IntercostalExternal) = {ric, inLead * s.intercostalAlpha};
   // expiratory muscles: internal intercostals and rectus on the expiratory drive (quiet breathing: none)
   slot(a, ElementGroup::IntercostalInternal) = {ric, out * s.internalIntercostalAlpha};

@@ -1,7 +1,6 @@
 #include "pneuma/sim/Elements.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 
@@ -13,7 +12,8 @@ double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangl
   return coneVolume(x, triangles, x.rowwise().mean());
 }
 
-double coneVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, const Eigen::Vector3d& origin) {
+double coneVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles,
+                  const Eigen::Vector3d& origin) {
   double sixV = 0.0;
   for (Eigen::Index f = 0; f < triangles.cols(); ++f) {
     const Eigen::Vector3d a = x.col(triangles(0, f)) - origin;

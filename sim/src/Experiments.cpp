@@ -1,13 +1,13 @@
 #include "pneuma/sim/Experiments.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/State.h"
-#include "pneuma/sim/Step.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/State.h"
+#include "pneuma/sim/Step.h"
 
 namespace pneuma::sim {
 
@@ -19,8 +19,8 @@ constexpr double kPct = 1e2;  // [%/1]
 constexpr double kBig = std::numeric_limits<double>::infinity();
 const std::string kZordan = "Zordan et al. 2004";
 
-Check check(std::string id, std::string what, std::string target, std::string source, std::string unit, double measured,
-            double lower, double upper) {
+Check check(std::string id, std::string what, std::string target, std::string source, std::string unit,
+            double measured, double lower, double upper) {
   Check c;
   c.id = std::move(id);
   c.what = std::move(what);
@@ -37,7 +37,8 @@ Check check(std::string id, std::string what, std::string target, std::string so
 int spineTopBody(const Model& model) {
   int spine = -1;
   for (int b = 0; b < model.bodies.size(); ++b) {
-    if (model.bodies.isFixed[static_cast<std::size_t>(b)] || model.bodies.name[static_cast<std::size_t>(b)].rfind("thoracic", 0) != 0)
+    if (model.bodies.isFixed[static_cast<std::size_t>(b)] ||
+        model.bodies.name[static_cast<std::size_t>(b)].rfind("thoracic", 0) != 0)
       continue;
     if (spine < 0 || model.bodies.com(2, b) > model.bodies.com(2, spine)) spine = b;
   }
@@ -61,8 +62,8 @@ class RelaxedController : public Controller {
 
 }  // namespace
 
-StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& style, const ExperimentSettings& settings,
-                        double frictionScale) {
+StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& style,
+                        const ExperimentSettings& settings, double frictionScale) {
   StyleRun r;
   r.style = style;
   r.frictionScale = frictionScale;
@@ -76,13 +77,15 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
   Simulation sim(std::move(model), std::make_unique<BreathStyleController>(style), o);
   const double duration = style.cycles > 0 ? settings.forcedExhaleDuration : settings.styleDuration;
   sim.advance(o.settleTime + duration, [&](const Simulation& s) {
-    r.spineTop.push_back(spine >= 0 ? Eigen::Vector3d(s.state().bodyPosition.col(spine)) : Eigen::Vector3d::Zero());
+    r.spineTop.push_back(spine >= 0 ? Eigen::Vector3d(s.state().bodyPosition.col(spine))
+                                    : Eigen::Vector3d::Zero());
     return true;
   });
   r.summary = sim.summary();
   r.trace = sim.trace();
   // the trace may hold a frame at t = 0 that precedes the first callback
-  while (r.spineTop.size() < r.trace.size()) r.spineTop.insert(r.spineTop.begin(), r.spineTop.empty() ? Eigen::Vector3d::Zero() : r.spineTop.front());
+  while (r.spineTop.size() < r.trace.size())
+    r.spineTop.insert(r.spineTop.begin(), r.spineTop.empty() ? Eigen::Vector3d::Zero() : r.spineTop.front());
   return r;
 }
 
@@ -100,40 +103,46 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
   // Section 6.2 / Figure 4 caption: "a tolerable error less than 2 percent during our results for breathing"
   for (const StyleRun* r : {calm, deep, panting, forced})
     if (r)
-      out.push_back(check(r->style.name + ".gut_volume_error", "max gut volume error, " + r->style.name, "< 2 %",
-                          kZordan + ", Sec. 6.2, Fig. 4 caption", "%", r->summary.maxGutVolumeError * kPct, 0.0, 2.0));
+      out.push_back(check(r->style.name + ".gut_volume_error", "max gut volume error, " + r->style.name,
+                          "< 2 %", kZordan + ", Sec. 6.2, Fig. 4 caption", "%",
+                          r->summary.maxGutVolumeError * kPct, 0.0, 2.0));
 
   // Figure 6: calm tidal volume "almost perfectly on the 500 mL average"; Table 2: 15 b/m
   if (calm) {
-    out.push_back(check("calm.tidal_volume", "tidal volume, calm", "500 +/- 50 mL", kZordan + ", Sec. 8.1, Fig. 6", "mL",
-                        calm->summary.tidalVolume * kMl, 450.0, 550.0));
+    out.push_back(check("calm.tidal_volume", "tidal volume, calm", "500 +/- 50 mL",
+                        kZordan + ", Sec. 8.1, Fig. 6", "mL", calm->summary.tidalVolume * kMl, 450.0, 550.0));
     out.push_back(check("calm.rate", "breathing rate, calm", "15 +/- 0.5 b/m", kZordan + ", Table 2", "b/m",
                         calm->summary.breathsPerMinute, 14.5, 15.5));
     // quiet expiration is the passive recoil of lungs and chest wall, damped by the airways: the volume falls
     // without bouncing back (West, Respiratory Physiology, ch. 7). Our bound: 2 % of the calm breath
-    out.push_back(check("calm.expiration_rebound", "largest rise of the lung volume during an exhale, after its peak, calm",
-                        "< 10 mL (the volume falls without bouncing)", "West, Respiratory Physiology, ch. 7", "mL",
-                        expirationRebound(*calm) * kMl, 0.0, 10.0));
+    out.push_back(check("calm.expiration_rebound",
+                        "largest rise of the lung volume during an exhale, after its peak, calm",
+                        "< 10 mL (the volume falls without bouncing)", "West, Respiratory Physiology, ch. 7",
+                        "mL", expirationRebound(*calm) * kMl, 0.0, 10.0));
   }
 
   // Table 2 slow/deep: 12 b/m; between 600 mL (clearly above the 500 mL calm breath; the paper's own deep
   // breath in Fig. 6 lies between 500 mL and the plot's 800 mL top) and 3 L, the inspiratory capacity of
   // a healthy adult (West, Respiratory Physiology, ch. 2), the largest breath that can be drawn
   if (deep) {
-    out.push_back(check("deep.tidal_volume", "tidal volume, deep", "600 - 3000 mL (above calm, up to the inspiratory capacity)",
-                        kZordan + ", Sec. 8.1 'slow deep breath', Fig. 6; West, Respiratory Physiology, ch. 2", "mL",
-                        deep->summary.tidalVolume * kMl, 600.0, 3000.0));
+    out.push_back(
+        check("deep.tidal_volume", "tidal volume, deep",
+              "600 - 3000 mL (above calm, up to the inspiratory capacity)",
+              kZordan + ", Sec. 8.1 'slow deep breath', Fig. 6; West, Respiratory Physiology, ch. 2", "mL",
+              deep->summary.tidalVolume * kMl, 600.0, 3000.0));
     out.push_back(check("deep.rate", "breathing rate, deep", "12 +/- 0.5 b/m", kZordan + ", Table 2", "b/m",
                         deep->summary.breathsPerMinute, 11.5, 12.5));
     if (calm)
-      out.push_back(check("deep.above_calm", "tidal volume deep minus calm", "> 0 mL", kZordan + ", Sec. 8.1, Fig. 6", "mL",
+      out.push_back(check("deep.above_calm", "tidal volume deep minus calm", "> 0 mL",
+                          kZordan + ", Sec. 8.1, Fig. 6", "mL",
                           (deep->summary.tidalVolume - calm->summary.tidalVolume) * kMl, 1e-9, kBig));
   }
 
-  // Section 8.1 panting: 60 b/m, "small rapid inhales and exhales where most of the motion is seen in the chest"
+  // Section 8.1 panting: 60 b/m, "small rapid inhales and exhales where most of the motion is seen in the
+  // chest"
   if (panting) {
-    out.push_back(check("panting.rate", "breathing rate, panting", "60 +/- 1 b/m", kZordan + ", Table 2", "b/m",
-                        panting->summary.breathsPerMinute, 59.0, 61.0));
+    out.push_back(check("panting.rate", "breathing rate, panting", "60 +/- 1 b/m", kZordan + ", Table 2",
+                        "b/m", panting->summary.breathsPerMinute, 59.0, 61.0));
     if (calm) {
       out.push_back(check("panting.below_calm", "tidal volume calm minus panting", "> 0 mL (small breaths)",
                           kZordan + ", Sec. 8.1 'panting breathing'", "mL",
@@ -144,7 +153,8 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
                std::max(landmarkRange(r.trace, r.umbilicus, r.settleTime).y(), 1e-12);
       };
       const double pantRatio = apRatio(*panting), calmRatio = apRatio(*calm);
-      out.push_back(check("panting.chest_dominant", "xiphoid/umbilicus anterior-posterior excursion ratio, panting minus calm",
+      out.push_back(check("panting.chest_dominant",
+                          "xiphoid/umbilicus anterior-posterior excursion ratio, panting minus calm",
                           "> 0 (motion mostly in the chest)", kZordan + ", Sec. 8.1 'panting breathing'", "-",
                           pantRatio - calmRatio, 1e-12, kBig));
     }
@@ -158,17 +168,20 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
     double minVolume = t.lungVolume[ref], minUmbY = 0.0, minXiphZ = 0.0;
     for (std::size_t i = ref; i < t.size(); ++i) {
       minVolume = std::min(minVolume, t.lungVolume[i]);
-      minUmbY = std::min(minUmbY, t.landmarks[i](1, forced->umbilicus) - t.landmarks[ref](1, forced->umbilicus));
-      minXiphZ = std::min(minXiphZ, t.landmarks[i](2, forced->xiphoid) - t.landmarks[ref](2, forced->xiphoid));
+      minUmbY =
+          std::min(minUmbY, t.landmarks[i](1, forced->umbilicus) - t.landmarks[ref](1, forced->umbilicus));
+      minXiphZ =
+          std::min(minXiphZ, t.landmarks[i](2, forced->xiphoid) - t.landmarks[ref](2, forced->xiphoid));
     }
     const std::string fig5 = kZordan + ", Sec. 8.1 'forced exhale', Fig. 5";
     if (calm)
-      out.push_back(check("forced_exhale.below_calm", "calm end-expiratory volume minus lowest forced-exhale volume",
-                          "> 0 mL", fig5, "mL", (calm->summary.endExpiratoryVolume - minVolume) * kMl, 1e-9, kBig));
-    out.push_back(check("forced_exhale.umbilicus", "umbilicus anterior displacement (most posterior)", "<= -10 mm", fig5,
-                        "mm", minUmbY * kMm, -kBig, -10.0));
-    out.push_back(check("forced_exhale.xiphoid", "xiphoid vertical displacement (lowest)", "< -1 mm (ribcage pulled down)",
-                        fig5, "mm", minXiphZ * kMm, -kBig, -1.0));
+      out.push_back(check("forced_exhale.below_calm",
+                          "calm end-expiratory volume minus lowest forced-exhale volume", "> 0 mL", fig5,
+                          "mL", (calm->summary.endExpiratoryVolume - minVolume) * kMl, 1e-9, kBig));
+    out.push_back(check("forced_exhale.umbilicus", "umbilicus anterior displacement (most posterior)",
+                        "<= -10 mm", fig5, "mm", minUmbY * kMm, -kBig, -10.0));
+    out.push_back(check("forced_exhale.xiphoid", "xiphoid vertical displacement (lowest)",
+                        "< -1 mm (ribcage pulled down)", fig5, "mm", minXiphZ * kMm, -kBig, -1.0));
   }
   return out;
 }
@@ -181,42 +194,48 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
       if (r.style.name == "calm") calm = &r;
       if (r.style.name == "deep") deep = &r;
     }
-  const std::string boussuges = "M-mode ultrasound, quiet breathing 18 +/- 3 mm and deep breathing 70 +/- 11 mm in men "
-                                "(Boussuges, Gole & Blanc 2009, Chest 135:391)";
-  const std::string wilson = "bucket-handle widening of the lower ribs (Wilson et al. 1987, J Appl Physiol 62:1872; "
-                             "De Troyer & Boriek 2011, Compr Physiol 1:1273)";
+  const std::string boussuges =
+      "M-mode ultrasound, quiet breathing 18 +/- 3 mm and deep breathing 70 +/- 11 mm in men "
+      "(Boussuges, Gole & Blanc 2009, Chest 135:391)";
+  const std::string wilson =
+      "bucket-handle widening of the lower ribs (Wilson et al. 1987, J Appl Physiol 62:1872; "
+      "De Troyer & Boriek 2011, Compr Physiol 1:1273)";
   std::vector<Check> out;
   if (calm) {
     const Motion& m = calm->summary.motion;
-    out.push_back(check("physiology.calm.dome_descent", "dome descent (central tendon, craniocaudal), calm", "12 - 25 mm",
-                        boussuges, "mm", m.domeDescent * kMm, 12.0, 25.0));
-    out.push_back(check("physiology.calm.umbilicus_forward", "umbilicus anterior motion, smallest over the calm breaths",
-                        "> 0 mm (the belly moves out on every inhale)", "Konno & Mead 1967, J Appl Physiol 22:407", "mm",
-                        m.umbilicusAnteriorMin * kMm, 1e-9, kBig));
-    out.push_back(check("physiology.calm.lower_rib_expansion", "rib-8 lateral distance, change, calm", ">= 2 mm", wilson, "mm",
-                        m.lowerRibExpansion * kMm, 2.0, kBig));
-    out.push_back(check("physiology.calm.rib_cage_share", "rib-cage share of the tidal volume, calm, upright", "55 - 85 %",
-                        "seated at rest the abdomen gives about a quarter (J Appl Physiol 1968, 24:159); rib cage dominant "
-                        "upright (Sharp et al. 1975, J Appl Physiol 39:608)",
-                        "%", kPct * m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal), 55.0, 85.0));
+    out.push_back(check("physiology.calm.dome_descent", "dome descent (central tendon, craniocaudal), calm",
+                        "12 - 25 mm", boussuges, "mm", m.domeDescent * kMm, 12.0, 25.0));
+    out.push_back(check(
+        "physiology.calm.umbilicus_forward", "umbilicus anterior motion, smallest over the calm breaths",
+        "> 0 mm (the belly moves out on every inhale)", "Konno & Mead 1967, J Appl Physiol 22:407", "mm",
+        m.umbilicusAnteriorMin * kMm, 1e-9, kBig));
+    out.push_back(check("physiology.calm.lower_rib_expansion", "rib-8 lateral distance, change, calm",
+                        ">= 2 mm", wilson, "mm", m.lowerRibExpansion * kMm, 2.0, kBig));
+    out.push_back(check(
+        "physiology.calm.rib_cage_share", "rib-cage share of the tidal volume, calm, upright", "55 - 85 %",
+        "seated at rest the abdomen gives about a quarter (J Appl Physiol 1968, 24:159); rib cage dominant "
+        "upright (Sharp et al. 1975, J Appl Physiol 39:608)",
+        "%", kPct * m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal), 55.0, 85.0));
     out.push_back(check("physiology.calm.phase", "rib-cage / abdomen phase angle, calm", "< 30 deg",
-                        "12-23 deg in healthy young adults (Chen et al. 2015)", "deg", m.phaseAngle * 180.0 / M_PI, 0.0, 30.0));
+                        "12-23 deg in healthy young adults (Chen et al. 2015)", "deg",
+                        m.phaseAngle * 180.0 / M_PI, 0.0, 30.0));
     out.push_back(check("physiology.calm.flow_reversals", "flow (dV/dt) sign changes per breath, calm", "2",
                         "a spirogram: one inspiration, one expiration", "-", m.flowSignChanges, 2.0, 2.0));
-    out.push_back(check("physiology.calm.flow_jump", "largest frame-to-frame flow change, calm", "<= 20 % of peak flow",
-                        "smooth tidal airflow profiles (Benchetrit 2000, Respir Physiol 122:123)", "% of peak",
-                        m.maxFlowJump * kPct, 0.0, 20.0));
+    out.push_back(check("physiology.calm.flow_jump", "largest frame-to-frame flow change, calm",
+                        "<= 20 % of peak flow",
+                        "smooth tidal airflow profiles (Benchetrit 2000, Respir Physiol 122:123)",
+                        "% of peak", m.maxFlowJump * kPct, 0.0, 20.0));
   }
   if (deep) {
     const Motion& m = deep->summary.motion;
     if (calm)
-      out.push_back(check("physiology.deep.dome_over_calm", "dome descent, deep over calm", ">= 2", boussuges, "-",
-                          m.domeDescent / calm->summary.motion.domeDescent, 2.0, kBig));
-    out.push_back(check("physiology.deep.dome_per_litre", "dome descent per litre inspired, deep", "20 - 35 mm/L",
-                        "derived: " + boussuges + " over an inspiratory capacity of 2-3.5 L", "mm/L",
-                        m.domeDescent * kMm / (deep->summary.tidalVolume * 1e3), 20.0, 35.0));
-    out.push_back(check("physiology.deep.lower_rib_expansion", "rib-8 lateral distance, change, deep", ">= 10 mm", wilson, "mm",
-                        m.lowerRibExpansion * kMm, 10.0, kBig));
+      out.push_back(check("physiology.deep.dome_over_calm", "dome descent, deep over calm", ">= 2", boussuges,
+                          "-", m.domeDescent / calm->summary.motion.domeDescent, 2.0, kBig));
+    out.push_back(check("physiology.deep.dome_per_litre", "dome descent per litre inspired, deep",
+                        "20 - 35 mm/L", "derived: " + boussuges + " over an inspiratory capacity of 2-3.5 L",
+                        "mm/L", m.domeDescent * kMm / (deep->summary.tidalVolume * 1e3), 20.0, 35.0));
+    out.push_back(check("physiology.deep.lower_rib_expansion", "rib-8 lateral distance, change, deep",
+                        ">= 10 mm", wilson, "mm", m.lowerRibExpansion * kMm, 10.0, kBig));
   }
   return out;
 }
@@ -230,8 +249,8 @@ std::vector<std::pair<std::size_t, std::size_t>> phaseFrames(const StyleRun& r, 
   const Trace& t = r.trace;
   std::vector<std::pair<std::size_t, std::size_t>> out;
   if (t.size() == 0) return out;
-  const double period = 60.0 / r.style.breathsPerMinute;   // [s]
-  const double split = r.style.inhaleFraction * period;    // [s]
+  const double period = 60.0 / r.style.breathsPerMinute;  // [s]
+  const double split = r.style.inhaleFraction * period;   // [s]
   const int cycles = r.style.cycles > 0 ? r.style.cycles : std::numeric_limits<int>::max();
   for (int k = 0; k < cycles; ++k) {
     const double cycle = r.settleTime + k * period;
@@ -255,7 +274,8 @@ double spineSway(const StyleRun& r) {
   for (const auto& [first, last] : phaseFrames(r, true)) {
     // the most posterior spine-top position during this inhale, from its start
     double back = 0.0;
-    for (std::size_t i = first; i < last; ++i) back = std::min(back, r.spineTop[i].y() - r.spineTop[first].y());
+    for (std::size_t i = first; i < last; ++i)
+      back = std::min(back, r.spineTop[i].y() - r.spineTop[first].y());
     sum += back;
     ++count;
   }
@@ -267,7 +287,8 @@ double expirationRebound(const StyleRun& r) {
   double rebound = 0.0;
   for (const auto& [first, last] : phaseFrames(r, false)) {
     // from the exhale's highest volume on, the largest rise above the running minimum
-    const auto peak = std::max_element(v.begin() + static_cast<std::ptrdiff_t>(first), v.begin() + static_cast<std::ptrdiff_t>(last));
+    const auto peak = std::max_element(v.begin() + static_cast<std::ptrdiff_t>(first),
+                                       v.begin() + static_cast<std::ptrdiff_t>(last));
     double low = *peak;
     for (auto it = peak; it != v.begin() + static_cast<std::ptrdiff_t>(last); ++it) {
       low = std::min(low, *it);
@@ -280,10 +301,12 @@ double expirationRebound(const StyleRun& r) {
 std::vector<Check> swayChecks(const StyleRun& withFriction, const StyleRun& frictionless) {
   const std::string sec5 = kZordan + ", Sec. 5, Eq. 3";
   const double a = spineSway(withFriction), b = spineSway(frictionless);
-  return {check("sway.backward", "spine-top (" + withFriction.spineBody + ") most posterior displacement during an inhale, mean over inhales, deep, with friction",
+  return {check("sway.backward",
+                "spine-top (" + withFriction.spineBody +
+                    ") most posterior displacement during an inhale, mean over inhales, deep, with friction",
                 "< -0.1 mm (spine moves backward on inhale)", sec5, "mm", a * kMm, -kBig, -0.1),
-          check("sway.friction_ratio", "spine sway frictionless / with friction", "< 0.5",
-                sec5, "-", std::abs(b) / std::max(std::abs(a), 1e-12), 0.0, 0.5)};
+          check("sway.friction_ratio", "spine sway frictionless / with friction", "< 0.5", sec5, "-",
+                std::abs(b) / std::max(std::abs(a), 1e-12), 0.0, 0.5)};
 }
 
 double settleDrift(const StyleRun& r, double window) {
@@ -335,12 +358,14 @@ ImpactRun runHeavyImpact(std::shared_ptr<const Model> modelPtr, const Experiment
   // the blow: wall nodes around the umbilicus move posteriorly (-y)
   ImpactRun run;
   for (int n = 0; n < model.nodes.size(); ++n) {
-    if (model.nodes.isFixed(n) || model.nodes.region[static_cast<std::size_t>(n)] != NodeRegion::Wall) continue;
+    if (model.nodes.isFixed(n) || model.nodes.region[static_cast<std::size_t>(n)] != NodeRegion::Wall)
+      continue;
     if ((s.nodePosition.col(n) - umb).norm() > settings.impactRadius) continue;
     s.nodeVelocity(1, n) -= settings.impactSpeed;
     ++run.struckNodes;
   }
-  if (run.struckNodes == 0) throw Error("heavy impact: no abdominal wall node within the impact radius of the umbilicus");
+  if (run.struckNodes == 0)
+    throw Error("heavy impact: no abdominal wall node within the impact radius of the umbilicus");
 
   // follow the deformation step by step
   StepWork w = makeStepWork(model);

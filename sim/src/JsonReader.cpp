@@ -1,17 +1,16 @@
 #include "pneuma/sim/JsonReader.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Limits.h"
-
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <cmath>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Limits.h"
 
 namespace pneuma::sim {
 
@@ -24,7 +23,8 @@ std::string readInputFile(const std::string& path, const std::string& hint) {
   if (!std::filesystem::is_regular_file(st)) throw Error(path + ": not a regular file");
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) throw Error(path + ": cannot open" + hint);
-  if (size > kMaxInputFileBytes) throw Error(path + ": larger than 256 MiB (" + std::to_string(size) + " bytes)");
+  if (size > kMaxInputFileBytes)
+    throw Error(path + ": larger than 256 MiB (" + std::to_string(size) + " bytes)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open" + hint);
   std::string text(static_cast<std::size_t>(size), '\0');
@@ -75,8 +75,12 @@ void writeBounded(const json& v, std::string& out, std::size_t limit) {
       out += ']';
       return;
     }
-    case json::value_t::string: out += quoted(v.get_ref<const std::string&>(), limit); return;
-    default: out += v.dump(); return;
+    case json::value_t::string:
+      out += quoted(v.get_ref<const std::string&>(), limit);
+      return;
+    default:
+      out += v.dump();
+      return;
   }
 }
 
@@ -96,7 +100,8 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
-// where the parser is in the document: one frame per open array or object, for paths, duplicate keys and depth
+// where the parser is in the document: one frame per open array or object, for paths, duplicate keys and
+// depth
 class ParsePosition {
  public:
   ParsePosition(const std::string& source, int maxDepth) : m_source(source), m_maxDepth(maxDepth) {}
@@ -120,7 +125,9 @@ class ParsePosition {
         m_frames.pop_back();
         advance();
         break;
-      case json::parse_event_t::value: advance(); break;
+      case json::parse_event_t::value:
+        advance();
+        break;
     }
     return true;
   }
@@ -129,8 +136,10 @@ class ParsePosition {
   std::string path() const {
     std::string p;
     for (const Frame& f : m_frames) {
-      if (f.isArray) p += "[" + std::to_string(f.index) + "]";
-      else if (!f.key.empty() || !f.seen.empty()) p += (p.empty() ? "" : ".") + excerptOf(f.key, 60);
+      if (f.isArray)
+        p += "[" + std::to_string(f.index) + "]";
+      else if (!f.key.empty() || !f.seen.empty())
+        p += (p.empty() ? "" : ".") + excerptOf(f.key, 60);
     }
     return p.empty() ? "(root)" : excerptOf(p, 120);  // deep nesting makes long paths
   }
@@ -189,7 +198,8 @@ JsonDocument JsonDocument::parse(const std::string& text, const std::string& sou
   impl->source = source;
   ParsePosition pos(impl->source, limits.maxDepth);
   try {
-    impl->doc = json::parse(text, [&pos](int, json::parse_event_t event, json& parsed) { return pos.onEvent(event, parsed); });
+    impl->doc = json::parse(
+        text, [&pos](int, json::parse_event_t event, json& parsed) { return pos.onEvent(event, parsed); });
   } catch (const json::parse_error& e) {
     throw Error(source + ": " + parseErrorText(e));
   } catch (const json::out_of_range& e) {
@@ -323,11 +333,12 @@ std::int64_t JsonReader::integerIn(std::int64_t lo, std::int64_t hi) const {
   const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   if (!j.is_number_integer()) fail("must be an integer in " + range + ", got " + excerpt());
   // unsigned values above the int64 range are out of any int64 range
-  const bool fits = j.is_number_unsigned()
-                        ? j.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) &&
-                              static_cast<std::int64_t>(j.get<std::uint64_t>()) <= hi &&
-                              static_cast<std::int64_t>(j.get<std::uint64_t>()) >= lo
-                        : j.get<std::int64_t>() >= lo && j.get<std::int64_t>() <= hi;
+  const bool fits =
+      j.is_number_unsigned()
+          ? j.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) &&
+                static_cast<std::int64_t>(j.get<std::uint64_t>()) <= hi &&
+                static_cast<std::int64_t>(j.get<std::uint64_t>()) >= lo
+          : j.get<std::int64_t>() >= lo && j.get<std::int64_t>() <= hi;
   if (!fits) fail("must be an integer in " + range + ", got " + excerpt());
   return j.get<std::int64_t>();
 }

@@ -43,18 +43,21 @@ std::size_t firstIndex(const Trace& t, double from) {
   return static_cast<std::size_t>(std::lower_bound(t.time.begin(), t.time.end(), from) - t.time.begin());
 }
 // the breath-frequency Fourier component of v over frames [a, b) at angular frequency omega [rad/s]
-std::complex<double> fundamental(const Trace& t, const std::vector<double>& v, std::size_t a, std::size_t b, double omega) {
+std::complex<double> fundamental(const Trace& t, const std::vector<double>& v, std::size_t a, std::size_t b,
+                                 double omega) {
   double mean = 0.0;
   for (std::size_t i = a; i < b; ++i) mean += v[i];
   mean /= static_cast<double>(b - a);
   std::complex<double> c = 0.0;
-  for (std::size_t i = a; i < b; ++i) c += (v[i] - mean) * std::exp(std::complex<double>(0.0, -omega * t.time[i]));
+  for (std::size_t i = a; i < b; ++i)
+    c += (v[i] - mean) * std::exp(std::complex<double>(0.0, -omega * t.time[i]));
   return c;
 }
 
-// motion in anatomical axes over the cycles delimited by the frames `up` (upward crossings of the mean volume)
-Motion measureMotion(const Trace& t, const std::vector<std::string>& names, const std::vector<std::size_t>& up,
-                     double period) {
+// motion in anatomical axes over the cycles delimited by the frames `up` (upward crossings of the mean
+// volume)
+Motion measureMotion(const Trace& t, const std::vector<std::string>& names,
+                     const std::vector<std::size_t>& up, double period) {
   Motion m;
   const int cycles = static_cast<int>(up.size()) - 1;
   if (cycles < 1) return m;
@@ -73,7 +76,8 @@ Motion measureMotion(const Trace& t, const std::vector<std::string>& names, cons
   // mean over cycles of f(end-inspiration frame) - f(end-expiration frame)
   auto change = [&](auto f) {
     double sum = 0.0;
-    for (int c = 0; c < cycles; ++c) sum += f(insp[static_cast<std::size_t>(c)]) - f(exp[static_cast<std::size_t>(c)]);
+    for (int c = 0; c < cycles; ++c)
+      sum += f(insp[static_cast<std::size_t>(c)]) - f(exp[static_cast<std::size_t>(c)]);
     return sum / cycles;
   };
   auto axis = [&](const char* name, int k, double sign) {
@@ -90,12 +94,14 @@ Motion measureMotion(const Trace& t, const std::vector<std::string>& names, cons
   if (const int u = landmark("umbilicus"); u >= 0) {
     m.umbilicusAnteriorMin = std::numeric_limits<double>::infinity();
     for (int c = 0; c < cycles; ++c)
-      m.umbilicusAnteriorMin = std::min(m.umbilicusAnteriorMin, t.landmarks[insp[static_cast<std::size_t>(c)]](1, u) -
-                                                                    t.landmarks[exp[static_cast<std::size_t>(c)]](1, u));
+      m.umbilicusAnteriorMin =
+          std::min(m.umbilicusAnteriorMin, t.landmarks[insp[static_cast<std::size_t>(c)]](1, u) -
+                                               t.landmarks[exp[static_cast<std::size_t>(c)]](1, u));
   }
   const int left = landmark("rib8_lateral_left"), right = landmark("rib8_lateral_right");
   if (left >= 0 && right >= 0)
-    m.lowerRibExpansion = change([&](std::size_t i) { return (t.landmarks[i].col(left) - t.landmarks[i].col(right)).norm(); });
+    m.lowerRibExpansion =
+        change([&](std::size_t i) { return (t.landmarks[i].col(left) - t.landmarks[i].col(right)).norm(); });
 
   // Konno-Mead partition: abdomen = the wall's displaced volume, rib cage = the rest of the lung volume
   if (t.abdomenVolume.size() == t.size()) {
@@ -166,8 +172,8 @@ Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNa
   for (std::size_t i = i0; i < trace.size(); ++i) mean += trace.lungVolume[i];
   mean /= static_cast<double>(trace.size() - i0);
   const double hysteresis = 0.25 * (hi - lo);
-  std::vector<std::size_t> up;     // frame index of each upward crossing
-  std::vector<double> upTime;      // [s] interpolated crossing time
+  std::vector<std::size_t> up;  // frame index of each upward crossing
+  std::vector<double> upTime;   // [s] interpolated crossing time
   bool armed = false;
   for (std::size_t i = i0 + 1; i < trace.size(); ++i) {
     const double v0 = trace.lungVolume[i - 1], v1 = trace.lungVolume[i];
@@ -190,7 +196,8 @@ Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNa
     double tidal = 0.0, minima = 0.0, maxima = 0.0;
     for (int c = 0; c < s.cycles; ++c) {
       const auto a = trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(up[static_cast<std::size_t>(c)]);
-      const auto b = trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(up[static_cast<std::size_t>(c) + 1]);
+      const auto b =
+          trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(up[static_cast<std::size_t>(c) + 1]);
       const double cmin = *std::min_element(a, b), cmax = *std::max_element(a, b);
       tidal += cmax - cmin;
       minima += cmin;

@@ -3,9 +3,12 @@
 namespace pneuma::sim {
 
 namespace {
-constexpr std::array<const char*, kElementGroupCount> kGroupNames = {
-    "intercostal_external", "intercostal_internal", "diaphragm",
-    "rectus",               "transversus_obliques", "cartilage"};
+constexpr std::array<const char*, kElementGroupCount> kGroupNames = {"intercostal_external",
+                                                                     "intercostal_internal",
+                                                                     "diaphragm",
+                                                                     "rectus",
+                                                                     "transversus_obliques",
+                                                                     "cartilage"};
 
 // append one column to a 3 x n matrix
 template <typename M, typename V>

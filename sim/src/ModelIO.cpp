@@ -1,19 +1,17 @@
 #include "pneuma/sim/ModelIO.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/JsonReader.h"
-#include "pneuma/sim/State.h"
-
-#include <nlohmann/json.hpp>
-
 #include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/State.h"
 
 namespace pneuma::sim {
 
@@ -27,9 +25,12 @@ constexpr const char* kRequiredLandmarks[] = {"xiphoid", "umbilicus", "diaphragm
 
 const char* regionName(NodeRegion r) {
   switch (r) {
-    case NodeRegion::Wall: return "wall";
-    case NodeRegion::Diaphragm: return "diaphragm";
-    case NodeRegion::Fixed: return "fixed";
+    case NodeRegion::Wall:
+      return "wall";
+    case NodeRegion::Diaphragm:
+      return "diaphragm";
+    case NodeRegion::Fixed:
+      return "fixed";
   }
   return "wall";
 }
@@ -39,16 +40,21 @@ const char* regionName(NodeRegion r) {
 
 using Reader = JsonReader;
 
-// anchor: {"body": i, "local": [x,y,z]} or {"nodes": [a(,b,c)], "weights": [wa(,wb,wc)]}; landmarks add "name"
+// anchor: {"body": i, "local": [x,y,z]} or {"nodes": [a(,b,c)], "weights": [wa(,wb,wc)]}; landmarks add
+// "name"
 void readAnchor(const Reader& r, AnchorSet& out, bool named = false) {
   if (r.has("body")) {
-    if (named) r.allowKeys({"body", "local", "name"});
-    else r.allowKeys({"body", "local"});
+    if (named)
+      r.allowKeys({"body", "local", "name"});
+    else
+      r.allowKeys({"body", "local"});
     out.addBodyPoint(r.at("body").integer(), r.at("local").vec3());
     return;
   }
-  if (named) r.allowKeys({"nodes", "weights", "name"});
-  else r.allowKeys({"nodes", "weights"});
+  if (named)
+    r.allowKeys({"nodes", "weights", "name"});
+  else
+    r.allowKeys({"nodes", "weights"});
   const Reader nodes = r.at("nodes");
   const Reader weights = r.at("weights");
   const std::size_t n = nodes.size();
@@ -83,7 +89,8 @@ json writeAnchor(const AnchorSet& a, int i) {
 
 json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-// lung surface: {"vertices": [{"cavity_vertices": [i, ...], "weights": [w, ...]}, ...], "triangles": [[a, b, c], ...]}
+// lung surface: {"vertices": [{"cavity_vertices": [i, ...], "weights": [w, ...]}, ...], "triangles": [[a, b,
+// c], ...]}
 void readLungSurface(const Reader& r, LungSurface& out) {
   r.allowKeys({"vertices", "triangles"});
   const Reader verts = r.at("vertices");
@@ -97,7 +104,8 @@ void readLungSurface(const Reader& r, LungSurface& out) {
     const Reader w = v.at("weights");
     if (idx.size() < 1 || idx.size() > kLungVertexSlots)
       idx.fail("must list 1 to " + std::to_string(kLungVertexSlots) + " cavity vertex indices");
-    if (w.size() != idx.size()) w.fail("must have as many entries as cavity_vertices (" + std::to_string(idx.size()) + ")");
+    if (w.size() != idx.size())
+      w.fail("must have as many entries as cavity_vertices (" + std::to_string(idx.size()) + ")");
     for (std::size_t k = 0; k < idx.size(); ++k) {
       out.cavityVertex(static_cast<Eigen::Index>(k), i) = idx[k].integer();
       out.weights(static_cast<Eigen::Index>(k), i) = w[k].number();
@@ -105,7 +113,8 @@ void readLungSurface(const Reader& r, LungSurface& out) {
   }
   const Reader tris = r.at("triangles");
   out.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
-  for (std::size_t i = 0; i < tris.size(); ++i) out.triangles.col(static_cast<Eigen::Index>(i)) = tris[i].index3();
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    out.triangles.col(static_cast<Eigen::Index>(i)) = tris[i].index3();
 }
 
 json writeLungSurface(const LungSurface& s) {
@@ -120,14 +129,17 @@ json writeLungSurface(const LungSurface& s) {
     verts.push_back({{"cavity_vertices", std::move(idx)}, {"weights", std::move(w)}});
   }
   json tris = json::array();
-  for (int i = 0; i < s.triangles.cols(); ++i) tris.push_back({s.triangles(0, i), s.triangles(1, i), s.triangles(2, i)});
+  for (int i = 0; i < s.triangles.cols(); ++i)
+    tris.push_back({s.triangles(0, i), s.triangles(1, i), s.triangles(2, i)});
   return {{"vertices", std::move(verts)}, {"triangles", std::move(tris)}};
 }
 
 // ---------------------------------------------------------------------------------------------
 // validation helpers
 
-[[noreturn]] void invalid(const std::string& field, const std::string& why) { throw Error(field + ": " + why); }
+[[noreturn]] void invalid(const std::string& field, const std::string& why) {
+  throw Error(field + ": " + why);
+}
 
 std::string num(double v) {
   std::ostringstream s;
@@ -153,17 +165,23 @@ void validateAnchors(const AnchorSet& a, const std::string& field, int nBodies, 
     const std::string f = field + "[" + std::to_string(i) + "]";
     const int b = a.body[static_cast<std::size_t>(i)];
     if (b >= 0) {
-      if (b >= nBodies) invalid(f + ".body", "index " + std::to_string(b) + " out of range [0, " + std::to_string(nBodies) + ")");
+      if (b >= nBodies)
+        invalid(f + ".body",
+                "index " + std::to_string(b) + " out of range [0, " + std::to_string(nBodies) + ")");
       requireFinite(a.local.col(i), f + ".local");
       continue;
     }
-    if (b != -1) invalid(f + ".body", "index " + std::to_string(b) + " out of range [0, " + std::to_string(nBodies) + ")");
+    if (b != -1)
+      invalid(f + ".body",
+              "index " + std::to_string(b) + " out of range [0, " + std::to_string(nBodies) + ")");
     double sum = 0.0;
     int used = 0;
     for (int k = 0; k < 3; ++k) {
       const int node = a.nodes(k, i);
       if (node < 0) continue;
-      if (node >= nNodes) invalid(f + ".nodes", "index " + std::to_string(node) + " out of range [0, " + std::to_string(nNodes) + ")");
+      if (node >= nNodes)
+        invalid(f + ".nodes",
+                "index " + std::to_string(node) + " out of range [0, " + std::to_string(nNodes) + ")");
       if (!std::isfinite(a.weights(k, i))) invalid(f + ".weights", "must be finite");
       sum += a.weights(k, i);
       ++used;
@@ -177,8 +195,9 @@ void validateTriangles(const Eigen::Matrix3Xi& t, const std::string& field, int 
   for (int i = 0; i < t.cols(); ++i) {
     for (int k = 0; k < 3; ++k) {
       if (t(k, i) < 0 || t(k, i) >= nVertices)
-        invalid(field + "[" + std::to_string(i) + "]",
-                "vertex index " + std::to_string(t(k, i)) + " out of range [0, " + std::to_string(nVertices) + ")");
+        invalid(field + "[" + std::to_string(i) + "]", "vertex index " + std::to_string(t(k, i)) +
+                                                           " out of range [0, " + std::to_string(nVertices) +
+                                                           ")");
     }
     if (t(0, i) == t(1, i) || t(1, i) == t(2, i) || t(0, i) == t(2, i))
       invalid(field + "[" + std::to_string(i) + "]", "degenerate triangle (repeated vertex)");
@@ -195,7 +214,8 @@ void validateLungVertices(const LungSurface& s, const std::string& field, int nC
       const int c = s.cavityVertex(k, i);
       if (c < 0) continue;
       if (c >= nCavity)
-        invalid(f + ".cavity_vertices", "index " + std::to_string(c) + " out of range [0, " + std::to_string(nCavity) + ")");
+        invalid(f + ".cavity_vertices",
+                "index " + std::to_string(c) + " out of range [0, " + std::to_string(nCavity) + ")");
       const double w = s.weights(k, i);
       if (!std::isfinite(w) || w < 0.0) invalid(f + ".weights", "must be finite and >= 0, got " + num(w));
       sum += w;
@@ -294,8 +314,9 @@ void validateModel(const Model& m) {
 
   // bodies
   if (nB == 0) invalid("bodies", "must not be empty");
-  if (static_cast<int>(m.bodies.isFixed.size()) != nB || m.bodies.mass.size() != nB || m.bodies.com.cols() != nB ||
-      static_cast<int>(m.bodies.inertia.size()) != nB || static_cast<int>(m.bodies.mesh.size()) != nB)
+  if (static_cast<int>(m.bodies.isFixed.size()) != nB || m.bodies.mass.size() != nB ||
+      m.bodies.com.cols() != nB || static_cast<int>(m.bodies.inertia.size()) != nB ||
+      static_cast<int>(m.bodies.mesh.size()) != nB)
     invalid("bodies", "inconsistent array sizes");
   std::set<std::string> names;
   for (int i = 0; i < nB; ++i) {
@@ -309,7 +330,8 @@ void validateModel(const Model& m) {
     if (!I.allFinite() || (I - I.transpose()).norm() > 1e-9 * (1.0 + I.norm()))
       invalid(f + ".inertia", "must be a finite symmetric 3x3 matrix");
     const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I).eigenvalues();
-    if (ev.minCoeff() <= 0.0) invalid(f + ".inertia", "must be positive definite, smallest eigenvalue " + num(ev.minCoeff()));
+    if (ev.minCoeff() <= 0.0)
+      invalid(f + ".inertia", "must be positive definite, smallest eigenvalue " + num(ev.minCoeff()));
   }
   if (m.bodies.mesh.size() != m.bodies.name.size()) invalid("bodies", "inconsistent mesh list");
 
@@ -342,8 +364,10 @@ void validateModel(const Model& m) {
   for (int i = 0; i < nN; ++i) {
     const std::string f = "nodes[" + std::to_string(i) + "]";
     requireFinite(m.nodes.rest.col(i), f + ".x");
-    if (m.nodes.isFixed(i)) requireNonNegative(m.nodes.mass[i], f + ".mass");
-    else requirePositive(m.nodes.mass[i], f + ".mass");
+    if (m.nodes.isFixed(i))
+      requireNonNegative(m.nodes.mass[i], f + ".mass");
+    else
+      requirePositive(m.nodes.mass[i], f + ".mass");
   }
   validateTriangles(m.gut.triangles, "gut.triangles", nN);
   requireNonNegative(m.gut.drag, "gut.drag");
@@ -351,7 +375,9 @@ void validateModel(const Model& m) {
     validateClosedSurface(m.gut.triangles, "gut.triangles");
     requirePositive(m.gut.kappa, "gut.kappa");
     const double v0 = enclosedVolume(m.nodes.rest, m.gut.triangles);
-    if (v0 <= 0.0) invalid("gut.triangles", "enclosed rest volume must be > 0 (outward orientation), got " + num(v0) + " m^3");
+    if (v0 <= 0.0)
+      invalid("gut.triangles",
+              "enclosed rest volume must be > 0 (outward orientation), got " + num(v0) + " m^3");
   }
 
   // elements
@@ -395,11 +421,13 @@ void validateModel(const Model& m) {
     invalid("lungs.mediastinum_volume", "must be smaller than the cavity's rest volume " + num(cavityVolume) +
                                             " m^3, got " + num(mediastinum));
   const bool hasRight = m.lungs.right.vertexCount() > 0, hasLeft = m.lungs.left.vertexCount() > 0;
-  if (hasRight != hasLeft) invalid(hasRight ? "lungs.left" : "lungs.right", "must be given with the other lung");
+  if (hasRight != hasLeft)
+    invalid(hasRight ? "lungs.left" : "lungs.right", "must be given with the other lung");
   if (hasRight) {
     const Eigen::Matrix3Xd cavityRest = restPoints(m.cavity.vertices, m);
-    for (const auto& [lung, name] : {std::pair<const LungSurface*, std::string>{&m.lungs.right, "lungs.right"},
-                                     {&m.lungs.left, "lungs.left"}}) {
+    for (const auto& [lung, name] :
+         {std::pair<const LungSurface*, std::string>{&m.lungs.right, "lungs.right"},
+          {&m.lungs.left, "lungs.left"}}) {
       validateLungVertices(*lung, name + ".vertices", m.cavity.vertices.size());
       validateTriangles(lung->triangles, name + ".triangles", lung->vertexCount());
       validateClosedSurface(lung->triangles, name + ".triangles");
@@ -407,7 +435,8 @@ void validateModel(const Model& m) {
       lungPositions(*lung, cavityRest, x);
       const double v = enclosedVolume(x, lung->triangles);
       if (!(v > 0.0))
-        invalid(name + ".triangles", "enclosed rest volume must be > 0 (outward orientation), got " + num(v) + " m^3");
+        invalid(name + ".triangles",
+                "enclosed rest volume must be > 0 (outward orientation), got " + num(v) + " m^3");
     }
   }
 
@@ -416,7 +445,8 @@ void validateModel(const Model& m) {
     invalid("landmarks", "inconsistent array sizes");
   validateAnchors(m.landmarks.points, "landmarks", nB, nN);
   for (const char* required : kRequiredLandmarks) {
-    if (m.landmarks.find(required) < 0) invalid("landmarks", std::string("missing required landmark '") + required + "'");
+    if (m.landmarks.find(required) < 0)
+      invalid("landmarks", std::string("missing required landmark '") + required + "'");
   }
 
   if (!m.gravity.allFinite()) invalid("gravity", "must be finite");
@@ -427,8 +457,8 @@ void validateModel(const Model& m) {
 Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
   const Reader root = doc.root();
-  root.allowKeys({"format", "version", "name", "anatomy", "units", "frame", "gravity", "bodies", "joints", "nodes",
-                  "gut", "elements", "cavity", "lungs", "landmarks"});
+  root.allowKeys({"format", "version", "name", "anatomy", "units", "frame", "gravity", "bodies", "joints",
+                  "nodes", "gut", "elements", "cavity", "lungs", "landmarks"});
 
   // header
   if (root.at("format").string() != kFormatName)
@@ -497,10 +527,14 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     m.nodes.rest.col(static_cast<Eigen::Index>(i)) = n.at("x").vec3();
     m.nodes.mass[static_cast<Eigen::Index>(i)] = n.at("mass").number();
     const std::string region = n.at("region").string();
-    if (region == "wall") m.nodes.region.push_back(NodeRegion::Wall);
-    else if (region == "diaphragm") m.nodes.region.push_back(NodeRegion::Diaphragm);
-    else if (region == "fixed") m.nodes.region.push_back(NodeRegion::Fixed);
-    else n.at("region").fail("unknown region '" + excerptOf(region) + "' (expected wall, diaphragm or fixed)");
+    if (region == "wall")
+      m.nodes.region.push_back(NodeRegion::Wall);
+    else if (region == "diaphragm")
+      m.nodes.region.push_back(NodeRegion::Diaphragm);
+    else if (region == "fixed")
+      m.nodes.region.push_back(NodeRegion::Fixed);
+    else
+      n.at("region").fail("unknown region '" + excerptOf(region) + "' (expected wall, diaphragm or fixed)");
   }
 
   // gut
@@ -510,7 +544,8 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   if (gut.has("drag")) m.gut.drag = gut.at("drag").number();  // optional: models written before it have none
   const Reader gutTris = gut.at("triangles");
   m.gut.triangles.resize(3, static_cast<Eigen::Index>(gutTris.size()));
-  for (std::size_t i = 0; i < gutTris.size(); ++i) m.gut.triangles.col(static_cast<Eigen::Index>(i)) = gutTris[i].index3();
+  for (std::size_t i = 0; i < gutTris.size(); ++i)
+    m.gut.triangles.col(static_cast<Eigen::Index>(i)) = gutTris[i].index3();
 
   // elements
   const Reader elements = root.at("elements");
@@ -543,11 +578,13 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   for (std::size_t i = 0; i < cavVerts.size(); ++i) readAnchor(cavVerts[i], m.cavity.vertices);
   const Reader cavTris = cavity.at("triangles");
   m.cavity.triangles.resize(3, static_cast<Eigen::Index>(cavTris.size()));
-  for (std::size_t i = 0; i < cavTris.size(); ++i) m.cavity.triangles.col(static_cast<Eigen::Index>(i)) = cavTris[i].index3();
+  for (std::size_t i = 0; i < cavTris.size(); ++i)
+    m.cavity.triangles.col(static_cast<Eigen::Index>(i)) = cavTris[i].index3();
 
   // lungs: required; a model written before the two lungs is refused with the way to rebuild it
   if (!root.has("lungs"))
-    throw Error(root.source() + ": lungs: missing (a model written before the two lungs; rebuild it with "
+    throw Error(root.source() +
+                ": lungs: missing (a model written before the two lungs; rebuild it with "
                 "'pneuma-cli model build')");
   const Reader lungs = root.at("lungs");
   lungs.allowKeys({"mediastinum_volume", "right", "left"});
@@ -583,12 +620,20 @@ std::string serializeModel(const Model& m) {
   doc["version"] = kModelFormatVersion;
   doc["name"] = m.name;
   doc["anatomy"] = m.anatomy;
-  doc["units"] = {{"length", "m"},          {"mass", "kg"},        {"time", "s"},
-                  {"force", "N"},           {"pressure", "Pa"},    {"inertia", "kg m^2"},
-                  {"stiffness", "N/m"},     {"damping", "N s/m"},  {"joint_friction", "N m s/rad"},
-                  {"joint_stiffness", "N m/rad"}, {"angle", "rad"}};
-  doc["frame"] = "RAS: +x subject's right, +y anterior, +z superior; body frames at the centre of mass, "
-                 "axes parallel to the world at rest";
+  doc["units"] = {{"length", "m"},
+                  {"mass", "kg"},
+                  {"time", "s"},
+                  {"force", "N"},
+                  {"pressure", "Pa"},
+                  {"inertia", "kg m^2"},
+                  {"stiffness", "N/m"},
+                  {"damping", "N s/m"},
+                  {"joint_friction", "N m s/rad"},
+                  {"joint_stiffness", "N m/rad"},
+                  {"angle", "rad"}};
+  doc["frame"] =
+      "RAS: +x subject's right, +y anterior, +z superior; body frames at the centre of mass, "
+      "axes parallel to the world at rest";
   doc["gravity"] = vec(m.gravity);
 
   json bodies = json::array();

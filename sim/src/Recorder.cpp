@@ -20,7 +20,8 @@ void Recorder::record(const State& state, const Metrics& metrics) {
     p[6] = static_cast<float>(q.z());
   }
   f.nodePosition.assign(state.nodePosition.data(), state.nodePosition.data() + state.nodePosition.size());
-  f.elementForce.assign(metrics.elementForce.data(), metrics.elementForce.data() + metrics.elementForce.size());
+  f.elementForce.assign(metrics.elementForce.data(),
+                        metrics.elementForce.data() + metrics.elementForce.size());
   f.lungVolume = metrics.lungVolume;
   f.gutVolumeError = metrics.gutVolumeError;
   f.gutPressure = metrics.gutPressure;
@@ -53,7 +54,8 @@ void Recorder::restore(std::size_t i, State& state) const {
   for (Eigen::Index b = 0; b < nb; ++b) {
     const float* p = f.bodyPose.data() + 7 * b;
     state.bodyPosition.col(b) = Eigen::Vector3d(p[0], p[1], p[2]);
-    state.bodyOrientation[static_cast<std::size_t>(b)] = Eigen::Quaterniond(p[3], p[4], p[5], p[6]).normalized();
+    state.bodyOrientation[static_cast<std::size_t>(b)] =
+        Eigen::Quaterniond(p[3], p[4], p[5], p[6]).normalized();
   }
   state.nodePosition = Eigen::Map<const Eigen::Matrix3Xf>(f.nodePosition.data(), 3, nn).cast<double>();
   state.bodyVelocity = Eigen::Matrix3Xd::Zero(3, nb);

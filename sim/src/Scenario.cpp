@@ -1,20 +1,19 @@
 #include "pneuma/sim/Scenario.h"
 
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/JsonReader.h"
-#include "pneuma/sim/Limits.h"
-#include "pneuma/sim/pattern/PatternController.h"
-
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/Limits.h"
+#include "pneuma/sim/pattern/PatternController.h"
 
 namespace pneuma::sim {
 
@@ -39,7 +38,8 @@ void parseGroupScales(const Field& f, std::array<double, kElementGroupCount>& ou
     ElementGroup g;
     if (!groupFromName(key, g)) {
       std::string valid;
-      for (int i = 0; i < kElementGroupCount; ++i) valid += std::string(i ? ", " : "") + groupName(static_cast<ElementGroup>(i));
+      for (int i = 0; i < kElementGroupCount; ++i)
+        valid += std::string(i ? ", " : "") + groupName(static_cast<ElementGroup>(i));
       f.at(key).fail("unknown muscle group (valid: " + valid + ")");
     }
     out[static_cast<std::size_t>(g)] = f.at(key).nonNegative();
@@ -59,9 +59,12 @@ void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
   } else {
     s.controller = ControllerKind::Pattern;
     const Field p = c.at("pattern");
-    if (p.isString()) s.controllerName = resolve(p.string(), baseDir);
-    else if (p.isObject()) s.patternText = p.dump(2);
-    else p.fail("must be a pattern file path or an inline pattern object");
+    if (p.isString())
+      s.controllerName = resolve(p.string(), baseDir);
+    else if (p.isObject())
+      s.patternText = p.dump(2);
+    else
+      p.fail("must be a pattern file path or an inline pattern object");
   }
   if (s.controller != ControllerKind::Pattern && s.controllerName.empty())
     c.at(controllerKindName(s.controller)).fail("must not be empty");
@@ -73,7 +76,8 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
     if (!integratorFromName(name, opt.step.integrator))
-      o.at("integrator").fail("unknown integrator '" + excerptOf(name) + "' (valid: " + integratorNames() + ")");
+      o.at("integrator")
+          .fail("unknown integrator '" + excerptOf(name) + "' (valid: " + integratorNames() + ")");
   }
   if (o.has("dt_s")) opt.dt = o.at("dt_s").numberIn(kTimeStepRange);
   if (o.has("settle_time_s")) opt.settleTime = o.at("settle_time_s").numberIn(kSettleTimeRange);
@@ -100,7 +104,8 @@ void parseOutputs(const Field& o, ScenarioOutputs& out, SimulationOptions& opt) 
 
 json groupScalesJson(const std::array<double, kElementGroupCount>& scales) {
   json j = json::object();
-  for (int i = 0; i < kElementGroupCount; ++i) j[groupName(static_cast<ElementGroup>(i))] = scales[static_cast<std::size_t>(i)];
+  for (int i = 0; i < kElementGroupCount; ++i)
+    j[groupName(static_cast<ElementGroup>(i))] = scales[static_cast<std::size_t>(i)];
   return j;
 }
 
@@ -108,21 +113,26 @@ json groupScalesJson(const std::array<double, kElementGroupCount>& scales) {
 
 const char* controllerKindName(ControllerKind k) {
   switch (k) {
-    case ControllerKind::Style: return "style";
-    case ControllerKind::Affect: return "affect";
-    case ControllerKind::Pattern: return "pattern";
+    case ControllerKind::Style:
+      return "style";
+    case ControllerKind::Affect:
+      return "affect";
+    case ControllerKind::Pattern:
+      return "pattern";
   }
   return "style";
 }
 
-Scenario parseScenario(const std::string& jsonText, const std::string& sourceName, const std::string& baseDir) {
+Scenario parseScenario(const std::string& jsonText, const std::string& sourceName,
+                       const std::string& baseDir) {
   const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
   const Field root = doc.root();
-  root.allowKeys({"format", "version", "name", "description", "model", "duration_s", "seed", "controller", "overrides",
-                  "outputs"});
+  root.allowKeys({"format", "version", "name", "description", "model", "duration_s", "seed", "controller",
+                  "overrides", "outputs"});
 
   // header
-  if (root.at("format").string() != kFormatName) root.at("format").fail(std::string("must be \"") + kFormatName + "\"");
+  if (root.at("format").string() != kFormatName)
+    root.at("format").fail(std::string("must be \"") + kFormatName + "\"");
   const Field version = root.at("version");
   if (version.integerIn(0, std::numeric_limits<int>::max()) != kScenarioFormatVersion)
     version.fail("unsupported version " + version.excerpt() + " (this build reads " +
@@ -180,7 +190,9 @@ std::string serializeScenario(const Scenario& s) {
   if (st.kappa) o["kappa_pa"] = *st.kappa;
   o["active_gain_scale"] = groupScalesJson(st.activeGainScale);
   o["passive_gain_scale"] = groupScalesJson(st.passiveGainScale);
-  j["outputs"] = {{"output_rate_hz", s.options.outputRate}, {"csv", s.outputs.csv}, {"plots", s.outputs.plots},
+  j["outputs"] = {{"output_rate_hz", s.options.outputRate},
+                  {"csv", s.outputs.csv},
+                  {"plots", s.outputs.plots},
                   {"vtk", s.outputs.vtk}};
   return j.dump(2) + "\n";
 }
@@ -198,12 +210,15 @@ auto named(const Scenario& s, F&& load) {
 }
 
 BreathStyle styleOf(const Scenario& s, const std::string& resourceDir) {
-  return named(s, [&] { return loadBreathStyle(s.controllerName, (fs::path(resourceDir) / "presets").string()); });
+  return named(
+      s, [&] { return loadBreathStyle(s.controllerName, (fs::path(resourceDir) / "presets").string()); });
 }
 
 pattern::Pattern patternOf(const Scenario& s, const std::string& resourceDir) {
-  if (s.controller == ControllerKind::Affect) return named(s, [&] { return pattern::loadAffect(s.controllerName, resourceDir); });
-  if (s.patternText.empty()) return named(s, [&] { return pattern::loadPatternFile(s.controllerName, resourceDir); });
+  if (s.controller == ControllerKind::Affect)
+    return named(s, [&] { return pattern::loadAffect(s.controllerName, resourceDir); });
+  if (s.patternText.empty())
+    return named(s, [&] { return pattern::loadPatternFile(s.controllerName, resourceDir); });
   // inline: the pattern parser's message already carries the path below "controller.pattern"
   return pattern::parsePattern(s.patternText, "controller.pattern", resourceDir);
 }
@@ -211,8 +226,10 @@ pattern::Pattern patternOf(const Scenario& s, const std::string& resourceDir) {
 }  // namespace
 
 void checkController(const Scenario& scenario, const std::string& resourceDir) {
-  if (scenario.controller == ControllerKind::Style) validateBreathStyle(styleOf(scenario, resourceDir));
-  else patternOf(scenario, resourceDir);
+  if (scenario.controller == ControllerKind::Style)
+    validateBreathStyle(styleOf(scenario, resourceDir));
+  else
+    patternOf(scenario, resourceDir);
 }
 
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,

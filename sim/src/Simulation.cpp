@@ -51,8 +51,9 @@ void Simulation::setOptions(const SimulationOptions& options) {
   m_options = options;
   updateTimeStep();
   m_recorder.setCapacity(
-      options.recordSeconds > 0.0 ? static_cast<std::size_t>(std::ceil(options.recordSeconds * options.outputRate)) + 1
-                                  : 0);
+      options.recordSeconds > 0.0
+          ? static_cast<std::size_t>(std::ceil(options.recordSeconds * options.outputRate)) + 1
+          : 0);
 }
 
 void Simulation::setController(std::unique_ptr<Controller> controller) {

@@ -24,7 +24,8 @@ void lungPositions(const LungSurface& lung, const Eigen::Matrix3Xd& cavity, Eige
   out.setZero(3, lung.vertexCount());
   for (int i = 0; i < lung.vertexCount(); ++i)
     for (int k = 0; k < kLungVertexSlots; ++k)
-      if (lung.cavityVertex(k, i) >= 0) out.col(i) += lung.weights(k, i) * cavity.col(lung.cavityVertex(k, i));
+      if (lung.cavityVertex(k, i) >= 0)
+        out.col(i) += lung.weights(k, i) * cavity.col(lung.cavityVertex(k, i));
 }
 
 }  // namespace pneuma::sim

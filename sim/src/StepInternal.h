@@ -125,8 +125,8 @@ void updateTreeLevers(const Model& model, StepWork& w);
 void stiffnessProduct(const Model& model, const StepOptions& o, StepWork& w, const Eigen::VectorXd& u,
                       Eigen::VectorXd& out);
 
-// the matrix the preconditioner factors, J^T (M + dt D + dt^2 K) J over the free coordinates without the gut's
-// and the pleural rank-one terms, dense (StepImplicit.cpp; for the stiffness tests)
+// the matrix the preconditioner factors, J^T (M + dt D + dt^2 K) J over the free coordinates without the
+// gut's and the pleural rank-one terms, dense (StepImplicit.cpp; for the stiffness tests)
 Eigen::MatrixXd assembledSystem(const Model& model, const StepOptions& o, StepWork& w, double dt);
 
 // linearly implicit Euler of the velocities in the joint tree's coordinates (StepImplicit.cpp)

@@ -63,11 +63,16 @@ Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o) {
   // the upright gravity turned into the body frame: quarter turns, exact in floating point
   const Eigen::Vector3d& g = model.gravity;
   switch (o.posture) {
-    case Posture::Upright: return g;
-    case Posture::Supine: return {g.x(), g.z(), -g.y()};        // R_x(-90 deg): -z -> -y
-    case Posture::Prone: return {g.x(), -g.z(), g.y()};         // R_x(+90 deg): -z -> +y
-    case Posture::LeftLateral: return {g.z(), g.y(), -g.x()};   // R_y(+90 deg): -z -> -x
-    case Posture::RightLateral: return {-g.z(), g.y(), g.x()};  // R_y(-90 deg): -z -> +x
+    case Posture::Upright:
+      return g;
+    case Posture::Supine:
+      return {g.x(), g.z(), -g.y()};  // R_x(-90 deg): -z -> -y
+    case Posture::Prone:
+      return {g.x(), -g.z(), g.y()};  // R_x(+90 deg): -z -> +y
+    case Posture::LeftLateral:
+      return {g.z(), g.y(), -g.x()};  // R_y(+90 deg): -z -> -x
+    case Posture::RightLateral:
+      return {-g.z(), g.y(), g.x()};  // R_y(-90 deg): -z -> +x
   }
   return g;
 }

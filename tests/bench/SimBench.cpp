@@ -20,12 +20,14 @@ namespace {
 
 using test::defaultModel;
 
-// real-time factor of a breath style on the default model at time step dt [s] (unset: the integrator's default),
-// after 100 settling steps (rtf is a rate over the CPU time of the loop, i.e. wall time on an idle core;
-// stepping, metrics and recording at 60 Hz are all included); one iteration is 25 steps. The recorder keeps 1 s,
-// as in `pneuma-cli bench`: its memory is then reused, the steady state of any run. While a fresh 300 s timeline
-// fills, each frame also touches new memory (14 KB; about 50 us per frame in page faults on the build machine).
-void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator, std::optional<double> dt) {
+// real-time factor of a breath style on the default model at time step dt [s] (unset: the integrator's
+// default), after 100 settling steps (rtf is a rate over the CPU time of the loop, i.e. wall time on an idle
+// core; stepping, metrics and recording at 60 Hz are all included); one iteration is 25 steps. The recorder
+// keeps 1 s, as in `pneuma-cli bench`: its memory is then reused, the steady state of any run. While a fresh
+// 300 s timeline fills, each frame also touches new memory (14 KB; about 50 us per frame in page faults on
+// the build machine).
+void realTimeFactor(benchmark::State& state, const std::string& style, IntegratorKind integrator,
+                    std::optional<double> dt) {
   const auto model = defaultModel();
   if (!model) {
     state.SkipWithError("default model missing: build it with 'pneuma-cli model build'");
@@ -80,8 +82,8 @@ void stepTime(benchmark::State& state) {
 }
 
 const bool kRegistered = [] {
-  // every breath style with the default integrator at its default dt (1/60 s) and at 10 ms; calm with symplectic
-  // Euler
+  // every breath style with the default integrator at its default dt (1/60 s) and at 10 ms; calm with
+  // symplectic Euler
   struct Run {
     IntegratorKind integrator;
     std::optional<double> dt;  // [s], unset: the integrator's default

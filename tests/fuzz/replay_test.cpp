@@ -1,12 +1,12 @@
 // Every input of the fuzzers' seed corpus (fuzz/corpus/<loader>/) and every reproducer found so far
 // (fuzz/reproducers/<loader>/) goes through its real loader: accepted or rejected with a sim::Error, never
 // another exception, and quickly (issue 15, "fuzzing as part of the project"; CONTRIBUTING.md "Fuzzing").
-#include "FuzzLoaders.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <filesystem>
+
+#include "FuzzLoaders.h"
 
 namespace fs = std::filesystem;
 using pneuma::fuzz::Loader;

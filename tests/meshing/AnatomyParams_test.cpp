@@ -1,12 +1,13 @@
 #include "pneuma/meshing/AnatomyParams.h"
-#include "pneuma/meshing/ModelBuilder.h"
-#include "pneuma/sim/Error.h"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "pneuma/meshing/ModelBuilder.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -38,7 +39,7 @@ TEST(AnatomyParams, PresetsLoadInSiUnits) {
   for (const char* name : {"male.json", "female.json"}) {
     const AnatomyParams a = loadAnatomy(kDir + name);
     ASSERT_EQ(a.ribs.size(), 12u) << name;
-    EXPECT_GT(a.ribs[6].arcLength, 0.2) << name;   // rib 7 is ~30 cm long
+    EXPECT_GT(a.ribs[6].arcLength, 0.2) << name;  // rib 7 is ~30 cm long
     EXPECT_LT(a.ribs[6].arcLength, 0.4) << name;
     EXPECT_GE(a.spine.thoracicSegments.size(), 3u) << name;
     EXPECT_DOUBLE_EQ(a.gains.wallMass, 8.0) << name;
@@ -66,7 +67,9 @@ TEST(AnatomyParams, MissingFieldIsNamed) {
 }
 
 TEST(AnatomyParams, TooFewSpineSegmentsAreRejected) {
-  const std::string e = errorOf([](nlohmann::json& j) { j["spine"]["thoracic_segments"] = {{1, 6}, {7, 12}}; });
+  const std::string e = errorOf([](nlohmann::json& j) {
+    j["spine"]["thoracic_segments"] = {{1, 6}, {7, 12}};
+  });
   EXPECT_NE(e.find("thoracic_segments: needs at least 3"), std::string::npos) << e;
 }
 
@@ -83,7 +86,8 @@ TEST(AnatomyParams, BadGainsAreRejectedNamingTheFile) {
     parseAnatomy(read(kDir + "male.json"), g.dump(), "male.json", "muscle_gains.json");
     FAIL() << "negative gain accepted";
   } catch (const sim::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("muscle_gains.json: groups.diaphragm.kpe"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("muscle_gains.json: groups.diaphragm.kpe"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -112,7 +116,8 @@ TEST(AnatomyParams, StrictJsonNamesTheKeyAndPath) {
             std::string::npos);
   nlohmann::json g = nlohmann::json::parse(gains);
   g["groups"]["rectus"]["kpee"] = 1.0;
-  EXPECT_EQ(parseError(male, g.dump()), "muscle_gains.json: groups.rectus.kpee: unknown field (did you mean kpe?)");
+  EXPECT_EQ(parseError(male, g.dump()),
+            "muscle_gains.json: groups.rectus.kpee: unknown field (did you mean kpe?)");
   g = nlohmann::json::parse(gains);
   g["groups"]["biceps"] = g["groups"]["rectus"];
   EXPECT_EQ(parseError(male, g.dump()), "muscle_gains.json: groups.biceps: unknown muscle group");

@@ -1,18 +1,20 @@
 #include "pneuma/meshing/MeshTools.h"
-#include "pneuma/meshing/Sweep.h"
-#include "pneuma/meshing/Tetrahedralizer.h"
-#include "pneuma/sim/Error.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+
+#include "pneuma/meshing/Sweep.h"
+#include "pneuma/meshing/Tetrahedralizer.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::meshing {
 namespace {
 
 TriangleMesh tube() {
   std::vector<SweepStation> st;
-  for (int i = 0; i <= 8; ++i) st.push_back({Eigen::Vector3d(0.01 * i, 0, 0.003 * i * i), Eigen::Vector3d::UnitZ(), 0.006, 0.004});
+  for (int i = 0; i <= 8; ++i)
+    st.push_back({Eigen::Vector3d(0.01 * i, 0, 0.003 * i * i), Eigen::Vector3d::UnitZ(), 0.006, 0.004});
   return sweepTube(st, 12, false);
 }
 
@@ -32,7 +34,8 @@ TEST(MeshTools, HoleIsDetectedAndNamedWhenRemeshing) {
     remeshIsotropic(m, 0.003, "rib5_left");
     FAIL() << "a non-closed mesh was accepted";
   } catch (const sim::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("rib5_left: input mesh is not closed"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rib5_left: input mesh is not closed"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -81,7 +84,8 @@ TEST(MeshTools, ConvexHullOfCubeCornersAndCentre) {
   const TriangleMesh h = convexHull(p, source);
   EXPECT_EQ(h.vertexCount(), 8);
   EXPECT_NEAR(enclosedVolume(h.vertices, h.triangles), 1.0, 1e-12);
-  for (int v = 0; v < h.vertexCount(); ++v) EXPECT_EQ(h.vertices.col(v), p.col(source[static_cast<std::size_t>(v)]));
+  for (int v = 0; v < h.vertexCount(); ++v)
+    EXPECT_EQ(h.vertices.col(v), p.col(source[static_cast<std::size_t>(v)]));
 }
 
 }  // namespace

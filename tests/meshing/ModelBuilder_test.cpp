@@ -1,19 +1,19 @@
 #include "pneuma/meshing/ModelBuilder.h"
 
-#include "pneuma/meshing/MeshTools.h"
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/ModelIO.h"
-#include "pneuma/sim/State.h"
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 #include <map>
+#include <nlohmann/json.hpp>
+
+#include "pneuma/meshing/MeshTools.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/State.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -22,7 +22,7 @@ using sim::ElementGroup;
 
 /// Physiological ranges (resources/anatomy/README.md, "Volume targets").
 constexpr double kCavityMinMl = 3000.0, kCavityMaxMl = 6500.0;  // thoracic cavity at FRC
-constexpr double kGutMinMl = 4500.0, kGutMaxMl = 11000.0;      // abdominopelvic cavity
+constexpr double kGutMinMl = 4500.0, kGutMaxMl = 11000.0;       // abdominopelvic cavity
 
 /// Each preset is built once per test process, when a test first needs it.
 class BuiltPresets : public ::testing::TestWithParam<std::string> {
@@ -31,8 +31,10 @@ class BuiltPresets : public ::testing::TestWithParam<std::string> {
   const BuiltModel& built() const {
     auto it = s_built.find(GetParam());
     if (it == s_built.end()) {
-      it = s_built.emplace(GetParam(), buildModel(loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" +
-                                                              GetParam() + ".json"))).first;
+      it = s_built
+               .emplace(GetParam(), buildModel(loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" +
+                                                           GetParam() + ".json")))
+               .first;
     }
     return it->second;
   }
@@ -79,7 +81,8 @@ TEST_P(BuiltPresets, ArticulationMatchesSection5) {
   // every moving rib hangs on one costovertebral joint; the sternum hangs on cartilage springs only
   for (int b = 0; b < m.bodies.size(); ++b) {
     int joints = 0;
-    for (int j = 0; j < m.joints.size(); ++j) joints += m.joints.child[static_cast<std::size_t>(j)] == b ? 1 : 0;
+    for (int j = 0; j < m.joints.size(); ++j)
+      joints += m.joints.child[static_cast<std::size_t>(j)] == b ? 1 : 0;
     const std::string& n = m.bodies.name[static_cast<std::size_t>(b)];
     if (n.rfind("rib", 0) == 0) {
       EXPECT_EQ(joints, m.bodies.isFixed[static_cast<std::size_t>(b)] ? 0 : 1) << n;
@@ -114,7 +117,8 @@ TEST_P(BuiltPresets, LeftAndRightAreMirrorSymmetricWithin1mm) {
   // every gut node has a mirror node
   for (int i = 0; i < m.nodes.size(); ++i) {
     double best = 1e9;
-    for (int k = 0; k < m.nodes.size(); ++k) best = std::min(best, (mirror(m.nodes.rest.col(i)) - m.nodes.rest.col(k)).norm());
+    for (int k = 0; k < m.nodes.size(); ++k)
+      best = std::min(best, (mirror(m.nodes.rest.col(i)) - m.nodes.rest.col(k)).norm());
     EXPECT_LT(best, kTol) << "node " << i;
   }
   const int l = m.landmarks.find("rib8_lateral_left"), r = m.landmarks.find("rib8_lateral_right");
@@ -162,13 +166,15 @@ TEST_P(BuiltPresets, GroupCountsFollowTable1Within25Percent) {
     EXPECT_GE(n, 0.75 * guide) << what;
     EXPECT_LE(n, 1.25 * guide) << what;
   };
-  expectNear(count(ElementGroup::IntercostalExternal) + count(ElementGroup::IntercostalInternal), 516, "intercostals");
+  expectNear(count(ElementGroup::IntercostalExternal) + count(ElementGroup::IntercostalInternal), 516,
+             "intercostals");
   expectNear(count(ElementGroup::IntercostalExternal), 258, "external intercostals");
   expectNear(count(ElementGroup::IntercostalInternal), 258, "internal intercostals");
   expectNear(count(ElementGroup::Diaphragm), 464, "diaphragm");
   expectNear(count(ElementGroup::Rectus), 85, "rectus");
   expectNear(count(ElementGroup::TransversusObliques), 350, "transversus and obliques");
-  EXPECT_GE(count(ElementGroup::Cartilage), 6 * 20);  // at least 6 springs per cartilage, ribs 1-10 both sides
+  EXPECT_GE(count(ElementGroup::Cartilage),
+            6 * 20);  // at least 6 springs per cartilage, ribs 1-10 both sides
 }
 
 TEST_P(BuiltPresets, VolumesAreWithinPhysiologicalRanges) {
@@ -179,10 +185,10 @@ TEST_P(BuiltPresets, VolumesAreWithinPhysiologicalRanges) {
   EXPECT_LT(s.gutVolume * 1e6, kGutMaxMl);
 }
 
-// the two lungs: closed, outward, free of self-intersections at rest (CGAL), split 53.5 : 46.5 as on upright CT
-// (Yamada et al. 2020: right 53.3 +/- 1.3 % standing), with the mediastinum (heart about 0.8 L, great vessels,
-// trachea, oesophagus, the vertebral bodies' bulge) between them; lungs at end-expiration in the range of FRC gas
-// plus lung tissue (resources/anatomy/README.md, "Lungs")
+// the two lungs: closed, outward, free of self-intersections at rest (CGAL), split 53.5 : 46.5 as on upright
+// CT (Yamada et al. 2020: right 53.3 +/- 1.3 % standing), with the mediastinum (heart about 0.8 L, great
+// vessels, trachea, oesophagus, the vertebral bodies' bulge) between them; lungs at end-expiration in the
+// range of FRC gas plus lung tissue (resources/anatomy/README.md, "Lungs")
 TEST_P(BuiltPresets, LungsSplitAsOnCtAroundTheMediastinum) {
   const sim::Model& m = model();
   Eigen::Matrix3Xd cavity(3, m.cavity.vertices.size());
@@ -215,9 +221,9 @@ TEST_P(BuiltPresets, LungsSplitAsOnCtAroundTheMediastinum) {
   EXPECT_LT(m.lungs.mediastinumVolume * 1e6, 1600.0) << GetParam();
   RecordProperty("lungs_ml", std::to_string((cavityVolume - m.lungs.mediastinumVolume) * 1e6));
   RecordProperty("mediastinum_ml", std::to_string(m.lungs.mediastinumVolume * 1e6));
-  std::printf("%s: cavity %.0f mL, mediastinum %.0f mL, lungs %.0f mL (right %.0f, left %.0f)\n", GetParam().c_str(),
-              cavityVolume * 1e6, m.lungs.mediastinumVolume * 1e6, (cavityVolume - m.lungs.mediastinumVolume) * 1e6,
-              volume[0] * 1e6, volume[1] * 1e6);
+  std::printf("%s: cavity %.0f mL, mediastinum %.0f mL, lungs %.0f mL (right %.0f, left %.0f)\n",
+              GetParam().c_str(), cavityVolume * 1e6, m.lungs.mediastinumVolume * 1e6,
+              (cavityVolume - m.lungs.mediastinumVolume) * 1e6, volume[0] * 1e6, volume[1] * 1e6);
 }
 
 TEST_P(BuiltPresets, TetGenVolumeEqualsSurfaceVolumeAndSurfaceHasNoSlivers) {
@@ -257,9 +263,12 @@ TEST_P(BuiltPresets, GutSurfaceIsSealedAndHasItsRegions) {
   EXPECT_GT(zMean[1] / count[1], zMean[0] / count[0]);
   const int apex = m.landmarks.find("diaphragm_apex");
   const int navel = m.landmarks.find("umbilicus");
-  EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, apex))], sim::NodeRegion::Diaphragm);
-  EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, navel))], sim::NodeRegion::Wall);
-  for (int i = 0; i < m.nodes.size(); ++i) EXPECT_LE(m.nodes.rest(2, i), m.nodes.rest(2, m.landmarks.points.nodes(0, apex)) + 1e-12);
+  EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, apex))],
+            sim::NodeRegion::Diaphragm);
+  EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, navel))],
+            sim::NodeRegion::Wall);
+  for (int i = 0; i < m.nodes.size(); ++i)
+    EXPECT_LE(m.nodes.rest(2, i), m.nodes.rest(2, m.landmarks.points.nodes(0, apex)) + 1e-12);
 }
 
 TEST_P(BuiltPresets, RoundTripsThroughModelJson) {
@@ -278,7 +287,8 @@ TEST(ModelBuilder, BuildIsDeterministicAndDirectoryIsReplacedWhole) {
   // bodies, joints, nodes, gut, elements and landmarks are bit-identical; the cavity's triangulation
   // comes from CGAL corefinement, whose tie-breaking follows heap addresses inside one process (separate
   // processes, as at build time, give identical bytes), so it is compared by its volume
-  EXPECT_NEAR(two.report.summary.cavityVolume, one.report.summary.cavityVolume, 1e-9 * one.report.summary.cavityVolume);
+  EXPECT_NEAR(two.report.summary.cavityVolume, one.report.summary.cavityVolume,
+              1e-9 * one.report.summary.cavityVolume);
   sim::Model a1 = one.model, a2 = two.model;
   a2.cavity = a1.cavity;
   EXPECT_TRUE(sim::serializeModel(a1) == sim::serializeModel(a2)) << "two builds differ";
@@ -291,10 +301,12 @@ TEST(ModelBuilder, BuildIsDeterministicAndDirectoryIsReplacedWhole) {
   writeModelDirectory(one, dir.string());
   EXPECT_FALSE(fs::exists(dir / "stale.txt"));
   for (const auto& e : fs::directory_iterator(dir.parent_path()))
-    EXPECT_EQ(e.path().filename().string().rfind(dir.filename().string() + ".", 0), std::string::npos) << e.path();
+    EXPECT_EQ(e.path().filename().string().rfind(dir.filename().string() + ".", 0), std::string::npos)
+        << e.path();
   EXPECT_TRUE(fs::exists(dir / "meshes" / "sternum.vtp"));
   const sim::Model loaded = sim::loadModel(dir.string());
-  EXPECT_TRUE(sim::serializeModel(loaded) == sim::serializeModel(one.model)) << "model.json does not round-trip";
+  EXPECT_TRUE(sim::serializeModel(loaded) == sim::serializeModel(one.model))
+      << "model.json does not round-trip";
   fs::remove_all(dir);
 }
 
@@ -339,7 +351,8 @@ TEST_P(BuiltPresets, CorruptedModelJsonIsRejected) {
     sim::parseModel(j.dump());
     FAIL() << "zero rest length accepted";
   } catch (const sim::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("elements[3].rest_length: must be > 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("elements[3].rest_length: must be > 0"), std::string::npos)
+        << e.what();
   }
 }
 

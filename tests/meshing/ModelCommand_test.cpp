@@ -1,13 +1,12 @@
 // `pneuma-cli model build` and `model info`, run as a child process (tests/app/cli/CliRunner.h).
-#include "CliRunner.h"
-
-#include "pneuma/meshing/ModelSummary.h"
-#include "pneuma/sim/ModelIO.h"
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "CliRunner.h"
+#include "pneuma/meshing/ModelSummary.h"
+#include "pneuma/sim/ModelIO.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -18,7 +17,8 @@ using test::runCli;
 const std::string kAnatomy = std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/";
 
 fs::path scratch(const std::string& name) {
-  const fs::path p = fs::path(testing::TempDir()) / ("pneuma_model_cmd_" + std::to_string(getpid()) + "_" + name);
+  const fs::path p =
+      fs::path(testing::TempDir()) / ("pneuma_model_cmd_" + std::to_string(getpid()) + "_" + name);
   fs::remove_all(p);
   return p;
 }
@@ -45,8 +45,8 @@ TEST(ModelCommand, InfoJsonDescribesTheDefaultModel) {
 
 TEST(ModelCommand, BuildWithoutDisplayWritesTheModelAndSkipsPreviews) {
   const fs::path out = scratch("female");
-  const test::CliResult r =
-      runCli({"model", "build", "--anatomy", kAnatomy + "female.json", "--out", out.string()}, 0.0, {"DISPLAY="});
+  const test::CliResult r = runCli(
+      {"model", "build", "--anatomy", kAnatomy + "female.json", "--out", out.string()}, 0.0, {"DISPLAY="});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("cavity volume"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("previews skipped"), std::string::npos) << r.err;
@@ -65,7 +65,8 @@ TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {
   { std::ofstream(dir / "male.json") << j.dump(); }
   fs::copy_file(kAnatomy + "muscle_gains.json", dir / "muscle_gains.json");
   const fs::path out = dir / "model";
-  const test::CliResult r = runCli({"model", "build", "--anatomy", (dir / "male.json").string(), "--out", out.string(), "--no-preview"});
+  const test::CliResult r = runCli(
+      {"model", "build", "--anatomy", (dir / "male.json").string(), "--out", out.string(), "--no-preview"});
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("ribs[2].arc_length_mm: must be in [30, 600], got -10"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
@@ -77,9 +78,11 @@ TEST(ModelCommand, BuildRefusesAFolderThatIsNotAModel) {
   const fs::path out = scratch("notamodel");
   fs::create_directories(out);
   { std::ofstream(out / "notes.txt") << "keep me"; }
-  const test::CliResult r = runCli({"model", "build", "--anatomy", kAnatomy + "male.json", "--out", out.string() + "/", "--no-preview"});
+  const test::CliResult r = runCli(
+      {"model", "build", "--anatomy", kAnatomy + "male.json", "--out", out.string() + "/", "--no-preview"});
   EXPECT_EQ(r.exitCode, 2);
-  EXPECT_NE(r.err.find("not a model directory (no model.json) and not empty; refusing to replace it"), std::string::npos)
+  EXPECT_NE(r.err.find("not a model directory (no model.json) and not empty; refusing to replace it"),
+            std::string::npos)
       << r.err;
   EXPECT_EQ(test::slurp((out / "notes.txt").string()), "keep me");
   fs::remove_all(out);

@@ -1,9 +1,10 @@
-#include "pneuma/meshing/Sweep.h"
 #include "pneuma/meshing/TriangleMesh.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+
+#include "pneuma/meshing/Sweep.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -14,7 +15,8 @@ TriangleMesh torus(double big, double small, const Eigen::Vector3d& c) {
   constexpr int kStations = 256;
   for (int i = 0; i < kStations; ++i) {
     const double t = 2.0 * M_PI * i / kStations;
-    st.push_back({c + big * Eigen::Vector3d(std::cos(t), std::sin(t), 0), Eigen::Vector3d::UnitZ(), small, small});
+    st.push_back(
+        {c + big * Eigen::Vector3d(std::cos(t), std::sin(t), 0), Eigen::Vector3d::UnitZ(), small, small});
   }
   return sweepTube(st, 128, true);
 }
@@ -31,13 +33,15 @@ TEST(TriangleMesh, TorusMassPropertiesMatchTheFormulas) {
   EXPECT_NEAR(p.inertia(1, 1), p.inertia(0, 0), 1e-6 * p.inertia(0, 0));
   // the centre of mass and the principal axes do not depend on where the torus sits
   EXPECT_LT((p.com - centre).norm(), 1e-9);
-  EXPECT_LT(std::abs(p.inertia(0, 1)) + std::abs(p.inertia(0, 2)) + std::abs(p.inertia(1, 2)), 1e-6 * p.inertia(2, 2));
+  EXPECT_LT(std::abs(p.inertia(0, 1)) + std::abs(p.inertia(0, 2)) + std::abs(p.inertia(1, 2)),
+            1e-6 * p.inertia(2, 2));
 }
 
 TEST(TriangleMesh, CapsuleTubeVolumeMatchesCylinder) {
   // a straight capped tube is a cylinder: V = pi a b L (within the polygon's area deficit)
   std::vector<SweepStation> st;
-  for (int i = 0; i <= 10; ++i) st.push_back({Eigen::Vector3d(0, 0, 0.02 * i), Eigen::Vector3d::UnitX(), 0.03, 0.01});
+  for (int i = 0; i <= 10; ++i)
+    st.push_back({Eigen::Vector3d(0, 0, 0.02 * i), Eigen::Vector3d::UnitX(), 0.03, 0.01});
   const TriangleMesh m = sweepTube(st, 256, false);
   const double v = M_PI * 0.03 * 0.01 * 0.2;
   EXPECT_NEAR(enclosedVolume(m.vertices, m.triangles), v, 1e-3 * v);

@@ -1,12 +1,12 @@
 #pragma once
 // The default model of the build (PNEUMA_DEFAULT_MODEL_DIR, or the same environment variable), loaded once
 // per test process; null when it has not been built (tests then skip).
-#include "pneuma/sim/ModelIO.h"
-
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
+
+#include "pneuma/sim/ModelIO.h"
 
 namespace pneuma::sim::test {
 
@@ -22,6 +22,6 @@ inline std::shared_ptr<const Model> defaultModel() {
 
 }  // namespace pneuma::sim::test
 
-#define REQUIRE_DEFAULT_MODEL()               \
+#define REQUIRE_DEFAULT_MODEL()             \
   if (!::pneuma::sim::test::defaultModel()) \
   GTEST_SKIP() << "default model not built (PNEUMA_DEFAULT_MODEL_DIR)"

@@ -1,16 +1,15 @@
 // Element laws of Zordan et al. 2004: the muscle law (Eq. 1, 2), structural springs, and the gut
 // pressure (Eq. 4, 5); forces against finite differences of the elastic energy, and invariance of the
 // assembled forces under a random rigid transform (as SOFA's SpringForceField_test).
-#include "ToyTorso.h"
-
 #include "pneuma/sim/Elements.h"
-#include "pneuma/sim/Step.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <random>
+
+#include "ToyTorso.h"
+#include "pneuma/sim/Step.h"
 
 namespace pneuma::sim {
 namespace {
@@ -98,7 +97,9 @@ TEST(GutPressure, ForcesAreMinusEnergyGradient) {
       Eigen::Matrix3Xd yp = y, ym = y;
       yp(k, i) += h;
       ym(k, i) -= h;
-      const double fd = -(gutEnergy(kappa, v0, enclosedVolume(yp, f)) - gutEnergy(kappa, v0, enclosedVolume(ym, f))) / (2 * h);
+      const double fd =
+          -(gutEnergy(kappa, v0, enclosedVolume(yp, f)) - gutEnergy(kappa, v0, enclosedVolume(ym, f))) /
+          (2 * h);
       EXPECT_NEAR(force(k, i), fd, 1e-6 * std::max(1.0, std::abs(fd)));
     }
   }

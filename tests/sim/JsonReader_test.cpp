@@ -1,17 +1,18 @@
 // The one JSON reading layer through the real loaders (scenario, pattern, breath style, model): deep nesting,
 // numbers beyond double range, wrapped integers, duplicate and unknown keys give a clear Error naming the
 // file and JSON path, quote a short excerpt and never crash.
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/JsonReader.h"
-#include "pneuma/sim/ModelIO.h"
-#include "pneuma/sim/Scenario.h"
-#include "pneuma/sim/pattern/Pattern.h"
 
 #include <gtest/gtest.h>
 
 #include <functional>
 #include <string>
+
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 using namespace pneuma::sim;
 
@@ -61,13 +62,14 @@ TEST(JsonLoaders, DeepNestingIsAnErrorNotAStackOverflow) {
 }
 
 TEST(JsonLoaders, NumberBeyondDoubleRangeNamesThePath) {
-  EXPECT_EQ(errorOf(kLoaders[0].second, "1e400"), "x.json: (root): number 1e400 is beyond the range of a double");
+  EXPECT_EQ(errorOf(kLoaders[0].second, "1e400"),
+            "x.json: (root): number 1e400 is beyond the range of a double");
   EXPECT_EQ(errorOf(kLoaders[0].second, edited(kScenario, "\"duration_s\": 5", "\"duration_s\": 1e400")),
             "x.json: duration_s: number 1e400 is beyond the range of a double");
   EXPECT_EQ(errorOf(kLoaders[1].second, edited(kPattern, "[0.1, 0.2]", "[0.1, -2e999]")),
             "x.json: layers[0].cycle.depth[1]: number -2e999 is beyond the range of a double");
-  EXPECT_EQ(errorOf(kLoaders[2].second, edited(kStyle, "0.8", "1" + std::string(400, '0'))).rfind(
-                "x.json: diaphragm_r: number 1000", 0),
+  EXPECT_EQ(errorOf(kLoaders[2].second, edited(kStyle, "0.8", "1" + std::string(400, '0')))
+                .rfind("x.json: diaphragm_r: number 1000", 0),
             0u);
 }
 
@@ -85,33 +87,40 @@ TEST(JsonLoaders, IntegersDoNotWrap) {
 TEST(JsonLoaders, DuplicateKeysAreRejected) {
   // the first duplicate is found while parsing, before any field is read
   for (const auto& [name, load] : kLoaders)
-    EXPECT_EQ(errorOf(load, edited(kScenario, "{", "{\"z\": 1, \"z\": 2, ")), "x.json: z: duplicate key") << name;
-  EXPECT_EQ(errorOf(kLoaders[1].second, edited(kPattern, "\"rate_bpm\": 12", "\"rate_bpm\": 12, \"rate_bpm\": 30")),
-            "x.json: layers[0].cycle.rate_bpm: duplicate key");
+    EXPECT_EQ(errorOf(load, edited(kScenario, "{", "{\"z\": 1, \"z\": 2, ")), "x.json: z: duplicate key")
+        << name;
+  EXPECT_EQ(
+      errorOf(kLoaders[1].second, edited(kPattern, "\"rate_bpm\": 12", "\"rate_bpm\": 12, \"rate_bpm\": 30")),
+      "x.json: layers[0].cycle.rate_bpm: duplicate key");
 }
 
 TEST(JsonLoaders, UnknownKeysInStylesAreRejectedWithASuggestion) {
   EXPECT_EQ(errorOf(kLoaders[2].second, edited(kStyle, "}", ", \"diaphragm_rr\": 1}")),
             "x.json: diaphragm_rr: unknown field (did you mean diaphragm_r?)");
-  EXPECT_EQ(errorOf(kLoaders[2].second, edited(kStyle, "}", ", \"colour\": 1}")), "x.json: colour: unknown field");
+  EXPECT_EQ(errorOf(kLoaders[2].second, edited(kStyle, "}", ", \"colour\": 1}")),
+            "x.json: colour: unknown field");
 }
 
 TEST(JsonLoaders, MessagesQuoteAShortExcerpt) {
   std::string big = "[";
   for (int i = 0; i < 100000; ++i) big += (i ? ", " : "") + std::to_string(i);
   big += "]";
-  const std::string e = errorOf(kLoaders[0].second, edited(kScenario, "\"duration_s\": 5", "\"duration_s\": " + big));
+  const std::string e =
+      errorOf(kLoaders[0].second, edited(kScenario, "\"duration_s\": 5", "\"duration_s\": " + big));
   EXPECT_EQ(e.rfind("x.json: duration_s: must be a number, got [0, 1, 2, ", 0), 0u) << e.substr(0, 200);
   EXPECT_LT(e.size(), 120u);
-  const std::string s = errorOf(kLoaders[2].second, edited(kStyle, "\"s\"", "\"" + std::string(1 << 20, 'x') + "\"}"));
+  const std::string s =
+      errorOf(kLoaders[2].second, edited(kStyle, "\"s\"", "\"" + std::string(1 << 20, 'x') + "\"}"));
   EXPECT_LT(s.size(), 300u) << s.substr(0, 300);
   // strings from the file quoted in semantic messages are cut too
   const std::string huge(1 << 20, 'y');
   const std::vector<std::string> messages = {
       errorOf(kLoaders[2].second, edited(edited(kStyle, "\"s\"", "\"" + huge + "\""), "12", "-3")),
       errorOf(kLoaders[1].second, edited(kPattern, "\"linear\"", "\"" + huge + "\"")),
-      errorOf(kLoaders[0].second, edited(kScenario, "}}", "}, \"overrides\": {\"integrator\": \"" + huge + "\"}}")),
-      errorOf(kLoaders[0].second, edited(kScenario, "}}", "}, \"overrides\": {\"active_gain_scale\": {\"" + huge + "\": 1}}}")),
+      errorOf(kLoaders[0].second,
+              edited(kScenario, "}}", "}, \"overrides\": {\"integrator\": \"" + huge + "\"}}")),
+      errorOf(kLoaders[0].second,
+              edited(kScenario, "}}", "}, \"overrides\": {\"active_gain_scale\": {\"" + huge + "\": 1}}}")),
   };
   for (const std::string& m : messages) {
     EXPECT_NE(m.find("yyy..."), std::string::npos) << m.substr(0, 200);
@@ -143,7 +152,8 @@ TEST(JsonLoaders, ModelRejectsUnknownDuplicateAndWrappedKeys) {
   const auto& load = kLoaders[3].second;
   EXPECT_EQ(errorOf(load, edited(text, "\"mass\"", "\"mas\"")),
             "x.json: bodies[0].mas: unknown field (did you mean mass?)");
-  EXPECT_EQ(errorOf(load, edited(text, "\"kappa\"", "\"kappa\": 2, \"kappa\"")), "x.json: gut.kappa: duplicate key");
+  EXPECT_EQ(errorOf(load, edited(text, "\"kappa\"", "\"kappa\": 2, \"kappa\"")),
+            "x.json: gut.kappa: duplicate key");
   EXPECT_EQ(errorOf(load, edited(text, "\"body\": 0", "\"body\": 4294967296")),
             "x.json: landmarks[0].body: must be an integer in [-2147483648, 2147483647], got 4294967296");
   EXPECT_EQ(errorOf(load, edited(text, "\"version\": 1", "\"version\": 4294967297")),
@@ -163,11 +173,14 @@ TEST(ReadInputFile, RefusesWhatIsNotARegularFile) {
     }
     return std::string("(no error)");
   };
-  EXPECT_NE(message([] { readInputFile("/dev/zero"); }).find("/dev/zero: not a regular file"), std::string::npos);
-  EXPECT_NE(message([] { loadScenario("/dev/zero"); }).find("not a regular file"), std::string::npos);
-  EXPECT_NE(message([] { loadBreathStyle("/dev/zero.json"); }).find("/dev/zero.json: cannot open"), std::string::npos);
-  EXPECT_NE(message([] { loadModel("/tmp"); }).find("/tmp/model.json: cannot open (is '/tmp' a model directory?)"),
+  EXPECT_NE(message([] { readInputFile("/dev/zero"); }).find("/dev/zero: not a regular file"),
             std::string::npos);
+  EXPECT_NE(message([] { loadScenario("/dev/zero"); }).find("not a regular file"), std::string::npos);
+  EXPECT_NE(message([] { loadBreathStyle("/dev/zero.json"); }).find("/dev/zero.json: cannot open"),
+            std::string::npos);
+  EXPECT_NE(
+      message([] { loadModel("/tmp"); }).find("/tmp/model.json: cannot open (is '/tmp' a model directory?)"),
+      std::string::npos);
   EXPECT_NE(message([] { readInputFile("/"); }).find("/: not a regular file"), std::string::npos);
   const std::string text = readInputFile(std::string(PNEUMA_RESOURCE_DIR) + "/presets/calm.json");
   EXPECT_NE(text.find("\"calm\""), std::string::npos);

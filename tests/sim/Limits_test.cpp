@@ -1,18 +1,18 @@
 // Run limits (Limits.h): inputs that would never finish are refused by every loader and by the Simulation,
 // each with the same rule and message naming the field and the value (issue 15, class 5).
-#include "ToyTorso.h"
-
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/Limits.h"
-#include "pneuma/sim/Scenario.h"
-#include "pneuma/sim/Simulation.h"
-#include "pneuma/sim/pattern/Pattern.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <string>
+
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 namespace pneuma::sim {
 namespace {

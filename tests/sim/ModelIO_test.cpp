@@ -1,16 +1,16 @@
 // Model format: round trip and rejection of corrupted files (docs/model-format.md).
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/ModelIO.h"
-#include "pneuma/sim/Simulation.h"
-#include "ToyTorso.h"
 
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
-
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
+
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Simulation.h"
 
 using namespace pneuma::sim;
 
@@ -63,7 +63,8 @@ Model tinyModel() {
   m.elements.kpe = Eigen::VectorXd::Constant(1, 10.0);
   m.elements.damping = Eigen::VectorXd::Constant(1, 0.5);
 
-  for (int i = 0; i < 4; ++i) m.cavity.vertices.addNodePoint(Eigen::Vector3i(i, -1, -1), Eigen::Vector3d(1, 0, 0));
+  for (int i = 0; i < 4; ++i)
+    m.cavity.vertices.addNodePoint(Eigen::Vector3i(i, -1, -1), Eigen::Vector3d(1, 0, 0));
   m.cavity.triangles = m.gut.triangles;
 
   // two lungs: the cavity tetrahedron shrunk by half towards its centroid (each vertex 5/8 its own corner and
@@ -77,7 +78,8 @@ Model tinyModel() {
   }
   m.lungs.mediastinumVolume = 0.1 * 1e-3 / 6.0;
 
-  for (const char* n : {"xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right"}) {
+  for (const char* n :
+       {"xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right"}) {
     m.landmarks.name.push_back(n);
     m.landmarks.points.addNodePoint(Eigen::Vector3i(1, 2, -1), Eigen::Vector3d(0.25, 0.75, 0));
   }
@@ -129,47 +131,57 @@ TEST(ModelIO, RejectsCorruptedFilesNamingTheField) {
               for (auto& t : j["gut"]["triangles"]) std::swap(t[0], t[1]);
             }).rfind("model.json: gut.triangles: enclosed rest volume must be > 0", 0),
             0u);
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["bodies"][0]["inertia"][0][0] = -1.0; })
-                .rfind("model.json: bodies[0].inertia: must be positive definite", 0),
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
+              j["bodies"][0]["inertia"][0][0] = -1.0;
+            }).rfind("model.json: bodies[0].inertia: must be positive definite", 0),
             0u);
 }
 
 // a model.json written before the lungs is refused in one line that names the missing block; a malformed lung
 // block names its field
 TEST(ModelIO, LungBlockIsRequiredAndChecked) {
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j.erase("lungs"); }),
-            "model.json: lungs: missing (a model written before the two lungs; rebuild it with 'pneuma-cli model "
-            "build')");
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"].erase("left"); }), "model.json: lungs.left: missing");
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][2]["cavity_vertices"][1] = 4; }),
-            "model.json: lungs.right.vertices[2].cavity_vertices: index 4 out of range [0, 4)");
+  EXPECT_EQ(
+      rejectionOf([](nlohmann::json& j) { j.erase("lungs"); }),
+      "model.json: lungs: missing (a model written before the two lungs; rebuild it with 'pneuma-cli model "
+      "build')");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"].erase("left"); }),
+            "model.json: lungs.left: missing");
+  EXPECT_EQ(
+      rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][2]["cavity_vertices"][1] = 4; }),
+      "model.json: lungs.right.vertices[2].cavity_vertices: index 4 out of range [0, 4)");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["left"]["vertices"][0]["weights"][1] = -0.125; }),
             "model.json: lungs.left.vertices[0].weights: must be finite and >= 0, got -0.125");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["left"]["vertices"][0]["weights"][1] = 0.5; }),
             "model.json: lungs.left.vertices[0].weights: must sum to 1, got 1.375");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][1]["weights"].erase(0); }),
             "model.json: lungs.right.vertices[1].weights: must have as many entries as cavity_vertices (4)");
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["mediastinum_volume"] = 1.0; }),
-            "model.json: lungs.mediastinum_volume: must be smaller than the cavity's rest volume 0.000166667 m^3, "
-            "got 1");
+  EXPECT_EQ(
+      rejectionOf([](nlohmann::json& j) { j["lungs"]["mediastinum_volume"] = 1.0; }),
+      "model.json: lungs.mediastinum_volume: must be smaller than the cavity's rest volume 0.000166667 m^3, "
+      "got 1");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["triangles"].erase(3); }),
             "model.json: lungs.right.triangles: must be a closed surface of at least 4 triangles, got 3");
-  EXPECT_NE(rejectionOf([](nlohmann::json& j) { std::swap(j["lungs"]["left"]["triangles"][1][0], j["lungs"]["left"]["triangles"][1][1]); })
-                .find("model.json: lungs.left.triangles[1]: edge"),
+  EXPECT_NE(rejectionOf([](nlohmann::json& j) {
+              std::swap(j["lungs"]["left"]["triangles"][1][0], j["lungs"]["left"]["triangles"][1][1]);
+            }).find("model.json: lungs.left.triangles[1]: edge"),
             std::string::npos);
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
               for (auto& t : j["lungs"]["left"]["triangles"]) std::swap(t[0], t[1]);
             }).rfind("model.json: lungs.left.triangles: enclosed rest volume must be > 0", 0),
             0u);
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["left"] = {{"vertices", nlohmann::json::array()}, {"triangles", nlohmann::json::array()}}; }),
-            "model.json: lungs.left: must be given with the other lung");
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["lungs"]["right"]["vertices"][0]["bones"] = 1; })
-                .rfind("model.json: lungs.right.vertices[0].bones: unknown field", 0),
+  EXPECT_EQ(
+      rejectionOf([](nlohmann::json& j) {
+        j["lungs"]["left"] = {{"vertices", nlohmann::json::array()}, {"triangles", nlohmann::json::array()}};
+      }),
+      "model.json: lungs.left: must be given with the other lung");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
+              j["lungs"]["right"]["vertices"][0]["bones"] = 1;
+            }).rfind("model.json: lungs.right.vertices[0].bones: unknown field", 0),
             0u);
 }
 
-// the lungs' volume is the cavity's minus the constant mediastinum, so its swing is the cavity's; the right and left
-// lungs split it as their surfaces do (here two equal surfaces: half each)
+// the lungs' volume is the cavity's minus the constant mediastinum, so its swing is the cavity's; the right
+// and left lungs split it as their surfaces do (here two equal surfaces: half each)
 TEST(ModelIO, LungVolumeIsTheCavityMinusTheMediastinum) {
   auto model = std::make_shared<const Model>(tinyModel());
   SimulationOptions o;
@@ -186,7 +198,8 @@ TEST(ModelIO, LungVolumeIsTheCavityMinusTheMediastinum) {
   anchorPositions(model->cavity.vertices, sim.state(), cavity);
   lungPositions(model->lungs.left, cavity, x);
   const Eigen::Vector3d centroid = cavity.rowwise().mean();
-  for (int v = 0; v < 4; ++v) EXPECT_LT((x.col(v) - (centroid + 0.5 * (cavity.col(v) - centroid))).norm(), 1e-15);
+  for (int v = 0; v < 4; ++v)
+    EXPECT_LT((x.col(v) - (centroid + 0.5 * (cavity.col(v) - centroid))).norm(), 1e-15);
 }
 
 // gut.drag is optional: a model written before the visceral drag existed loads without it
@@ -212,7 +225,8 @@ TEST(ModelIO, MissingDirectoryNamesThePath) {
     loadModel("/nonexistent/pneuma-model");
     FAIL() << "missing directory was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/pneuma-model/model.json: cannot open"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/pneuma-model/model.json: cannot open"),
+              std::string::npos);
   }
 }
 
@@ -338,8 +352,8 @@ TEST(ModelStructure, ElementsMustExistHoldAndEndOnTheModel) {
   EXPECT_EQ(invalidOf(node), "elements.b[0].nodes: index 4 out of range [0, 4)");
 }
 
-// a model that loads but cannot hold itself (every passive gain scaled to 0): the lungs turn inside out, and the
-// run stops with that as its error instead of going on with a negative volume (issue 15, class 7)
+// a model that loads but cannot hold itself (every passive gain scaled to 0): the lungs turn inside out, and
+// the run stops with that as its error instead of going on with a negative volume (issue 15, class 7)
 TEST(ModelStructure, ARunWhoseLungsTurnInsideOutStopsNamingIt) {
   SimulationOptions o;
   for (double& s : o.step.passiveGainScale) s = 0.0;

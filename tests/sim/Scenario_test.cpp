@@ -1,5 +1,4 @@
 // Scenario files: parsing, defaults, round trip, and errors that name the failing JSON path.
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/Scenario.h"
 
 #include <gtest/gtest.h>
@@ -7,12 +6,15 @@
 #include <filesystem>
 #include <string>
 
+#include "pneuma/sim/Error.h"
+
 using namespace pneuma::sim;
 namespace fs = std::filesystem;
 
 namespace {
 
-const char* kMinimal = R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"style": "calm"}})";
+const char* kMinimal =
+    R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"style": "calm"}})";
 
 // parses `text` expecting an Error whose message contains every string of `mentions`
 void expectError(const std::string& text, const std::vector<std::string>& mentions) {
@@ -22,13 +24,15 @@ void expectError(const std::string& text, const std::vector<std::string>& mentio
   } catch (const Error& e) {
     const std::string what = e.what();
     EXPECT_EQ(what.rfind("bad.json: ", 0), 0u) << what;
-    for (const std::string& m : mentions) EXPECT_NE(what.find(m), std::string::npos) << "'" << m << "' not in: " << what;
+    for (const std::string& m : mentions)
+      EXPECT_NE(what.find(m), std::string::npos) << "'" << m << "' not in: " << what;
   }
 }
 
 // kMinimal with one top-level member replaced or added
 std::string with(const std::string& member) {
-  std::string t = R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"style": "calm"}, )";
+  std::string t =
+      R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"style": "calm"}, )";
   return t + member + "}";
 }
 
@@ -53,15 +57,16 @@ TEST(Scenario, RelativePathsResolveAgainstTheScenarioDirectory) {
   const Scenario s = parseScenario(with(R"("model": "models/small")"), "x.json", "/data/runs");
   EXPECT_EQ(s.model, "/data/runs/models/small");
   const Scenario p = parseScenario(
-      R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"pattern": "p/sigh.json"}})", "x.json",
-      "/data/runs");
+      R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"pattern": "p/sigh.json"}})",
+      "x.json", "/data/runs");
   EXPECT_EQ(p.controller, ControllerKind::Pattern);
   EXPECT_EQ(p.controllerName, "/data/runs/p/sigh.json");
 }
 
 TEST(Scenario, OverridesReachTheSimulationOptions) {
   const Scenario s = parseScenario(
-      with(R"("overrides": {"integrator": "symplectic-euler", "dt_s": 0.0002, "settle_time_s": 0.5, "gravity": false,
+      with(
+          R"("overrides": {"integrator": "symplectic-euler", "dt_s": 0.0002, "settle_time_s": 0.5, "gravity": false,
               "posture": "supine",
               "joint_friction_scale": 0, "gut_drag_scale": 0.5, "kappa_pa": 40000, "active_gain_scale": {"rectus": 1.5},
               "passive_gain_scale": {"cartilage": 2}}, "outputs": {"output_rate_hz": 25, "vtk": true})"),
@@ -107,30 +112,38 @@ TEST(Scenario, ExampleTimelineIsNeutralThenStartleAtTenSeconds) {
 
 TEST(Scenario, BadFieldsAreNamedByTheirJsonPath) {
   expectError("{", {"invalid JSON"});
-  expectError(R"({"format": "pneuma-pattern", "version": 1, "duration_s": 5, "controller": {"style": "calm"}})",
-              {"format", "pneuma-scenario"});
-  expectError(R"({"format": "pneuma-scenario", "version": 2, "duration_s": 5, "controller": {"style": "calm"}})",
-              {"version", "unsupported"});
-  expectError(R"({"format": "pneuma-scenario", "version": 1, "controller": {"style": "calm"}})", {"duration_s: missing"});
+  expectError(
+      R"({"format": "pneuma-pattern", "version": 1, "duration_s": 5, "controller": {"style": "calm"}})",
+      {"format", "pneuma-scenario"});
+  expectError(
+      R"({"format": "pneuma-scenario", "version": 2, "duration_s": 5, "controller": {"style": "calm"}})",
+      {"version", "unsupported"});
+  expectError(R"({"format": "pneuma-scenario", "version": 1, "controller": {"style": "calm"}})",
+              {"duration_s: missing"});
   expectError(
       R"({"format": "pneuma-scenario", "version": 1, "duration_s": -2, "controller": {"style": "calm"}})",
       {"duration_s: must be in [0.001, 86400] s, got -2"});
-  expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": "long", "controller": {"style": "calm"}})",
-              {"duration_s: must be a number"});
+  expectError(
+      R"({"format": "pneuma-scenario", "version": 1, "duration_s": "long", "controller": {"style": "calm"}})",
+      {"duration_s: must be a number"});
   expectError(with(R"("seed": -1)"), {"seed: must be a non-negative integer"});
   expectError(with(R"("sead": 1)"), {"sead: unknown field"});
-  expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"style": "calm", "affect": "joy"}})",
-              {"controller: needs exactly one"});
+  expectError(
+      R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"style": "calm", "affect": "joy"}})",
+      {"controller: needs exactly one"});
   expectError(R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"pattern": 3}})",
               {"controller.pattern: must be a pattern file path"});
   expectError(with(R"("overrides": {"dt_s": 0})"), {"overrides.dt_s: must be in [1e-06, 0.05] s, got 0"});
-  expectError(with(R"("overrides": {"integrator": "rk4"})"), {"overrides.integrator", "rk4", "implicit-euler-joints"});
+  expectError(with(R"("overrides": {"integrator": "rk4"})"),
+              {"overrides.integrator", "rk4", "implicit-euler-joints"});
   expectError(with(R"("overrides": {"active_gain_scale": {"diaphram": 2}})"),
               {"overrides.active_gain_scale.diaphram: unknown muscle group", "diaphragm"});
-  expectError(with(R"("overrides": {"passive_gain_scale": {"rectus": -1}})"), {"overrides.passive_gain_scale.rectus: must be >= 0"});
+  expectError(with(R"("overrides": {"passive_gain_scale": {"rectus": -1}})"),
+              {"overrides.passive_gain_scale.rectus: must be >= 0"});
   expectError(with(R"("overrides": {"gravity": "yes"})"), {"overrides.gravity: must be true or false"});
   expectError(with(R"("overrides": {"posture": "sitting"})"),
-              {"overrides.posture: unknown posture 'sitting' (valid: upright, supine, prone, left-lateral, right-lateral)"});
+              {"overrides.posture: unknown posture 'sitting' (valid: upright, supine, prone, left-lateral, "
+               "right-lateral)"});
   expectError(with(R"("overrides": {"posture": 1})"), {"overrides.posture"});
   expectError(with(R"("outputs": {"output_rate_hz": 0})"),
               {"outputs.output_rate_hz: must be in [0.01, 10000] Hz, got 0"});
@@ -139,7 +152,8 @@ TEST(Scenario, BadFieldsAreNamedByTheirJsonPath) {
 
 TEST(Scenario, BadControllerContentsAreNamedByTheirPath) {
   Scenario s = parseScenario(
-      R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"affect": "ennui"}})", "a.json", "");
+      R"({"format": "pneuma-scenario", "version": 1, "duration_s": 5, "controller": {"affect": "ennui"}})",
+      "a.json", "");
   try {
     checkController(s, PNEUMA_RESOURCE_DIR);
     ADD_FAILURE() << "unknown affect accepted";
@@ -157,6 +171,7 @@ TEST(Scenario, BadControllerContentsAreNamedByTheirPath) {
     checkController(s, PNEUMA_RESOURCE_DIR);
     ADD_FAILURE() << "negative timeline time accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("controller.pattern: timeline[0].time_s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("controller.pattern: timeline[0].time_s"), std::string::npos)
+        << e.what();
   }
 }

@@ -1,16 +1,16 @@
 // The Simulation logic layer: parameter validation before running, blow-up detection, determinism
 // (bit-identical recordings), the recorder, the breath-style controller (Zordan et al. 2004,
 // Section 7, Table 2) and the Summary's cycle analysis.
-#include "ToyTorso.h"
-
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/Simulation.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <memory>
+
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Error.h"
 
 namespace pneuma::sim {
 namespace {
@@ -22,7 +22,9 @@ std::shared_ptr<const Model> toy() {
   return model;
 }
 
-std::unique_ptr<Controller> calm() { return std::make_unique<BreathStyleController>(loadBreathStyle("calm")); }
+std::unique_ptr<Controller> calm() {
+  return std::make_unique<BreathStyleController>(loadBreathStyle("calm"));
+}
 
 // expects an Error whose message contains `needle`
 template <typename F>
@@ -88,7 +90,8 @@ TEST(Simulation, ResolveOptionsIsTheRuleTheRunFollows) {
   EXPECT_EQ(resolveOptions(*model, o).kappa, 3.0 * model->gut.kappa);
   o.step.kappa = 0.0;
   expectError([&] { Simulation(model, calm(), o); }, "kappa");
-  for (const std::optional<double> kappa : {std::optional<double>{}, std::optional<double>{4.0 * model->gut.kappa}}) {
+  for (const std::optional<double> kappa :
+       {std::optional<double>{}, std::optional<double>{4.0 * model->gut.kappa}}) {
     o.step.kappa = kappa;
     Simulation sim(model, calm(), o);
     sim.advance(0.2);
@@ -122,9 +125,14 @@ TEST(SimulationInput, RejectsContractionRatioOutOfRange) {
 
 TEST(SimulationInput, UnknownPresetListsValidNames) {
   expectError([] { loadBreathStyle("yawning"); }, "valid: calm, deep, forced-exhale, panting");
-  expectError([] { parseBreathStyle("{\"name\": \"x\", \"breaths_per_minute\": -3, \"diaphragm_r\": 0.8, "
-                                    "\"intercostal_mean\": 0.9, \"intercostal_amplitude\": 0.1}", "x.json"); },
-              "breaths_per_minute");
+  expectError(
+      [] {
+        parseBreathStyle(
+            "{\"name\": \"x\", \"breaths_per_minute\": -3, \"diaphragm_r\": 0.8, "
+            "\"intercostal_mean\": 0.9, \"intercostal_amplitude\": 0.1}",
+            "x.json");
+      },
+      "breaths_per_minute");
 }
 
 // a step that cannot be integrated stably names the time, the part and the likely cause
@@ -156,20 +164,26 @@ TEST(BreathStyleController, InspiratoryAndExpiratoryMusclesTakeTurns) {
   EXPECT_NEAR(at(0.5 * inhale - calm.intercostalLead, ElementGroup::IntercostalExternal).alpha,
               0.5 * calm.intercostalAlpha, 1e-12);
   EXPECT_GT(at(0.01, ElementGroup::IntercostalExternal).alpha, at(0.01, ElementGroup::Diaphragm).alpha);
-  EXPECT_NEAR(at(0.5 * inhale, ElementGroup::IntercostalExternal).r, calm.intercostalMean - calm.intercostalAmplitude, 1e-12);
+  EXPECT_NEAR(at(0.5 * inhale, ElementGroup::IntercostalExternal).r,
+              calm.intercostalMean - calm.intercostalAmplitude, 1e-12);
   // post-inspiratory braking: half-way down at half the decay window, off after it
-  EXPECT_NEAR(at(inhale + 0.5 * calm.driveDecayFraction * exhale, ElementGroup::Diaphragm).alpha, 0.5 * calm.diaphragmAlpha, 1e-9);
+  EXPECT_NEAR(at(inhale + 0.5 * calm.driveDecayFraction * exhale, ElementGroup::Diaphragm).alpha,
+              0.5 * calm.diaphragmAlpha, 1e-9);
   EXPECT_EQ(at(inhale + 1.01 * calm.driveDecayFraction * exhale, ElementGroup::Diaphragm).alpha, 0.0);
   // the drive is continuous: no step larger than a smooth curve's over 1 ms
   for (double t = 0.001; t < 2 * period; t += 0.001)
-    EXPECT_LT(std::abs(at(t, ElementGroup::Diaphragm).alpha - at(t - 0.001, ElementGroup::Diaphragm).alpha), 0.005) << t;
+    EXPECT_LT(std::abs(at(t, ElementGroup::Diaphragm).alpha - at(t - 0.001, ElementGroup::Diaphragm).alpha),
+              0.005)
+        << t;
   for (double t = 0.0; t < period; t += 0.05) {
     EXPECT_EQ(at(t, ElementGroup::Rectus).alpha, 0.0);
     EXPECT_EQ(at(t, ElementGroup::IntercostalInternal).alpha, 0.0);  // quiet expiration is passive recoil
   }
   BreathStyleController forced(loadBreathStyle("forced-exhale"));  // 6 s cycle, 2.4 s inhale
-  auto forcedAt = [&](double t, ElementGroup g) { return forced.activations(t, none)[static_cast<std::size_t>(g)]; };
-  EXPECT_EQ(forcedAt(1.0, ElementGroup::Rectus).alpha, 0.0);  // inhale
+  auto forcedAt = [&](double t, ElementGroup g) {
+    return forced.activations(t, none)[static_cast<std::size_t>(g)];
+  };
+  EXPECT_EQ(forcedAt(1.0, ElementGroup::Rectus).alpha, 0.0);         // inhale
   EXPECT_DOUBLE_EQ(forcedAt(4.0, ElementGroup::Rectus).alpha, 1.0);  // exhale, after the drive's rise
   EXPECT_DOUBLE_EQ(forcedAt(4.0, ElementGroup::Rectus).r, 0.5);
   EXPECT_DOUBLE_EQ(forcedAt(4.0, ElementGroup::IntercostalInternal).alpha, 1.0);
@@ -191,9 +205,11 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   const BreathStyle panting = loadBreathStyle("panting");
   BreathStyleController c(panting);
   const Metrics none;
-  const Activations a = c.activations(0.5 - 1e-9, none);  // the end of the 0.5 s inhale, at full inspiratory drive
+  const Activations a =
+      c.activations(0.5 - 1e-9, none);  // the end of the 0.5 s inhale, at full inspiratory drive
   EXPECT_NEAR(a[static_cast<std::size_t>(ElementGroup::Diaphragm)].alpha, panting.diaphragmAlpha, 1e-9);
-  EXPECT_NEAR(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha, 1e-9);
+  EXPECT_NEAR(a[static_cast<std::size_t>(ElementGroup::IntercostalExternal)].alpha, panting.intercostalAlpha,
+              1e-9);
   EXPECT_LT(panting.diaphragmAlpha, 1.0);
   const std::string text = serializeBreathStyle(panting);
   EXPECT_EQ(serializeBreathStyle(parseBreathStyle(text, "panting.json")), text);
@@ -243,7 +259,8 @@ TEST(Summary, CycleAnalysisOfASine) {
   EXPECT_NEAR(s.motion.abdomenTidal, 2e-4 * std::cos(kPi / 9.0), 1e-7);
   EXPECT_NEAR(s.motion.ribCageTidal, 5e-4 - s.motion.abdomenTidal, 1e-9);
   EXPECT_TRUE(std::isnan(s.motion.xiphoidAnterior));  // no such landmark
-  // the rib-cage signal 2.5 sin(wt) - 1.0 sin(wt + 20 deg) has phase atan2(-sin 20, 2.5 - cos 20) = -13.3 degrees
+  // the rib-cage signal 2.5 sin(wt) - 1.0 sin(wt + 20 deg) has phase atan2(-sin 20, 2.5 - cos 20) = -13.3
+  // degrees
   const double rcPhase = std::atan2(-std::sin(kPi / 9.0), 2.5 - std::cos(kPi / 9.0));
   EXPECT_NEAR(s.motion.phaseAngle, kPi / 9.0 - rcPhase, 2e-3);
   EXPECT_NEAR(s.motion.flowSignChanges, 2.0, 1e-9);

@@ -27,8 +27,9 @@ int breathe(const Model& model, const StepOptions& o, double dt, double seconds,
 
 // a fresh factorization solves the step directly (no CG): the assembled sparse system (bodies in the joint
 // tree's coordinates, their coupling to the gut nodes, joints, the gut's and the pleural rank-one pressure
-// stiffness by Sherman-Morrison) must equal the matrix-free operator that CG solves; with the first factorization kept
-// for the whole run and CG converged to 1e-10, the motion agrees with the direct solve of every step
+// stiffness by Sherman-Morrison) must equal the matrix-free operator that CG solves; with the first
+// factorization kept for the whole run and CG converged to 1e-10, the motion agrees with the direct solve of
+// every step
 TEST(ImplicitSolve, FreshFactorizationSolvesTheLinearStepExactly) {
   StepOptions fresh;
   fresh.integrator = IntegratorKind::ImplicitEulerJoints;
@@ -84,7 +85,8 @@ TEST(ImplicitSolve, StaleFactorizationGivesTheSameMotion) {
 namespace pneuma::sim {
 namespace {
 
-// a rib on a rib-neck hinge (Joints): a fixed parent, one child, axis a, k about every direction plus k_lock off a
+// a rib on a rib-neck hinge (Joints): a fixed parent, one child, axis a, k about every direction plus k_lock
+// off a
 Model hingedRib(const Eigen::Vector3d& axis, double k, double kLock) {
   Model m;
   m.gravity.setZero();
@@ -94,11 +96,12 @@ Model hingedRib(const Eigen::Vector3d& axis, double k, double kLock) {
   return m;
 }
 
-// the torque on a rib turned by theta is -K theta, K = k I + k_lock (I - a a^T): about the neck axis only k resists,
-// across it k + k_lock; the same for the potential, whose derivative along theta is the torque
+// the torque on a rib turned by theta is -K theta, K = k I + k_lock (I - a a^T): about the neck axis only k
+// resists, across it k + k_lock; the same for the potential, whose derivative along theta is the torque
 TEST(RibNeckHinge, TorqueIsKThetaAndTheGradientOfItsEnergy) {
-  const Eigen::Vector3d a = Eigen::Vector3d(std::cos(0.9), -std::sin(0.9), 0.0);  // about 52 degrees from transverse
-  const double k = 5.0, kLock = 100.0;  // [N m/rad]
+  const Eigen::Vector3d a =
+      Eigen::Vector3d(std::cos(0.9), -std::sin(0.9), 0.0);  // about 52 degrees from transverse
+  const double k = 5.0, kLock = 100.0;                      // [N m/rad]
   const Model m = hingedRib(a, k, kLock);
   const Eigen::Vector3d across = a.cross(Eigen::Vector3d::UnitZ()).normalized();
   for (const Eigen::Vector3d& dir : {a, across, Eigen::Vector3d(a + across).normalized()}) {
@@ -107,7 +110,8 @@ TEST(RibNeckHinge, TorqueIsKThetaAndTheGradientOfItsEnergy) {
     s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(angle, dir));
     StepWork w = makeStepWork(m);
     computeForces(m, s, relaxedActivations(), StepOptions{}, w);
-    const Eigen::Matrix3d K = k * Eigen::Matrix3d::Identity() + kLock * (Eigen::Matrix3d::Identity() - a * a.transpose());
+    const Eigen::Matrix3d K =
+        k * Eigen::Matrix3d::Identity() + kLock * (Eigen::Matrix3d::Identity() - a * a.transpose());
     const Eigen::Vector3d expected = -K * (angle * dir);
     EXPECT_LT((w.scratch.bodyTorque.col(1) - expected).norm(), 1e-9 * expected.norm()) << dir.transpose();
     // energy: E(angle) = 1/2 theta^T K theta, so dE/dangle = -tau . dir
@@ -133,8 +137,8 @@ TEST(RibNeckHinge, TorqueIsKThetaAndTheGradientOfItsEnergy) {
   EXPECT_NEAR(offAxis / w.scratch.bodyTorque.col(1).norm(), (k + kLock) / k, 1e-6);
 }
 
-// the hinge's axis turns with its parent: a rotation of the whole pair leaves the joint unloaded, and a rib turned
-// about the parent's turned axis meets only k
+// the hinge's axis turns with its parent: a rotation of the whole pair leaves the joint unloaded, and a rib
+// turned about the parent's turned axis meets only k
 TEST(RibNeckHinge, AxisFollowsTheParent) {
   const Eigen::Vector3d a = Eigen::Vector3d::UnitX();
   Model m = hingedRib(a, 5.0, 100.0);
@@ -154,15 +158,16 @@ TEST(RibNeckHinge, AxisFollowsTheParent) {
 namespace pneuma::sim {
 namespace {
 
-// the pleural pressure (Cavity) is the gradient of its potential: on the node it pulls hardest, the force change
-// it makes equals minus the finite-difference derivative of the elastic energy, and it pulls the walls inward
+// the pleural pressure (Cavity) is the gradient of its potential: on the node it pulls hardest, the force
+// change it makes equals minus the finite-difference derivative of the elastic energy, and it pulls the walls
+// inward
 TEST(PleuralPressure, ForceIsMinusTheGradientOfTheRecoilEnergy) {
   Model off = test::makeToyTorso();
   off.gravity.setZero();
   ASSERT_GT(off.cavity.triangles.cols(), 0);
   Model on = off;
-  on.cavity.recoilPressure = 490.0;   // [Pa] 5 cmH2O
-  on.cavity.compliance = 2.0e-6;      // [m^3/Pa] 0.2 L/cmH2O
+  on.cavity.recoilPressure = 490.0;  // [Pa] 5 cmH2O
+  on.cavity.compliance = 2.0e-6;     // [m^3/Pa] 0.2 L/cmH2O
   const State s0 = makeInitialState(on);
   StepWork wOn = makeStepWork(on), wOff = makeStepWork(off);
   computeForces(on, s0, relaxedActivations(), StepOptions{}, wOn);

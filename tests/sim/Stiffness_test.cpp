@@ -1,10 +1,10 @@
 // The stiffness the implicit step linearises the forces with (StepImplicit.cpp), against central finite
-// differences of the forces themselves, SOFA-style: K u = -(F(q + h u) - F(q - h u)) / 2h on the toy torso, for
-// the matrix-free product CG applies and for the matrix the preconditioner factors. q = [x_b, theta_b]_b ++
-// [x_n]_n; a body turns by the rotation vector h theta about its com. K is exact but for two terms the step leaves
-// out on purpose (docs/integrator.md): the turning of a lever under a body-end force, d(r x f) = (dtheta x r) x f,
-// and the gut pressure's geometric part P d(grad V); the test adds both from the kernels, so everything else must
-// agree to rounding.
+// differences of the forces themselves, SOFA-style: K u = -(F(q + h u) - F(q - h u)) / 2h on the toy torso,
+// for the matrix-free product CG applies and for the matrix the preconditioner factors. q = [x_b, theta_b]_b
+// ++ [x_n]_n; a body turns by the rotation vector h theta about its com. K is exact but for two terms the
+// step leaves out on purpose (docs/integrator.md): the turning of a lever under a body-end force, d(r x f) =
+// (dtheta x r) x f, and the gut pressure's geometric part P d(grad V); the test adds both from the kernels,
+// so everything else must agree to rounding.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -20,10 +20,10 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-// the toy torso at a loaded configuration: mid-inhale activations (muscles in tension at rest length), the gut
-// squeezed by 3 % toward its centroid so its pressure pushes (P > 0) and every node nudged off the rest pose, bodies
-// at rest orientation (joint springs unloaded, where their linearisation is exact); at rest (no velocity), no
-// gravity, no pleural recoil (its own rank-one term is tested in Step_test)
+// the toy torso at a loaded configuration: mid-inhale activations (muscles in tension at rest length), the
+// gut squeezed by 3 % toward its centroid so its pressure pushes (P > 0) and every node nudged off the rest
+// pose, bodies at rest orientation (joint springs unloaded, where their linearisation is exact); at rest (no
+// velocity), no gravity, no pleural recoil (its own rank-one term is tested in Step_test)
 struct Loaded {
   Model model;
   State state;
@@ -59,7 +59,8 @@ VectorXd forces(const Loaded& l, const State& s) {
     f.segment<3>(6 * b) = w.scratch.bodyForce.col(b);
     f.segment<3>(6 * b + 3) = w.scratch.bodyTorque.col(b);
   }
-  for (int n = 0; n < l.model.nodes.size(); ++n) f.segment<3>(detail::nodeOffset(l.model, n)) = w.scratch.nodeForce.col(n);
+  for (int n = 0; n < l.model.nodes.size(); ++n)
+    f.segment<3>(detail::nodeOffset(l.model, n)) = w.scratch.nodeForce.col(n);
   return f;
 }
 
@@ -71,10 +72,12 @@ State displaced(const Loaded& l, const VectorXd& u, double h) {
     const Vector3d theta = h * u.segment<3>(6 * b + 3);
     if (theta.norm() > 0.0)
       s.bodyOrientation[static_cast<std::size_t>(b)] =
-          (Eigen::Quaterniond(Eigen::AngleAxisd(theta.norm(), theta.normalized())) * s.bodyOrientation[static_cast<std::size_t>(b)])
+          (Eigen::Quaterniond(Eigen::AngleAxisd(theta.norm(), theta.normalized())) *
+           s.bodyOrientation[static_cast<std::size_t>(b)])
               .normalized();
   }
-  for (int n = 0; n < l.model.nodes.size(); ++n) s.nodePosition.col(n) += h * u.segment<3>(detail::nodeOffset(l.model, n));
+  for (int n = 0; n < l.model.nodes.size(); ++n)
+    s.nodePosition.col(n) += h * u.segment<3>(detail::nodeOffset(l.model, n));
   return s;
 }
 
@@ -84,13 +87,15 @@ VectorXd forceDerivative(const Loaded& l, const VectorXd& u) {
   return -(forces(l, displaced(l, u, h)) - forces(l, displaced(l, u, -h))) / (2.0 * h);
 }
 
-// the two terms the step leaves out of K, times u: the lever's turn under each body-end force, -(dtheta x r) x f,
-// and the gut pressure's geometric part, -P d(grad V)/dx u (grad V is quadratic in x: its central difference is exact)
+// the two terms the step leaves out of K, times u: the lever's turn under each body-end force, -(dtheta x r)
+// x f, and the gut pressure's geometric part, -P d(grad V)/dx u (grad V is quadratic in x: its central
+// difference is exact)
 VectorXd omitted(const Loaded& l, const StepWork& w, const VectorXd& u) {
   VectorXd out = VectorXd::Zero(u.size());
   const Elements& el = l.model.elements;
   for (int e = 0; e < el.size(); ++e) {
-    const Vector3d f = w.outputs.elementForce(e) * w.scratch.elementDirection.col(e);  // on end B; -f on end A
+    const Vector3d f =
+        w.outputs.elementForce(e) * w.scratch.elementDirection.col(e);  // on end B; -f on end A
     for (int side = 0; side < 2; ++side) {
       const int b = w.constants.endpointBody(side, e);
       if (b < 0) continue;
@@ -105,16 +110,20 @@ VectorXd omitted(const Loaded& l, const StepWork& w, const VectorXd& u) {
   Eigen::Matrix3Xd gp = Eigen::Matrix3Xd::Zero(3, x.cols()), gm = gp;
   addVolumeGradient(x + du, l.model.gut.triangles, 1.0, gp);
   addVolumeGradient(x - du, l.model.gut.triangles, 1.0, gm);
-  for (int n = 0; n < l.model.nodes.size(); ++n) out.segment<3>(detail::nodeOffset(l.model, n)) -= 0.5 * p * (gp.col(n) - gm.col(n));
+  for (int n = 0; n < l.model.nodes.size(); ++n)
+    out.segment<3>(detail::nodeOffset(l.model, n)) -= 0.5 * p * (gp.col(n) - gm.col(n));
   return out;
 }
 
-// |a - b| <= tol |b| on the body entries (the first `bodyEntries`) and on the node entries apart: the gut's pressure
-// makes the node forces the larger by far
-void expectClose(const VectorXd& a, const VectorXd& b, Eigen::Index bodyEntries, double tol, const std::string& what) {
+// |a - b| <= tol |b| on the body entries (the first `bodyEntries`) and on the node entries apart: the gut's
+// pressure makes the node forces the larger by far
+void expectClose(const VectorXd& a, const VectorXd& b, Eigen::Index bodyEntries, double tol,
+                 const std::string& what) {
   const Eigen::Index nodeEntries = b.size() - bodyEntries;
-  EXPECT_LT((a.head(bodyEntries) - b.head(bodyEntries)).norm(), tol * b.head(bodyEntries).norm()) << what << ", bodies";
-  EXPECT_LT((a.tail(nodeEntries) - b.tail(nodeEntries)).norm(), tol * b.tail(nodeEntries).norm()) << what << ", nodes";
+  EXPECT_LT((a.head(bodyEntries) - b.head(bodyEntries)).norm(), tol * b.head(bodyEntries).norm())
+      << what << ", bodies";
+  EXPECT_LT((a.tail(nodeEntries) - b.tail(nodeEntries)).norm(), tol * b.tail(nodeEntries).norm())
+      << what << ", nodes";
 }
 
 // a random direction over the moving coordinates
@@ -133,7 +142,8 @@ TEST(Stiffness, ProductIsMinusTheForceDerivative) {
   StepWork w = makeStepWork(l.model);
   computeForces(l.model, l.state, l.act, l.options, w);
   ASSERT_GT(w.outputs.gutPressure, 100.0) << "the squeezed gut pushes";
-  ASSERT_GT((w.outputs.elementForce.array() < 0.0).count(), l.model.elements.size() / 4) << "muscles in tension";
+  ASSERT_GT((w.outputs.elementForce.array() < 0.0).count(), l.model.elements.size() / 4)
+      << "muscles in tension";
   for (unsigned seed : {1u, 2u, 3u}) {
     const VectorXd u = randomDirection(w, seed);
     VectorXd ku;
@@ -146,9 +156,9 @@ TEST(Stiffness, ProductIsMinusTheForceDerivative) {
   }
 }
 
-// the matrix the preconditioner factors, J^T (M + dt D + dt^2 K) J over the free coordinates of the joint tree:
-// quadratic in dt, so (A(1) + A(-1)) / 2 - A(0) is J^T K J exactly; with the gut's rank-one term that the solver
-// adds by Sherman-Morrison, J^T K J u equals J^T of the force derivative along J u
+// the matrix the preconditioner factors, J^T (M + dt D + dt^2 K) J over the free coordinates of the joint
+// tree: quadratic in dt, so (A(1) + A(-1)) / 2 - A(0) is J^T K J exactly; with the gut's rank-one term that
+// the solver adds by Sherman-Morrison, J^T K J u equals J^T of the force derivative along J u
 TEST(Stiffness, AssembledMatrixIsMinusTheForceDerivativeInTheJointTreesCoordinates) {
   const Loaded l = loaded();
   StepWork w = makeStepWork(l.model);

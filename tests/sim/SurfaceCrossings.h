@@ -1,17 +1,17 @@
 #pragma once
-// Triangle-triangle crossings between closed surfaces (the lung cavity, the lungs, the gut): how the tests find a
-// surface that passes through another or through itself. Header-only test support (no metric uses it).
+// Triangle-triangle crossings between closed surfaces (the lung cavity, the lungs, the gut): how the tests
+// find a surface that passes through another or through itself. Header-only test support (no metric uses it).
 //
-// Two triangles cross when an edge of one passes through the interior of the other: its end points lie strictly
-// on opposite sides of the other's plane (signed distances beyond `tolerance`) and the point where it meets the
-// plane lies strictly inside the triangle (Moller 1997, "A fast triangle-triangle intersection test", with the
-// segment form of Ericson 2005, "Real-Time Collision Detection", 5.3.6). Two non-coplanar triangles that
-// intersect along a segment of positive length always have such an edge. Touching (a vertex or an edge lying
-// on the other triangle, coplanar faces shared by two surfaces bound to the same walls) is not a crossing.
-// A uniform grid over the triangles' bounding boxes keeps the pairs tested near-linear in the mesh size.
+// Two triangles cross when an edge of one passes through the interior of the other: its end points lie
+// strictly on opposite sides of the other's plane (signed distances beyond `tolerance`) and the point where
+// it meets the plane lies strictly inside the triangle (Moller 1997, "A fast triangle-triangle intersection
+// test", with the segment form of Ericson 2005, "Real-Time Collision Detection", 5.3.6). Two non-coplanar
+// triangles that intersect along a segment of positive length always have such an edge. Touching (a vertex or
+// an edge lying on the other triangle, coplanar faces shared by two surfaces bound to the same walls) is not
+// a crossing. A uniform grid over the triangles' bounding boxes keeps the pairs tested near-linear in the
+// mesh size.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -27,8 +27,9 @@ constexpr double kCrossingTolerance = 1e-9;
 namespace detail {
 
 // true when segment p-q passes through the interior of triangle (a, b, c)
-inline bool segmentCrossesTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                                   const Eigen::Vector3d& b, const Eigen::Vector3d& c, double tolerance) {
+inline bool segmentCrossesTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                                   const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                   const Eigen::Vector3d& c, double tolerance) {
   const Eigen::Vector3d n = (b - a).cross(c - a);
   const double area2 = n.norm();
   if (!(area2 > 0.0)) return false;  // degenerate triangle
@@ -61,13 +62,14 @@ inline std::array<Eigen::Vector3d, 3> corners(const Eigen::Matrix3Xd& v, const E
 
 }  // namespace detail
 
-/// Number of pairs (triangle of A, triangle of B) that cross (see the file comment). When `same` is true, A and B
-/// are one surface: each unordered pair is counted once and pairs of triangles that share a vertex index are
-/// skipped (neighbours meet along their common edge or corner).
+/// Number of pairs (triangle of A, triangle of B) that cross (see the file comment). When `same` is true, A
+/// and B are one surface: each unordered pair is counted once and pairs of triangles that share a vertex
+/// index are skipped (neighbours meet along their common edge or corner).
 /// @param va, vb  vertex positions [m] (3 x #V); @param fa, fb  vertex indices (3 x #F)
 /// @param pairs   when not null, receives the crossing pairs (triangle of A, triangle of B)
 inline int countCrossings(const Eigen::Matrix3Xd& va, const Eigen::Matrix3Xi& fa, const Eigen::Matrix3Xd& vb,
-                          const Eigen::Matrix3Xi& fb, bool same = false, double tolerance = kCrossingTolerance,
+                          const Eigen::Matrix3Xi& fb, bool same = false,
+                          double tolerance = kCrossingTolerance,
                           std::vector<std::pair<int, int>>* pairs = nullptr) {
   const int na = static_cast<int>(fa.cols()), nb = static_cast<int>(fb.cols());
   if (na == 0 || nb == 0) return 0;
@@ -93,7 +95,8 @@ inline int countCrossings(const Eigen::Matrix3Xd& va, const Eigen::Matrix3Xi& fa
   };
   std::unordered_map<long long, std::vector<int>> grid;
   for (int j = 0; j < nb; ++j) {
-    const Eigen::Vector3i lo = cellOf(bb[static_cast<std::size_t>(j)].min()), hi = cellOf(bb[static_cast<std::size_t>(j)].max());
+    const Eigen::Vector3i lo = cellOf(bb[static_cast<std::size_t>(j)].min()),
+                          hi = cellOf(bb[static_cast<std::size_t>(j)].max());
     for (int x = lo.x(); x <= hi.x(); ++x)
       for (int y = lo.y(); y <= hi.y(); ++y)
         for (int z = lo.z(); z <= hi.z(); ++z) grid[key(x, y, z)].push_back(j);
@@ -113,10 +116,13 @@ inline int countCrossings(const Eigen::Matrix3Xd& va, const Eigen::Matrix3Xi& fa
             if (seen[static_cast<std::size_t>(j)] == i) continue;
             seen[static_cast<std::size_t>(j)] = i;
             if (same && j <= i) continue;
-            if (same && (fa.col(i).array() == fb(0, j) || fa.col(i).array() == fb(1, j) || fa.col(i).array() == fb(2, j)).any())
+            if (same && (fa.col(i).array() == fb(0, j) || fa.col(i).array() == fb(1, j) ||
+                         fa.col(i).array() == fb(2, j))
+                            .any())
               continue;
             if (!box.intersects(bb[static_cast<std::size_t>(j)])) continue;
-            if (!detail::trianglesCross(detail::corners(va, fa, i), detail::corners(vb, fb, j), tolerance)) continue;
+            if (!detail::trianglesCross(detail::corners(va, fa, i), detail::corners(vb, fb, j), tolerance))
+              continue;
             ++count;
             if (pairs != nullptr) pairs->emplace_back(i, j);
           }

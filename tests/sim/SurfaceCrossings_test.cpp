@@ -1,5 +1,5 @@
-// The crossing test of SurfaceCrossings.h on analytic cases: two triangles that cross, touch, share a plane or
-// stay apart, and a closed sphere mesh with one vertex pushed through the opposite side.
+// The crossing test of SurfaceCrossings.h on analytic cases: two triangles that cross, touch, share a plane
+// or stay apart, and a closed sphere mesh with one vertex pushed through the opposite side.
 #include "SurfaceCrossings.h"
 
 #include <gtest/gtest.h>
@@ -31,7 +31,8 @@ void sphere(int rings, int segments, Eigen::Matrix3Xd& v, Eigen::Matrix3Xi& f) {
   for (int r = 1; r < rings; ++r)
     for (int s = 0; s < segments; ++s) {
       const double th = pi * r / rings, ph = 2 * pi * s / segments;
-      v.col(at(r, s)) = Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+      v.col(at(r, s)) =
+          Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
     }
   std::vector<Eigen::Vector3i> t;
   for (int s = 0; s < segments; ++s) {
@@ -62,7 +63,8 @@ TEST(SurfaceCrossings, TouchingIsNotCrossing) {
   EXPECT_EQ(crossings(kFloor, triangle({0, 0, 0}, {-1, 0, 0.5}, {0, -1, 0.5})), 0);
   // coplanar and overlapping (a face shared by two surfaces bound to the same wall)
   EXPECT_EQ(crossings(kFloor, triangle({0.1, 0.1, 0}, {0.6, 0.1, 0}, {0.1, 0.6, 0})), 0);
-  // in the plane x = y, one edge standing on the floor's hypotenuse: the floor's edge meets it at a point of both
+  // in the plane x = y, one edge standing on the floor's hypotenuse: the floor's edge meets it at a point of
+  // both
   EXPECT_EQ(crossings(kFloor, triangle({0.5, 0.5, -0.1}, {0.5, 0.5, 0.4}, {0.9, 0.9, 0.2})), 0);
   // a piercing edge that passes the floor just outside its hypotenuse
   EXPECT_EQ(crossings(kFloor, triangle({0.6, 0.6, -0.1}, {0.7, 0.6, -0.1}, {0.65, 0.6, 0.5})), 0);

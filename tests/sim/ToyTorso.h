@@ -6,13 +6,7 @@
 // strands. It has every part the default model has, at a tenth of the size, so tests can run the
 // whole pipeline without the meshing layer. Gains are plausible SI values, not calibrated ones.
 
-#include "pneuma/sim/Elements.h"
-#include "pneuma/sim/Model.h"
-#include "pneuma/sim/State.h"
-#include "pneuma/sim/Step.h"
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -20,13 +14,19 @@
 #include <utility>
 #include <vector>
 
+#include "pneuma/sim/Elements.h"
+#include "pneuma/sim/Model.h"
+#include "pneuma/sim/State.h"
+#include "pneuma/sim/Step.h"
+
 namespace pneuma::sim::test {
 
 // unit icosphere: `subdivisions` loop subdivisions of an icosahedron, outward counter-clockwise faces
 inline void icosphere(int subdivisions, Eigen::Matrix3Xd& vertices, Eigen::Matrix3Xi& faces) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   for (auto& p : v) p.normalize();
   std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                     {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
@@ -61,7 +61,7 @@ inline void icosphere(int subdivisions, Eigen::Matrix3Xd& vertices, Eigen::Matri
 
 // inertia [kg m^2] about the centroid of equal point masses at `points`, plus a small isotropic term
 inline Eigen::Matrix3d pointCloudInertia(const std::vector<Eigen::Vector3d>& points, double mass,
-                                          const Eigen::Vector3d& com, double radius) {
+                                         const Eigen::Vector3d& com, double radius) {
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity() * (0.4 * mass * radius * radius);
   const double m = mass / static_cast<double>(points.size());
   for (const auto& p : points) {
@@ -86,8 +86,8 @@ inline int addBody(Model& m, const std::string& name, bool fixed, double mass, c
 }
 
 inline void addJoint(Model& m, const std::string& name, int parent, int child, const Eigen::Vector3d& anchor,
-                     double friction, double stiffness, const Eigen::Vector3d& axis = Eigen::Vector3d::UnitX(),
-                     double lockStiffness = 0.0) {
+                     double friction, double stiffness,
+                     const Eigen::Vector3d& axis = Eigen::Vector3d::UnitX(), double lockStiffness = 0.0) {
   const int i = m.joints.size();
   m.joints.name.push_back(name);
   m.joints.parent.push_back(parent);
@@ -118,9 +118,12 @@ inline void addEnd(const Model& m, AnchorSet& set, const End& e) {
     set.addNodePoint(Eigen::Vector3i(e.node, -1, -1), Eigen::Vector3d(1, 0, 0));
 }
 
-inline Eigen::Vector3d endPosition(const Model& m, const End& e) { return e.body >= 0 ? e.world : Eigen::Vector3d(m.nodes.rest.col(e.node)); }
+inline Eigen::Vector3d endPosition(const Model& m, const End& e) {
+  return e.body >= 0 ? e.world : Eigen::Vector3d(m.nodes.rest.col(e.node));
+}
 
-inline void addElement(Model& m, ElementGroup g, const End& a, const End& b, double kac, double kpe, double damping) {
+inline void addElement(Model& m, ElementGroup g, const End& a, const End& b, double kac, double kpe,
+                       double damping) {
   const int i = m.elements.size();
   m.elements.group.push_back(g);
   addEnd(m, m.elements.endA, a);
@@ -142,14 +145,16 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   m.anatomy = "synthetic";
 
   // spine: fixed lumbar, three thoracic segments chained by stiff ball joints
-  const int lumbar = addBody(m, "lumbar", true, 2.0, Vector3d(0, -0.08, 0.20), Eigen::Matrix3d::Identity() * 1e-3);
+  const int lumbar =
+      addBody(m, "lumbar", true, 2.0, Vector3d(0, -0.08, 0.20), Eigen::Matrix3d::Identity() * 1e-3);
   std::vector<int> thoracic;
   int parent = lumbar;
   for (int s = 0; s < 3; ++s) {
     const double z = 0.32 + 0.1 * s;
     const int b = addBody(m, "thoracic_" + std::to_string(s + 1), false, 0.5, Vector3d(0, -0.08, z),
                           Eigen::Matrix3d::Identity() * (0.4 * 0.5 * 0.03 * 0.03));
-    addJoint(m, "intervertebral_" + std::to_string(s + 1), parent, b, Vector3d(0, -0.08, z - 0.05), 0.05, 40.0);
+    addJoint(m, "intervertebral_" + std::to_string(s + 1), parent, b, Vector3d(0, -0.08, z - 0.05), 0.05,
+             40.0);
     thoracic.push_back(b);
     parent = b;
   }
@@ -162,7 +167,8 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   constexpr int kLevels = 5, kSamples = 9;
   auto ribPoint = [&](int level, int side, double theta) {
     const double z = 0.30 + 0.045 * level;
-    return Vector3d(side * (0.02 + 0.12 * std::sin(theta)), -0.08 * std::cos(theta), z - 0.03 * (1.0 - std::cos(theta)));
+    return Vector3d(side * (0.02 + 0.12 * std::sin(theta)), -0.08 * std::cos(theta),
+                    z - 0.03 * (1.0 - std::cos(theta)));
   };
   std::map<std::pair<int, int>, int> rib;  // (level, side) -> body
   for (int level = 0; level < kLevels; ++level) {
@@ -180,8 +186,8 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
       // cartilage: two springs from the rib front to the sternum
       for (double th : {kPi, 0.9 * kPi}) {
         const Vector3d p = ribPoint(level, side, th);
-        addElement(m, ElementGroup::Cartilage, End{b, -1, p}, End{sternum, -1, Vector3d(0.0, 0.085, p.z() + 0.01)}, 0.0,
-                   2000.0, 2.0);
+        addElement(m, ElementGroup::Cartilage, End{b, -1, p},
+                   End{sternum, -1, Vector3d(0.0, 0.085, p.z() + 0.01)}, 0.0, 2000.0, 2.0);
       }
     }
   }
@@ -211,25 +217,30 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   for (int i = 0; i < nn; ++i) {
     const Vector3d p = m.nodes.rest.col(i);
     NodeRegion r = NodeRegion::Wall;
-    if (p.y() < -0.03 || p.z() < 0.09) r = NodeRegion::Fixed;
-    else if (p.z() > 0.23) r = NodeRegion::Diaphragm;
+    if (p.y() < -0.03 || p.z() < 0.09)
+      r = NodeRegion::Fixed;
+    else if (p.z() > 0.23)
+      r = NodeRegion::Diaphragm;
     m.nodes.region[static_cast<std::size_t>(i)] = r;
     if (r != NodeRegion::Fixed) ++moving;
   }
   m.nodes.mass = Eigen::VectorXd::Zero(nn);
-  for (int i = 0; i < nn; ++i) m.nodes.mass(i) = m.nodes.isFixed(i) ? 0.0 : 8.0 / moving;  // 8 kg wall (Section 6.1)
+  for (int i = 0; i < nn; ++i)
+    m.nodes.mass(i) = m.nodes.isFixed(i) ? 0.0 : 8.0 / moving;  // 8 kg wall (Section 6.1)
   m.gut.kappa = 2e5;
 
   // surface strands along mesh edges: diaphragm dome, rectus (front, vertical), transversus (the rest)
   std::map<std::pair<int, int>, bool> edges;
   for (Eigen::Index f = 0; f < m.gut.triangles.cols(); ++f)
-    for (int k = 0; k < 3; ++k) edges[std::minmax(m.gut.triangles(k, f), m.gut.triangles((k + 1) % 3, f))] = true;
+    for (int k = 0; k < 3; ++k)
+      edges[std::minmax(m.gut.triangles(k, f), m.gut.triangles((k + 1) % 3, f))] = true;
   std::vector<int> rim;
   for (const auto& [e, unused] : edges) {
     (void)unused;
     const int a = e.first, b = e.second;
     if (m.nodes.isFixed(a) && m.nodes.isFixed(b)) continue;
-    const auto ra = m.nodes.region[static_cast<std::size_t>(a)], rb = m.nodes.region[static_cast<std::size_t>(b)];
+    const auto ra = m.nodes.region[static_cast<std::size_t>(a)],
+               rb = m.nodes.region[static_cast<std::size_t>(b)];
     const Vector3d d = (m.nodes.rest.col(b) - m.nodes.rest.col(a)).normalized();
     const Vector3d mid = 0.5 * (m.nodes.rest.col(a) + m.nodes.rest.col(b));
     if (ra == NodeRegion::Diaphragm && rb == NodeRegion::Diaphragm)
@@ -238,7 +249,8 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
       addElement(m, ElementGroup::Rectus, End{-1, a, {}}, End{-1, b, {}}, 300.0, 60.0, 0.5);
     else
       addElement(m, ElementGroup::TransversusObliques, End{-1, a, {}}, End{-1, b, {}}, 0.0, 60.0, 0.5);
-    if ((ra == NodeRegion::Diaphragm) != (rb == NodeRegion::Diaphragm)) rim.push_back(ra == NodeRegion::Diaphragm ? a : b);
+    if ((ra == NodeRegion::Diaphragm) != (rb == NodeRegion::Diaphragm))
+      rim.push_back(ra == NodeRegion::Diaphragm ? a : b);
   }
   // diaphragm rim strands up to the lowest ribs (costal margin)
   std::sort(rim.begin(), rim.end());
@@ -247,7 +259,8 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
     const Vector3d p = m.nodes.rest.col(n);
     const int side = p.x() < 0 ? -1 : 1;
     const double th = std::atan2(std::abs(p.x()), -p.y());
-    addElement(m, ElementGroup::Diaphragm, End{-1, n, {}}, End{rib[{0, side}], -1, ribPoint(0, side, th)}, 300.0, 30.0, 0.5);
+    addElement(m, ElementGroup::Diaphragm, End{-1, n, {}}, End{rib[{0, side}], -1, ribPoint(0, side, th)},
+               300.0, 30.0, 0.5);
   }
 
   // lung cavity: one ring per rib level, capped at the top (thoracic segment) and the bottom (diaphragm apex)
@@ -257,9 +270,11 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   const int ringSize = 2 * (kSamples - 1);
   for (int level = 0; level < kLevels; ++level) {
     for (int k = 0; k < kSamples - 1; ++k)
-      m.cavity.vertices.addBodyPoint(rib[{level, 1}], ribPoint(level, 1, kPi * k / (kSamples - 1)) - m.bodies.com.col(rib[{level, 1}]));
+      m.cavity.vertices.addBodyPoint(
+          rib[{level, 1}], ribPoint(level, 1, kPi * k / (kSamples - 1)) - m.bodies.com.col(rib[{level, 1}]));
     for (int k = kSamples - 1; k > 0; --k)
-      m.cavity.vertices.addBodyPoint(rib[{level, -1}], ribPoint(level, -1, kPi * k / (kSamples - 1)) - m.bodies.com.col(rib[{level, -1}]));
+      m.cavity.vertices.addBodyPoint(rib[{level, -1}], ribPoint(level, -1, kPi * k / (kSamples - 1)) -
+                                                           m.bodies.com.col(rib[{level, -1}]));
   }
   const int top = m.cavity.vertices.size();
   m.cavity.vertices.addBodyPoint(thoracic[2], Vector3d(0, 0.08, 0.51) - m.bodies.com.col(thoracic[2]));
@@ -278,25 +293,30 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
     tris.push_back({(k + 1) % ringSize, k, bottom});
   }
   m.cavity.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
-  for (std::size_t i = 0; i < tris.size(); ++i) m.cavity.triangles.col(static_cast<Eigen::Index>(i)) = tris[i];
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    m.cavity.triangles.col(static_cast<Eigen::Index>(i)) = tris[i];
   Eigen::Matrix3Xd cavityRest(3, m.cavity.vertices.size());
   for (int i = 0; i < m.cavity.vertices.size(); ++i) {
     const int b = m.cavity.vertices.body[static_cast<std::size_t>(i)];
-    cavityRest.col(i) = b >= 0 ? Vector3d(m.bodies.com.col(b) + m.cavity.vertices.local.col(i)) : Vector3d(m.nodes.rest.col(apex));
+    cavityRest.col(i) = b >= 0 ? Vector3d(m.bodies.com.col(b) + m.cavity.vertices.local.col(i))
+                               : Vector3d(m.nodes.rest.col(apex));
   }
-  if (enclosedVolume(cavityRest, m.cavity.triangles) < 0.0) m.cavity.triangles.row(1).swap(m.cavity.triangles.row(2));
+  if (enclosedVolume(cavityRest, m.cavity.triangles) < 0.0)
+    m.cavity.triangles.row(1).swap(m.cavity.triangles.row(2));
 
   // landmarks
   int umbilicus = 0;
   for (int i = 1; i < nn; ++i)
-    if ((m.nodes.rest.col(i) - Vector3d(0, 0.09, 0.14)).norm() < (m.nodes.rest.col(umbilicus) - Vector3d(0, 0.09, 0.14)).norm())
+    if ((m.nodes.rest.col(i) - Vector3d(0, 0.09, 0.14)).norm() <
+        (m.nodes.rest.col(umbilicus) - Vector3d(0, 0.09, 0.14)).norm())
       umbilicus = i;
   m.landmarks.name = {"xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right"};
   m.landmarks.points.addBodyPoint(sternum, Vector3d(0, 0.085, 0.30) - sternumCom);
   m.landmarks.points.addNodePoint(Eigen::Vector3i(umbilicus, -1, -1), Vector3d(1, 0, 0));
   m.landmarks.points.addNodePoint(Eigen::Vector3i(apex, -1, -1), Vector3d(1, 0, 0));
   for (int side : {-1, 1})
-    m.landmarks.points.addBodyPoint(rib[{0, side}], ribPoint(0, side, 0.5 * kPi) - m.bodies.com.col(rib[{0, side}]));
+    m.landmarks.points.addBodyPoint(rib[{0, side}],
+                                    ribPoint(0, side, 0.5 * kPi) - m.bodies.com.col(rib[{0, side}]));
   return m;
 }
 
@@ -309,23 +329,28 @@ inline State randomVelocityState(const Model& m, double nodeSpeed, double spin, 
   for (int i = 0; i < m.nodes.size(); ++i)
     if (!m.nodes.isFixed(i)) s.nodeVelocity.col(i) = nodeSpeed * Eigen::Vector3d(n(rng), n(rng), n(rng));
   for (int b = 0; b < m.bodies.size(); ++b)
-    if (!m.bodies.isFixed[static_cast<std::size_t>(b)]) s.bodyAngularVelocity.col(b) = spin * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    if (!m.bodies.isFixed[static_cast<std::size_t>(b)])
+      s.bodyAngularVelocity.col(b) = spin * Eigen::Vector3d(n(rng), n(rng), n(rng));
   return s;
 }
 
 /// Sets the linear velocity of every jointed body to what its parent's motion and its own spin imply, so that
-/// the joint anchors move together: v_c = v_p + w_p x (a - x_p) - w_c x (a - x_c), a the anchor, parents first.
+/// the joint anchors move together: v_c = v_p + w_p x (a - x_p) - w_c x (a - x_c), a the anchor, parents
+/// first.
 inline void jointConsistentVelocities(const Model& m, State& s) {
   std::vector<char> done(static_cast<std::size_t>(m.bodies.size()), 0);
   for (int b = 0; b < m.bodies.size(); ++b)
-    done[static_cast<std::size_t>(b)] = std::find(m.joints.child.begin(), m.joints.child.end(), b) == m.joints.child.end();
+    done[static_cast<std::size_t>(b)] =
+        std::find(m.joints.child.begin(), m.joints.child.end(), b) == m.joints.child.end();
   for (int pass = 0; pass < m.joints.size(); ++pass) {
     for (int j = 0; j < m.joints.size(); ++j) {
-      const int p = m.joints.parent[static_cast<std::size_t>(j)], c = m.joints.child[static_cast<std::size_t>(j)];
+      const int p = m.joints.parent[static_cast<std::size_t>(j)],
+                c = m.joints.child[static_cast<std::size_t>(j)];
       if (!done[static_cast<std::size_t>(p)] || done[static_cast<std::size_t>(c)]) continue;
       const Eigen::Vector3d a = s.bodyPosition.col(p) + s.bodyOrientation[static_cast<std::size_t>(p)] *
                                                             (m.joints.anchor.col(j) - m.bodies.com.col(p));
-      s.bodyVelocity.col(c) = s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(a - s.bodyPosition.col(p)) -
+      s.bodyVelocity.col(c) = s.bodyVelocity.col(p) +
+                              s.bodyAngularVelocity.col(p).cross(a - s.bodyPosition.col(p)) -
                               s.bodyAngularVelocity.col(c).cross(a - s.bodyPosition.col(c));
       done[static_cast<std::size_t>(c)] = 1;
     }
@@ -361,7 +386,9 @@ class RelaxedRun {
 
 /// [s] time step of the integrator tests on the toy models: its bodies are heavier than the default model's
 /// ribs, so the explicit scheme runs at 0.25 ms here (the default model needs defaultTimeStep(): 10 us).
-inline double toyTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : defaultTimeStep(k); }
+inline double toyTimeStep(IntegratorKind k) {
+  return k == IntegratorKind::SymplecticEuler ? 2.5e-4 : defaultTimeStep(k);
+}
 
 /// A name usable as a gtest parameter name: "implicit-euler-joints" -> "implicit_euler_joints".
 inline std::string gtestName(std::string name) {

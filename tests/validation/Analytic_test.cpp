@@ -2,18 +2,16 @@
 // Sections 5, 6): a spring-mass period, a pendulum on a ball joint, a pressurised closed spring sphere, and
 // the stopping distance of a node under the visceral drag (Gut::drag).
 // Every check runs with both integrators at their default time step.
-#include "ToyTorso.h"
-
-#include "pneuma/sim/Elements.h"
-#include "pneuma/sim/Step.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <functional>
 #include <vector>
+
+#include "ToyTorso.h"
+#include "pneuma/sim/Elements.h"
+#include "pneuma/sim/Step.h"
 
 namespace pneuma::sim {
 namespace {
@@ -53,7 +51,8 @@ TEST_P(Integrators, SpringMassPeriodWithinOnePercent) {
   o.gravity = false;
   State s = makeInitialState(m);
   s.nodePosition(0, 1) += 0.01;
-  const double period = measurePeriod(m, s, o, 4.0, [](const State& st) { return st.nodePosition(0, 1) - 0.1; });
+  const double period =
+      measurePeriod(m, s, o, 4.0, [](const State& st) { return st.nodePosition(0, 1) - 0.1; });
   const double expected = 2.0 * kPi * std::sqrt(0.2 / 20.0);
   EXPECT_NEAR(period, expected, 0.01 * expected);
 }
@@ -105,7 +104,8 @@ TEST_P(Integrators, PressurisedSpringSphereReachesEquilibriumRadius) {
   double lo = restScale, hi = 1.0;
   for (int i = 0; i < 100; ++i) {
     const double l = 0.5 * (lo + hi);
-    const double residual = k * (l - restScale) * sumL2 - m.gut.kappa * (1.0 / (l * l * l) - 1.0) * 3.0 * vMesh * l * l;
+    const double residual =
+        k * (l - restScale) * sumL2 - m.gut.kappa * (1.0 / (l * l * l) - 1.0) * 3.0 * vMesh * l * l;
     (residual > 0.0 ? hi : lo) = l;
   }
   const double expected = 0.5 * (lo + hi) * r0;
@@ -150,7 +150,8 @@ TEST_P(Integrators, VisceralDragStopsAFreeNodeAfterItsAnalyticDistance) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, Integrators,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEulerJoints),
+                         ::testing::Values(IntegratorKind::SymplecticEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
                          [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 }  // namespace

@@ -1,12 +1,10 @@
 // Energy without actuation and gravity (STYLE "Tests": invariants): with relaxed muscles, no gravity
 // and random initial velocities, total energy (kinetic + elastic: springs, gut pressure, joint springs)
 // never increases, for both integrators, and the damped system comes to rest.
-#include "ToyTorso.h"
-
-#include "pneuma/sim/Step.h"
-
 #include <gtest/gtest.h>
 
+#include "ToyTorso.h"
+#include "pneuma/sim/Step.h"
 
 namespace pneuma::sim {
 namespace {
@@ -37,7 +35,8 @@ TEST_P(EnergyDecay, NeverIncreasesAndComesToRest) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, EnergyDecay,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEulerJoints),
+                         ::testing::Values(IntegratorKind::SymplecticEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
                          [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
 }  // namespace

@@ -1,31 +1,30 @@
 // The integrators on the default model (sim/Step.h): every one is stable at its default time step (issue 4);
-// implicit-euler-joints, backward Euler in the coordinates of the joint tree, (a) only dissipates under strong
-// rib-joint friction (Eq. 3, Zordan et al. 2004 Sec. 5), where a split solve (joints imposed after the linear
-// solve) gained energy, (b) breathes the same at dt 10 ms and 5 ms, and (c) keeps the gut volume through the
-// forced exhale at dt 20 ms.
-#include "DefaultModel.h"
-#include "ToyTorso.h"
-
-#include "pneuma/sim/Experiments.h"
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Simulation.h"
-#include "pneuma/sim/Step.h"
-
+// implicit-euler-joints, backward Euler in the coordinates of the joint tree, (a) only dissipates under
+// strong rib-joint friction (Eq. 3, Zordan et al. 2004 Sec. 5), where a split solve (joints imposed after the
+// linear solve) gained energy, (b) breathes the same at dt 10 ms and 5 ms, and (c) keeps the gut volume
+// through the forced exhale at dt 20 ms.
 #include <gtest/gtest.h>
 
+#include "DefaultModel.h"
+#include "ToyTorso.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Experiments.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/Step.h"
 
 namespace pneuma::sim {
 namespace {
 
 class DefaultStep : public ::testing::TestWithParam<IntegratorKind> {};
 
-// deep breathing (the largest motion) from the rest pose at the integrator's default dt: no blow-up (Simulation
-// checks every step for NaN, speed and joint error) and the joints hold within 0.1 mm
+// deep breathing (the largest motion) from the rest pose at the integrator's default dt: no blow-up
+// (Simulation checks every step for NaN, speed and joint error) and the joints hold within 0.1 mm
 TEST_P(DefaultStep, IsStableOnTheDefaultModel) {
   REQUIRE_DEFAULT_MODEL();
-  // known defect (issue 13): with the lung-volume check the explicit scheme's deep breath from the rest pose turns
-  // the cavity inside out within 0.3 s (-0.7 L with neither the lungs' recoil nor the zone of apposition, -0.04 L
-  // with both), while the joints hold; until that is found the explicit case is reported, not passed
+  // known defect (issue 13): with the lung-volume check the explicit scheme's deep breath from the rest pose
+  // turns the cavity inside out within 0.3 s (-0.7 L with neither the lungs' recoil nor the zone of
+  // apposition, -0.04 L with both), while the joints hold; until that is found the explicit case is reported,
+  // not passed
   if (GetParam() == IntegratorKind::SymplecticEuler)
     GTEST_SKIP() << "symplectic-euler on the default model: the lung cavity inverts within 0.3 s (issue 13)";
   SimulationOptions o;
@@ -44,13 +43,14 @@ TEST_P(DefaultStep, IsStableOnTheDefaultModel) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, DefaultStep,
-                         ::testing::Values(IntegratorKind::SymplecticEuler, IntegratorKind::ImplicitEulerJoints),
+                         ::testing::Values(IntegratorKind::SymplecticEuler,
+                                           IntegratorKind::ImplicitEulerJoints),
                          [](const auto& info) { return test::gtestName(integratorName(info.param)); });
 
-// relaxed, no gravity, random spins of every moving body about the relaxed equilibrium, with the linear velocities
-// the joints imply: total energy must not grow (Eq. 3 is dissipative). Not from the rest pose: there the lungs'
-// recoil P0 is a sudden load, whose first linearly implicit step lands muscles that were slack in the
-// linearisation taut
+// relaxed, no gravity, random spins of every moving body about the relaxed equilibrium, with the linear
+// velocities the joints imply: total energy must not grow (Eq. 3 is dissipative). Not from the rest pose:
+// there the lungs' recoil P0 is a sudden load, whose first linearly implicit step lands muscles that were
+// slack in the linearisation taut
 class StrongRibFriction : public ::testing::TestWithParam<bool> {};
 
 TEST_P(StrongRibFriction, OnlyDissipates) {

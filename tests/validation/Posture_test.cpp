@@ -1,13 +1,12 @@
-// Posture (StepOptions::posture) on the default model: calm breathing upright and lying on the back, against the
-// direction the physiology gives. The checks live in sim/Experiments.h (postureChecks()), beside the papers'.
-// Skips when the default model has not been built.
-#include "DefaultModel.h"
-
-#include "pneuma/sim/Experiments.h"
-
+// Posture (StepOptions::posture) on the default model: calm breathing upright and lying on the back, against
+// the direction the physiology gives. The checks live in sim/Experiments.h (postureChecks()), beside the
+// papers'. Skips when the default model has not been built.
 #include <gtest/gtest.h>
 
 #include <map>
+
+#include "DefaultModel.h"
+#include "pneuma/sim/Experiments.h"
 
 namespace pneuma::sim {
 namespace {
@@ -35,8 +34,8 @@ Check postureCheck(const std::string& id) {
 }
 
 void expectPassed(const Check& c) {
-  EXPECT_TRUE(c.isPassed()) << c.id << ": " << c.what << " = " << c.measured << " " << c.unit << ", target " << c.target
-                            << " (" << c.source << ")";
+  EXPECT_TRUE(c.isPassed()) << c.id << ": " << c.what << " = " << c.measured << " " << c.unit << ", target "
+                            << c.target << " (" << c.source << ")";
 }
 
 // lying on the back the weight of the viscera no longer pulls the dome caudally: it rests higher and the
@@ -46,23 +45,24 @@ TEST(Posture, SupineEndExpiratoryVolumeBelowUpright) {
   expectPassed(postureCheck("posture.end_expiratory_volume"));
   const int apex = defaultModel()->landmarks.find("diaphragm_apex");
   ASSERT_GE(apex, 0);
-  const auto restingApex = [&](const StyleRun& r) {  // [m] height of the central tendon when the settling ends
-    std::size_t k = 0;
-    while (k + 1 < r.trace.size() && r.trace.time[k + 1] <= r.settleTime) ++k;
-    return r.trace.landmarks[k](2, apex);
-  };
+  const auto restingApex =
+      [&](const StyleRun& r) {  // [m] height of the central tendon when the settling ends
+        std::size_t k = 0;
+        while (k + 1 < r.trace.size() && r.trace.time[k + 1] <= r.settleTime) ++k;
+        return r.trace.landmarks[k](2, apex);
+      };
   EXPECT_GT(restingApex(calm(Posture::Supine)), restingApex(calm(Posture::Upright)));
 }
 
-// lying down, the viscera shift and the dome rises while the relaxed torso settles: the lung volume has stopped
-// moving when the controller starts (the drift in the last 0.5 s is 7 mL after the default 2 s)
+// lying down, the viscera shift and the dome rises while the relaxed torso settles: the lung volume has
+// stopped moving when the controller starts (the drift in the last 0.5 s is 7 mL after the default 2 s)
 TEST(Posture, SettlingConvergesLyingDown) {
   REQUIRE_DEFAULT_MODEL();
   expectPassed(postureCheck("posture.settled_supine"));
 }
 
-// people breathe more with the abdomen supine and more with the rib cage upright (Sharp et al. 1975; Konno & Mead
-// 1967): the rib cage's share of the calm tidal volume is smaller supine
+// people breathe more with the abdomen supine and more with the rib cage upright (Sharp et al. 1975; Konno &
+// Mead 1967): the rib cage's share of the calm tidal volume is smaller supine
 TEST(Posture, SupineRibCageShareBelowUpright) {
   REQUIRE_DEFAULT_MODEL();
   expectPassed(postureCheck("posture.rib_cage_share"));

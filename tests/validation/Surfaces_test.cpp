@@ -1,16 +1,10 @@
 // No surface passes through another (issue 13): the lung cavity, the two lungs and the gut, posed at
 // end-expiration and end-inspiration (the frames of smallest and largest lung volume after settling) of every
-// shipped breath style (resources/presets/*.json) and every affect preset (resources/presets/affect/), checked
-// with the triangle-triangle crossing test of SurfaceCrossings.h: each surface against itself, and the pairs
-// that must not cross (each lung with the gut, with the cavity and with the other lung). Short runs: two
-// seconds of settling and one breath or a few seconds of each style. Skips when the default model is absent.
-#include "DefaultModel.h"
-#include "SurfaceCrossings.h"
-
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Simulation.h"
-#include "pneuma/sim/pattern/PatternController.h"
-
+// shipped breath style (resources/presets/*.json) and every affect preset (resources/presets/affect/),
+// checked with the triangle-triangle crossing test of SurfaceCrossings.h: each surface against itself, and
+// the pairs that must not cross (each lung with the gut, with the cavity and with the other lung). Short
+// runs: two seconds of settling and one breath or a few seconds of each style. Skips when the default model
+// is absent.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,6 +12,12 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+
+#include "DefaultModel.h"
+#include "SurfaceCrossings.h"
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/pattern/PatternController.h"
 
 namespace pneuma::sim {
 namespace {
@@ -44,8 +44,8 @@ std::map<std::string, int> crossings(const Model& m, const State& s) {
   using pneuma::test::countCrossings;
   using pneuma::test::countSelfCrossings;
   const Posed p = pose(m, s);
-  const Eigen::Matrix3Xi &tc = m.cavity.triangles, &tr = m.lungs.right.triangles, &tl = m.lungs.left.triangles,
-                         &tg = m.gut.triangles;
+  const Eigen::Matrix3Xi &tc = m.cavity.triangles, &tr = m.lungs.right.triangles,
+                         &tl = m.lungs.left.triangles, &tg = m.gut.triangles;
   return {{"cavity", countSelfCrossings(p.cavity, tc)},
           {"gut", countSelfCrossings(p.gut, tg)},
           {"right", countSelfCrossings(p.right, tr)},
@@ -63,8 +63,9 @@ std::string describe(const std::map<std::string, int>& c) {
   return s.str();
 }
 
-// the lung's self-crossings that involve a face on the mediastinum (a vertex embedded between the cavity points
-// above and below it, 6 cavity slots): the embedding's own, as opposed to those it inherits from the cavity's walls
+// the lung's self-crossings that involve a face on the mediastinum (a vertex embedded between the cavity
+// points above and below it, 6 cavity slots): the embedding's own, as opposed to those it inherits from the
+// cavity's walls
 int medialCrossings(const LungSurface& l, const Eigen::Matrix3Xd& x) {
   std::vector<std::pair<int, int>> pairs;
   pneuma::test::countSelfCrossings(x, l.triangles, pneuma::test::kCrossingTolerance, &pairs);
@@ -78,17 +79,17 @@ int medialCrossings(const LungSurface& l, const Eigen::Matrix3Xd& x) {
   return n;
 }
 
-// The cavity's walls cross at the costal margin once the model has settled (issue 13): the diaphragm's dome, bound to
-// the gut, moves outward through the rib-bound wall at ribs 7-8 on both sides (z about 230 mm), its nodes up to 25-80
-// mm beyond the wall's plane, and the gut crosses itself in 0-17 places. The lungs inherit it: their costal and
-// diaphragmatic faces lie on those walls (every lung self-crossing there is between two wall faces). It is the
-// mechanics' (nothing keeps the gut inside the rib cage), not the meshing's. Until it is fixed, those pairs are
-// reported and the test is skipped naming them; set this to true to enforce them.
+// The cavity's walls cross at the costal margin once the model has settled (issue 13): the diaphragm's dome,
+// bound to the gut, moves outward through the rib-bound wall at ribs 7-8 on both sides (z about 230 mm), its
+// nodes up to 25-80 mm beyond the wall's plane, and the gut crosses itself in 0-17 places. The lungs inherit
+// it: their costal and diaphragmatic faces lie on those walls (every lung self-crossing there is between two
+// wall faces). It is the mechanics' (nothing keeps the gut inside the rib cage), not the meshing's. Until it
+// is fixed, those pairs are reported and the test is skipped naming them; set this to true to enforce them.
 constexpr bool kEnforceWallCrossings = false;
 
-// runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after settling:
-// the two lungs never cross each other nor does a mediastinal face cross anything; the other crossings are added
-// to `wall` (see kEnforceWallCrossings)
+// runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
+// settling: the two lungs never cross each other nor does a mediastinal face cross anything; the other
+// crossings are added to `wall` (see kEnforceWallCrossings)
 void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> controller, double duration,
                        std::ostringstream& wall) {
   const auto model = defaultModel();
@@ -107,23 +108,28 @@ void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> cont
     return true;
   });
   ASSERT_GT(vMax, vMin) << name;
-  for (const auto& [phase, state] : {std::pair<const char*, const State*>{"end-expiration", &lo}, {"end-inspiration", &hi}}) {
+  for (const auto& [phase, state] :
+       {std::pair<const char*, const State*>{"end-expiration", &lo}, {"end-inspiration", &hi}}) {
     const std::map<std::string, int> c = crossings(*model, *state);
     const Posed p = pose(*model, *state);
-    const int medial = medialCrossings(model->lungs.right, p.right) + medialCrossings(model->lungs.left, p.left);
+    const int medial =
+        medialCrossings(model->lungs.right, p.right) + medialCrossings(model->lungs.left, p.left);
     EXPECT_EQ(c.at("right-left"), 0) << name << " at " << phase;
     EXPECT_EQ(medial, 0) << name << " at " << phase << ": mediastinal faces cross";
     int total = 0;
     for (const auto& [pair, n] : c) total += n;
     testing::Test::RecordProperty(name + "." + phase, describe(c));
-    if (kEnforceWallCrossings) EXPECT_EQ(total, 0) << name << " at " << phase << ": " << describe(c);
+    if (kEnforceWallCrossings) {
+      EXPECT_EQ(total, 0) << name << " at " << phase << ": " << describe(c);
+    }
     if (total > 0) wall << "\n  " << name << " at " << phase << ": " << describe(c);
   }
 }
 
 // the known crossings at the costal margin, reported as a skip until kEnforceWallCrossings
 void reportWallCrossings(const std::ostringstream& wall) {
-  if (!wall.str().empty()) GTEST_SKIP() << "surfaces cross at the costal margin (kEnforceWallCrossings):" << wall.str();
+  if (!wall.str().empty())
+    GTEST_SKIP() << "surfaces cross at the costal margin (kEnforceWallCrossings):" << wall.str();
 }
 
 TEST(Surfaces, DefaultModelAtRestHasNoCrossings) {
@@ -156,8 +162,8 @@ TEST(Surfaces, NoCrossingsInAnyAffect) {
   ASSERT_GE(names.size(), 10u);
   std::ostringstream wall;
   for (const std::string& name : names)
-    expectNoCrossings("affect " + name, pattern::makeAffectController(name, PNEUMA_RESOURCE_DIR, 1, calibration), 4.0,
-                      wall);
+    expectNoCrossings("affect " + name,
+                      pattern::makeAffectController(name, PNEUMA_RESOURCE_DIR, 1, calibration), 4.0, wall);
   reportWallCrossings(wall);
 }
 

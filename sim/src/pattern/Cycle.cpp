@@ -1,12 +1,12 @@
 #include "pneuma/sim/pattern/Cycle.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/Limits.h"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/Limits.h"
 
 namespace pneuma::sim::pattern {
 
@@ -36,9 +36,12 @@ double monotoneSlope(double d0, double h0, double d1, double h1) {
 
 const char* cycleKindName(CycleKind k) {
   switch (k) {
-    case CycleKind::Linear: return "linear";
-    case CycleKind::Keyframe: return "keyframe";
-    case CycleKind::Spline: return "spline";
+    case CycleKind::Linear:
+      return "linear";
+    case CycleKind::Keyframe:
+      return "keyframe";
+    case CycleKind::Spline:
+      return "spline";
   }
   return "linear";
 }
@@ -68,7 +71,8 @@ void validateCycle(const CycleSpec& c) {
     const std::string f = "keyframes[" + std::to_string(i) + "]";
     if (!std::isfinite(k[i].time)) fail(f + ".time", "must be finite");
     requireRange(f + ".volume", k[i].volume, 0.0, 1.0);
-    if (i == 0 && k[i].time != 0.0) fail(f + ".time", "the first keyframe must be at time 0, got " + num(k[i].time));
+    if (i == 0 && k[i].time != 0.0)
+      fail(f + ".time", "the first keyframe must be at time 0, got " + num(k[i].time));
     if (i > 0 && !(k[i].time > k[i - 1].time))
       fail(f + ".time", num(k[i].time) + " is not after keyframes[" + std::to_string(i - 1) + "].time " +
                             num(k[i - 1].time) + " (keyframes out of order)");
@@ -76,7 +80,8 @@ void validateCycle(const CycleSpec& c) {
   if (!k.empty()) {
     const std::string last = "keyframes[" + std::to_string(k.size() - 1) + "]";
     if (c.isRelative && k.back().time != 1.0)
-      fail(last + ".time", "the last keyframe of a relative cycle must be at time 1, got " + num(k.back().time));
+      fail(last + ".time",
+           "the last keyframe of a relative cycle must be at time 1, got " + num(k.back().time));
     if (k.back().volume != k.front().volume)
       fail(last + ".volume", "must equal keyframes[0].volume " + num(k.front().volume) +
                                  " so that the cycle repeats continuously, got " + num(k.back().volume));

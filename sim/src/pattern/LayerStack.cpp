@@ -10,16 +10,19 @@ namespace pneuma::sim::pattern {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kMaxBlend = 0.4;            // [s] longest cross-fade
-constexpr double kSameVolume = 1e-9;         // [-] start volumes closer than this need no cross-fade
+constexpr double kMaxBlend = 0.4;     // [s] longest cross-fade
+constexpr double kSameVolume = 1e-9;  // [-] start volumes closer than this need no cross-fade
 }  // namespace
 
 const char* switchModeName(SwitchMode m) { return m == SwitchMode::Immediate ? "immediate" : "end_of_cycle"; }
 
 bool switchModeFromName(const std::string& name, SwitchMode& out) {
-  if (name == "immediate") out = SwitchMode::Immediate;
-  else if (name == "end_of_cycle") out = SwitchMode::EndOfCycle;
-  else return false;
+  if (name == "immediate")
+    out = SwitchMode::Immediate;
+  else if (name == "end_of_cycle")
+    out = SwitchMode::EndOfCycle;
+  else
+    return false;
   return true;
 }
 
@@ -66,7 +69,8 @@ double LayerStack::sample(double t) {
       continue;
     }
     const double dueTime = m_scheduled.empty() ? kInf : std::max(m_scheduled.front().time, now);
-    const double endTime = m_layers.empty() ? kInf : m_breathStart + m_layers.back().cycle.duration(m_variation);
+    const double endTime =
+        m_layers.empty() ? kInf : m_breathStart + m_layers.back().cycle.duration(m_variation);
     if (dueTime <= t && dueTime <= endTime) {
       Pending p = std::move(m_scheduled.front());
       m_scheduled.erase(m_scheduled.begin());
@@ -153,7 +157,9 @@ void LayerStack::setStartVolume(double v) {
 
 double LayerStack::balance() const { return m_layers.empty() ? 0.5 : m_layers.back().cycle.spec().balance; }
 
-std::string LayerStack::currentLayerName() const { return m_layers.empty() ? std::string() : m_layers.back().name; }
+std::string LayerStack::currentLayerName() const {
+  return m_layers.empty() ? std::string() : m_layers.back().name;
+}
 
 namespace {
 

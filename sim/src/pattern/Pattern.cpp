@@ -1,14 +1,14 @@
 #include "pneuma/sim/pattern/Pattern.h"
 
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/JsonReader.h"
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/JsonReader.h"
 
 namespace pneuma::sim::pattern {
 
@@ -27,16 +27,19 @@ CycleKind parseKind(const Node& n) {
 
 CycleSpec parseCycle(const Node& n) {
   n.allowKeys({"kind", "time", "rate_bpm", "depth", "ie_ratio", "post_inspiratory_pause_s",
-                 "post_expiratory_pause_s", "irregularity", "balance", "keyframes"});
+               "post_expiratory_pause_s", "irregularity", "balance", "keyframes"});
   CycleSpec c;
   c.kind = parseKind(n.at("kind"));
 
   // time base: relative cycles need a rate, absolute ones take it from the keyframes
   const std::string time = n.stringOr("time", "relative");
-  if (time != "relative" && time != "absolute") n.at("time").fail("must be 'relative' or 'absolute', got '" + sim::excerptOf(time) + "'");
+  if (time != "relative" && time != "absolute")
+    n.at("time").fail("must be 'relative' or 'absolute', got '" + sim::excerptOf(time) + "'");
   c.isRelative = time == "relative";
-  if (c.isRelative) c.rate = n.at("rate_bpm").number();
-  else if (n.has("rate_bpm")) n.at("rate_bpm").fail("not allowed with absolute time (the keyframes set the rate)");
+  if (c.isRelative)
+    c.rate = n.at("rate_bpm").number();
+  else if (n.has("rate_bpm"))
+    n.at("rate_bpm").fail("not allowed with absolute time (the keyframes set the rate)");
 
   // depth [min, max]
   const Node depth = n.at("depth");
@@ -45,7 +48,8 @@ CycleSpec parseCycle(const Node& n) {
   c.depthMax = depth[1].number();
 
   // timing extras
-  if (n.has("ie_ratio") && n.has("keyframes")) n.at("ie_ratio").fail("not allowed with keyframes (they set the shape)");
+  if (n.has("ie_ratio") && n.has("keyframes"))
+    n.at("ie_ratio").fail("not allowed with keyframes (they set the shape)");
   c.ieRatio = n.numberOr("ie_ratio", c.ieRatio);
   c.postInspiratoryPause = n.numberOr("post_inspiratory_pause_s", 0.0);
   c.postExpiratoryPause = n.numberOr("post_expiratory_pause_s", 0.0);
@@ -106,7 +110,8 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
 Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, int nesting);
 
 // a layer source: inline "layers" or a reference "affect": NAME (exactly one of them)
-std::vector<Layer> parseLayerSource(const Node& n, const std::string& resourceDir, int nesting, std::string* label) {
+std::vector<Layer> parseLayerSource(const Node& n, const std::string& resourceDir, int nesting,
+                                    std::string* label) {
   if (n.has("layers") == n.has("affect")) n.fail("needs exactly one of \"layers\" or \"affect\"");
   if (n.has("affect")) {
     const Node a = n.at("affect");
@@ -156,10 +161,12 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
       ev.time = time.number();
       if (ev.time < 0.0) time.fail("must be >= 0");
       if (!p.timeline.empty() && ev.time < p.timeline.back().time)
-        time.fail("events must be in time order (previous at " + std::to_string(p.timeline.back().time) + " s)");
+        time.fail("events must be in time order (previous at " + std::to_string(p.timeline.back().time) +
+                  " s)");
       const std::string mode = e.stringOr("switch", "immediate");
       if (!switchModeFromName(mode, ev.mode))
-        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + sim::excerptOf(mode) + "\"");
+        e.at("switch").fail("must be \"immediate\" or \"end_of_cycle\", got \"" + sim::excerptOf(mode) +
+                            "\"");
       ev.layers = parseLayerSource(e, resourceDir, nesting, &ev.label);
       ev.label = e.stringOr("label", ev.label);
       p.timeline.push_back(std::move(ev));
@@ -173,8 +180,8 @@ Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, in
   if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
     std::string list;
     for (const std::string& v : valid) list += (list.empty() ? "" : ", ") + v;
-    throw Error("unknown affect '" + sim::excerptOf(name) + "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) +
-                ")");
+    throw Error("unknown affect '" + sim::excerptOf(name) +
+                "' (valid: " + (list.empty() ? "none found in " + resourceDir : list) + ")");
   }
   const std::string path = affectPath(resourceDir, name);
   return parseAt(readText(path), std::filesystem::path(path).filename().string(), resourceDir, nesting);
@@ -182,7 +189,8 @@ Pattern loadAffectAt(const std::string& name, const std::string& resourceDir, in
 
 }  // namespace
 
-Pattern parsePattern(const std::string& jsonText, const std::string& sourceName, const std::string& resourceDir) {
+Pattern parsePattern(const std::string& jsonText, const std::string& sourceName,
+                     const std::string& resourceDir) {
   return parseAt(jsonText, sourceName, resourceDir, 0);
 }
 

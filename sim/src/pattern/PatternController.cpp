@@ -13,9 +13,9 @@ namespace {
 
 std::size_t idx(ElementGroup g) { return static_cast<std::size_t>(g); }
 
-constexpr ElementGroup kDrivenGroups[] = {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal,
-                                          ElementGroup::Diaphragm, ElementGroup::Rectus,
-                                          ElementGroup::TransversusObliques};
+constexpr ElementGroup kDrivenGroups[] = {ElementGroup::IntercostalExternal,
+                                          ElementGroup::IntercostalInternal, ElementGroup::Diaphragm,
+                                          ElementGroup::Rectus, ElementGroup::TransversusObliques};
 
 // the useful part of a response curve in direction `sign` (+1 raises, -1 lowers the volume), made
 // monotone: reach[k] = max over j <= k of max(sign R[j], 0); reach.back() is the group's capacity
@@ -26,15 +26,16 @@ GroupResponse reach(const GroupResponse& response, double sign) {
 }
 
 // the activation whose reach is `demand` (linear between levels; 0 for no demand; beyond the capacity the
-// lowest level that reaches it: a group whose answer falls again at high activation is not driven past its peak)
+// lowest level that reaches it: a group whose answer falls again at high activation is not driven past its
+// peak)
 double invert(const GroupResponse& reach, double demand) {
   if (demand <= 0.0) return 0.0;
   std::size_t peak = 0;
   for (std::size_t k = 1; k < reach.size(); ++k) {
     if (reach[k] <= reach[k - 1]) continue;
     if (reach[k] >= demand)
-      return kCalibrationAlphas[k - 1] +
-             (demand - reach[k - 1]) / (reach[k] - reach[k - 1]) * (kCalibrationAlphas[k] - kCalibrationAlphas[k - 1]);
+      return kCalibrationAlphas[k - 1] + (demand - reach[k - 1]) / (reach[k] - reach[k - 1]) *
+                                             (kCalibrationAlphas[k] - kCalibrationAlphas[k - 1]);
     peak = k;
   }
   return kCalibrationAlphas[peak];
@@ -50,7 +51,9 @@ struct Lever {
 struct Channel {
   Lever in, out;
   // [-] the capacity in the direction of a signed demand (0 for none)
-  double capacity(double demand) const { return demand > 0.0 ? in.capacity() : demand < 0.0 ? out.capacity() : 0.0; }
+  double capacity(double demand) const {
+    return demand > 0.0 ? in.capacity() : demand < 0.0 ? out.capacity() : 0.0;
+  }
 };
 // the drive's two channels: chest (external / internal intercostals) and belly (diaphragm / abdominal
 // wall: rectus and transversus/obliques at one activation, their useful reaches added)
@@ -58,14 +61,19 @@ struct Levers {
   Channel chest, belly;
 };
 Levers levers(const DriveCalibration& c) {
-  auto lever = [&c](ElementGroup g, double sign) { return Lever{reach(c.response[idx(g)], sign), c.timeConstant[idx(g)]}; };
+  auto lever = [&c](ElementGroup g, double sign) {
+    return Lever{reach(c.response[idx(g)], sign), c.timeConstant[idx(g)]};
+  };
   Levers l;
   l.chest = {lever(ElementGroup::IntercostalExternal, 1.0), lever(ElementGroup::IntercostalInternal, -1.0)};
   l.belly.in = lever(ElementGroup::Diaphragm, 1.0);
-  const Lever rectus = lever(ElementGroup::Rectus, -1.0), obliques = lever(ElementGroup::TransversusObliques, -1.0);
-  for (std::size_t k = 0; k < l.belly.out.reach.size(); ++k) l.belly.out.reach[k] = rectus.reach[k] + obliques.reach[k];
+  const Lever rectus = lever(ElementGroup::Rectus, -1.0),
+              obliques = lever(ElementGroup::TransversusObliques, -1.0);
+  for (std::size_t k = 0; k < l.belly.out.reach.size(); ++k)
+    l.belly.out.reach[k] = rectus.reach[k] + obliques.reach[k];
   const double wall = rectus.capacity() + obliques.capacity();
-  l.belly.out.tau = wall > 0.0 ? (rectus.capacity() * rectus.tau + obliques.capacity() * obliques.tau) / wall : 0.0;
+  l.belly.out.tau =
+      wall > 0.0 ? (rectus.capacity() * rectus.tau + obliques.capacity() * obliques.tau) / wall : 0.0;
   return l;
 }
 
@@ -82,7 +90,8 @@ double channelDemand(double demand, double rate, const Channel& ch) {
 double chestShare(double balance, double chestWhole, double bellyWhole, const Levers& l) {
   if (chestWhole * bellyWhole < 0.0) return balance;  // opposite directions: each is clipped on its own
   double b = balance;
-  if (std::abs(b * chestWhole) > l.chest.capacity(chestWhole)) b = l.chest.capacity(chestWhole) / std::abs(chestWhole);
+  if (std::abs(b * chestWhole) > l.chest.capacity(chestWhole))
+    b = l.chest.capacity(chestWhole) / std::abs(chestWhole);
   if (std::abs((1.0 - b) * bellyWhole) > l.belly.capacity(bellyWhole))
     b = std::max(b, 1.0 - l.belly.capacity(bellyWhole) / std::abs(bellyWhole));
   return b;
@@ -90,8 +99,8 @@ double chestShare(double balance, double chestWhole, double bellyWhole, const Le
 
 // calibration run of one group: it rests for kRest, then steps through the non-zero levels of
 // kCalibrationAlphas, kLevel at each (r fixed), while every other group stays relaxed; control time t
-constexpr double kRest = 0.6;   // [s]
-constexpr double kLevel = 0.8;  // [s]
+constexpr double kRest = 0.6;                                                    // [s]
+constexpr double kLevel = 0.8;                                                   // [s]
 constexpr double kGroupTime = kRest + kLevel * (kCalibrationAlphas.size() - 1);  // [s] per group
 class StaircaseController : public Controller {
  public:
@@ -99,7 +108,8 @@ class StaircaseController : public Controller {
   Activations activations(double t, const Metrics&) override {
     Activations a = relaxedActivations();
     if (t >= kRest) {
-      const auto level = std::min(1 + static_cast<std::size_t>((t - kRest) / kLevel), kCalibrationAlphas.size() - 1);
+      const auto level =
+          std::min(1 + static_cast<std::size_t>((t - kRest) / kLevel), kCalibrationAlphas.size() - 1);
       a[idx(m_group)] = {m_r, kCalibrationAlphas[level]};
     }
     return a;
@@ -119,7 +129,9 @@ double meanVolume(const Trace& trace, double from, double to) {
   int n = 0;
   for (std::size_t i = 0; i < trace.size(); ++i)
     if (trace.time[i] >= from && trace.time[i] < to) sum += trace.lungVolume[i], ++n;
-  if (n == 0) throw Error("calibrateDrive: no output frames in [" + std::to_string(from) + ", " + std::to_string(to) + ") s");
+  if (n == 0)
+    throw Error("calibrateDrive: no output frames in [" + std::to_string(from) + ", " + std::to_string(to) +
+                ") s");
   return sum / n;
 }
 
@@ -128,7 +140,8 @@ double meanVolume(const Trace& trace, double from, double to) {
 double settlingArea(const Trace& trace, double from, double to, double final) {
   double area = 0.0;
   for (std::size_t i = 1; i < trace.size(); ++i)
-    if (trace.time[i] > from && trace.time[i] <= to) area += (final - trace.lungVolume[i - 1]) * (trace.time[i] - trace.time[i - 1]);
+    if (trace.time[i] > from && trace.time[i] <= to)
+      area += (final - trace.lungVolume[i - 1]) * (trace.time[i] - trace.time[i - 1]);
   return area;
 }
 
@@ -206,11 +219,15 @@ PatternController::PatternController(LayerStack stack, DriveCalibration calibrat
   if (l.chest.in.capacity() + l.belly.in.capacity() <= 0.0)
     throw Error("calibration.response: neither intercostal_external nor diaphragm raises the lung volume");
   if (l.chest.out.capacity() + l.belly.out.capacity() <= 0.0)
-    throw Error("calibration.response: none of intercostal_internal, rectus, transversus_obliques lowers the lung volume");
+    throw Error(
+        "calibration.response: none of intercostal_internal, rectus, transversus_obliques lowers the lung "
+        "volume");
   if (!(c.volumePerFraction > 0.0)) throw Error("calibration.volumePerFraction: must be > 0");
   if (!(c.restVolume >= 0.0)) throw Error("calibration.restVolume: must be >= 0");
-  if (!(c.contractionR > 0.0 && c.contractionR <= 1.5)) throw Error("calibration.contractionR: must be in (0, 1.5]");
-  if (!(options.kp >= 0.0 && options.ki >= 0.0 && options.integralLimit >= 0.0 && options.balanceTimeConstant > 0.0))
+  if (!(c.contractionR > 0.0 && c.contractionR <= 1.5))
+    throw Error("calibration.contractionR: must be in (0, 1.5]");
+  if (!(options.kp >= 0.0 && options.ki >= 0.0 && options.integralLimit >= 0.0 &&
+        options.balanceTimeConstant > 0.0))
     throw Error("pattern controller options: gains and times must be >= 0 (balanceTimeConstant > 0)");
   m_balance = m_stack.balance();
 }
@@ -223,7 +240,9 @@ double PatternController::fractionToVolume(double fraction) const {
   return m_calibration.restVolume + (fraction - m_calibration.restFraction) * m_calibration.volumePerFraction;
 }
 
-void PatternController::push(const std::vector<Layer>& playOrder, SwitchMode mode) { m_stack.push(playOrder, mode); }
+void PatternController::push(const std::vector<Layer>& playOrder, SwitchMode mode) {
+  m_stack.push(playOrder, mode);
+}
 
 void PatternController::restart() {
   m_stack = m_initialStack;
@@ -303,7 +322,8 @@ Activations PatternController::distribute(double demand, double rate, double bal
   const Levers l = levers(m_calibration);
   // split the target by the balance, each channel with its own lag compensation; a saturated channel
   // hands part of its share to the other
-  const double chestWhole = channelDemand(demand, rate, l.chest), bellyWhole = channelDemand(demand, rate, l.belly);
+  const double chestWhole = channelDemand(demand, rate, l.chest),
+               bellyWhole = channelDemand(demand, rate, l.belly);
   const double b = chestShare(balance, chestWhole, bellyWhole, l);
   const double chest = b * chestWhole, belly = (1.0 - b) * bellyWhole;
   // chest: external intercostals raise, internal intercostals lower the volume
@@ -324,7 +344,9 @@ std::string PatternController::describe() const {
   return os.str();
 }
 
-std::unique_ptr<Controller> PatternController::clone() const { return std::make_unique<PatternController>(*this); }
+std::unique_ptr<Controller> PatternController::clone() const {
+  return std::make_unique<PatternController>(*this);
+}
 
 void PatternController::saveState(CheckpointWriter& out) const {
   out.write("pattern.description", m_description);
@@ -370,12 +392,13 @@ void PatternController::loadState(CheckpointReader& in) {
 
 std::unique_ptr<PatternController> makePatternController(const Pattern& pattern, std::uint64_t seed,
                                                          const DriveCalibration& calibration) {
-  return std::make_unique<PatternController>(makeLayerStack(pattern, seed), calibration, PatternControllerOptions{},
-                                             pattern.name);
+  return std::make_unique<PatternController>(makeLayerStack(pattern, seed), calibration,
+                                             PatternControllerOptions{}, pattern.name);
 }
 
-std::unique_ptr<PatternController> makeAffectController(const std::string& name, const std::string& resourceDir,
-                                                        std::uint64_t seed, const DriveCalibration& calibration) {
+std::unique_ptr<PatternController> makeAffectController(const std::string& name,
+                                                        const std::string& resourceDir, std::uint64_t seed,
+                                                        const DriveCalibration& calibration) {
   return makePatternController(loadAffect(name, resourceDir), seed, calibration);
 }
 

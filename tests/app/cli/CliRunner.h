@@ -1,11 +1,10 @@
 #pragma once
 /// @file CliRunner.h
-/// Runs build/bin/pneuma-cli (or the app) as a child process for the CLI and GUI tests: captured stdout/stderr and exit code,
-/// optionally interrupted with SIGINT after a delay.
-
-#include <gtest/gtest.h>
+/// Runs build/bin/pneuma-cli (or the app) as a child process for the CLI and GUI tests: captured
+/// stdout/stderr and exit code, optionally interrupted with SIGINT after a delay.
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -38,7 +37,8 @@ inline std::string slurp(const std::string& path) {
 inline CliResult runProgram(const std::string& program, const std::vector<std::string>& args,
                             double sigintAfterSeconds = 0.0, const std::vector<std::string>& env = {}) {
   static int counter = 0;
-  const std::string base = testing::TempDir() + "pneuma_cli_" + std::to_string(getpid()) + "_" + std::to_string(++counter);
+  const std::string base =
+      testing::TempDir() + "pneuma_cli_" + std::to_string(getpid()) + "_" + std::to_string(++counter);
   const std::string outPath = base + ".out", errPath = base + ".err";
   const std::string exe = std::string(PNEUMA_BIN_DIR) + "/" + program;
 

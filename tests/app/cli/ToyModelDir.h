@@ -1,15 +1,14 @@
 #pragma once
 // A model directory holding the sim tests' toy torso (tests/sim/ToyTorso.h), written once per test
 // binary, so the CLI tests run the whole pipeline in seconds without the meshing layer.
-#include "../../sim/ToyTorso.h"
-
-#include "pneuma/sim/ModelIO.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <string>
+
+#include "../../sim/ToyTorso.h"
+#include "pneuma/sim/ModelIO.h"
 
 namespace pneuma::test {
 

@@ -1,7 +1,7 @@
 // pneuma-cli conventions: --version, --help, exit code 2 with a one-line error for bad usage.
-#include "CliRunner.h"
-
 #include <string>
+
+#include "CliRunner.h"
 
 using pneuma::test::runCli;
 

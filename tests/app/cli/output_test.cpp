@@ -1,10 +1,6 @@
 // The output helpers behind simulate's files (issue 15): the atomic writer never leaves a partial file under
 // a final name, and MinMaxSeries thins a series to bounded size while keeping every extreme.
-#include "viz/AtomicFile.h"
-#include "viz/MinMaxSeries.h"
-
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "viz/AtomicFile.h"
+#include "viz/MinMaxSeries.h"
 
 namespace fs = std::filesystem;
 using pneuma::viz::AtomicFileWriter;

@@ -1,10 +1,8 @@
 // pneuma::viz::Plot: PNG and SVG from one layout (viz::layoutPlot, shared with the app's PlotView), without
 // OpenGL.
 #include "viz/Plot.h"
-#include "viz/PlotLayout.h"
 
 #include <gtest/gtest.h>
-
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
@@ -18,6 +16,8 @@
 #include <fstream>
 #include <string>
 #include <vector>
+
+#include "viz/PlotLayout.h"
 
 using pneuma::viz::AxisTicks;
 using pneuma::viz::Color;
@@ -71,8 +71,8 @@ TEST(Plot, PngDecodesWithRequestedSizeAndShowsBothSeriesColours) {
       blue += std::abs(p[0] - 31) < 20 && std::abs(p[1] - 120) < 20 && std::abs(p[2] - 181) < 20;
       white += p[0] == 255 && p[1] == 255 && p[2] == 255;
     }
-  EXPECT_GT(blue, 1000);   // a 2 px line across ~700 px
-  EXPECT_GT(dark, 1000);   // calm series, frame and text
+  EXPECT_GT(blue, 1000);  // a 2 px line across ~700 px
+  EXPECT_GT(dark, 1000);  // calm series, frame and text
   EXPECT_GT(white, 800 * 450 / 2);
 }
 
@@ -84,7 +84,8 @@ TEST(Plot, SvgIsWellFormedXmlWithEscapedLabels) {
   vtkSmartPointer<vtkXMLDataElement> root;
   root.TakeReference(vtkXMLUtilities::ReadElementFromString(svg.c_str()));
   ASSERT_NE(root, nullptr);
-  EXPECT_EQ(vtkXMLUtilities::ReadElementFromString("<svg><g></svg>"), nullptr);  // the parser does reject bad XML
+  EXPECT_EQ(vtkXMLUtilities::ReadElementFromString("<svg><g></svg>"),
+            nullptr);  // the parser does reject bad XML
   EXPECT_STREQ(root->GetName(), "svg");
   EXPECT_STREQ(root->GetAttribute("width"), "960");
   EXPECT_EQ(svg.rfind("<?xml", 0), 0u);

@@ -1,10 +1,5 @@
 // pneuma-cli simulate under adverse conditions (issue 15): Ctrl-C at any output rate and during the drive
 // calibration (class 10), and a disk that fills up during the run (class 4).
-#include "CliRunner.h"
-#include "ToyModelDir.h"
-
-#include <nlohmann/json.hpp>
-
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -14,7 +9,11 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <thread>
+
+#include "CliRunner.h"
+#include "ToyModelDir.h"
 
 using pneuma::test::freshOutDir;
 using pneuma::test::lineCount;

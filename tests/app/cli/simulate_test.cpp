@@ -1,8 +1,4 @@
 // pneuma-cli simulate: outputs, their units and values, interruption and bad input.
-#include "CliRunner.h"
-#include "ToyModelDir.h"
-
-#include <nlohmann/json.hpp>
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkNew.h>
@@ -10,11 +6,14 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "CliRunner.h"
+#include "ToyModelDir.h"
 
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
@@ -50,17 +49,34 @@ void expectPng(const std::string& path) {
 TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
   const std::string out = freshOutDir("calm");
   // dt pinned: the toy torso is uncalibrated and these tests are about the outputs, not its physics
-  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "8", "--settle", "1",
-                   "--output-rate", "30", "--dt", "0.002", "--out", out});
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "8", "--settle",
+                   "1", "--output-rate", "30", "--dt", "0.002", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
 
   // summary.json: every documented field, consistent values
   const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
-  for (const char* key : {"tidal_volume_ml", "breaths_per_minute", "end_expiratory_volume_ml", "max_gut_volume_error_pct",
-                          "mean_gut_volume_error_pct", "dome_descent_mm", "xiphoid_anterior_mm",
-                          "lower_rib_expansion_mm", "umbilicus_anterior_mm", "rib_cage_tidal_ml", "abdomen_tidal_ml",
-                          "rc_ab_phase_deg", "real_time_factor", "dt_s", "steps", "integrator", "posture", "model",
-                          "controller", "pneuma_version", "partial", "tracking_rms_pct"})
+  for (const char* key : {"tidal_volume_ml",
+                          "breaths_per_minute",
+                          "end_expiratory_volume_ml",
+                          "max_gut_volume_error_pct",
+                          "mean_gut_volume_error_pct",
+                          "dome_descent_mm",
+                          "xiphoid_anterior_mm",
+                          "lower_rib_expansion_mm",
+                          "umbilicus_anterior_mm",
+                          "rib_cage_tidal_ml",
+                          "abdomen_tidal_ml",
+                          "rc_ab_phase_deg",
+                          "real_time_factor",
+                          "dt_s",
+                          "steps",
+                          "integrator",
+                          "posture",
+                          "model",
+                          "controller",
+                          "pneuma_version",
+                          "partial",
+                          "tracking_rms_pct"})
     EXPECT_TRUE(s.contains(key)) << key;
   EXPECT_FALSE(s["partial"].get<bool>());
   EXPECT_EQ(s["pneuma_version"], PNEUMA_VERSION);
@@ -83,9 +99,11 @@ TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
   EXPECT_EQ(header.at(1), "lung_volume [mL]");
   EXPECT_EQ(header.at(2), "gut_volume_error [%]");
   for (const std::string& h : header) EXPECT_NE(h.find(" ["), std::string::npos) << "no unit: " << h;
-  for (const char* col : {"diaphragm.r [-]", "diaphragm.alpha [-]", "diaphragm.mean_tension [N]", "xiphoid.z [mm]"})
+  for (const char* col :
+       {"diaphragm.r [-]", "diaphragm.alpha [-]", "diaphragm.mean_tension [N]", "xiphoid.z [mm]"})
     EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << col;
-  // the summary's figures follow from the CSV's columns in their units (mL, %, mm), from the end of settling on
+  // the summary's figures follow from the CSV's columns in their units (mL, %, mm), from the end of settling
+  // on
   auto column = [&](const std::string& name) {
     return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
   };
@@ -128,14 +146,15 @@ TEST(CliSimulate, CalmStyleWritesSummaryCsvAndPlotsWithUnits) {
     EXPECT_NE(svg.find("time [s]"), std::string::npos) << stem;
   }
   // no temporary files left behind
-  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
 }
 
 TEST(CliSimulate, SameSeedAndInputsGiveIdenticalCsv) {
   const std::string a = freshOutDir("det_a"), b = freshOutDir("det_b");
   for (const std::string& out : {a, b}) {
-    auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "deep", "--duration", "2", "--settle", "0.5",
-                     "--dt", "0.002", "--out", out});
+    auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "deep", "--duration", "2", "--settle",
+                     "0.5", "--dt", "0.002", "--out", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
   }
   EXPECT_EQ(slurp(a + "/timeseries.csv"), slurp(b + "/timeseries.csv"));
@@ -143,8 +162,8 @@ TEST(CliSimulate, SameSeedAndInputsGiveIdenticalCsv) {
 
 TEST(CliSimulate, VtkSeriesListsFivePartsPerFrame) {
   const std::string out = freshOutDir("vtk");
-  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--settle", "0",
-                   "--output-rate", "10", "--dt", "0.002", "--vtk", "--out", out});
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--settle",
+                   "0", "--output-rate", "10", "--dt", "0.002", "--vtk", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const std::string pvd = slurp(out + "/frames.pvd");
   EXPECT_NE(pvd.find("type=\"Collection\""), std::string::npos);
@@ -178,8 +197,8 @@ TEST(CliSimulate, VtkSeriesListsFivePartsPerFrame) {
 
 TEST(CliSimulate, AffectAddsTargetAndMeasuredVolumeFraction) {
   const std::string out = freshOutDir("affect");
-  auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "neutral", "--duration", "4", "--settle", "1",
-                   "--output-rate", "20", "--dt", "0.002", "--out", out});
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "neutral", "--duration", "4", "--settle",
+                   "1", "--output-rate", "20", "--dt", "0.002", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
   EXPECT_EQ(s["controller_kind"], "affect");
@@ -207,8 +226,8 @@ TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
   const std::string inputs = freshOutDir("scenario_inputs");
   fs::create_directories(inputs);
   const std::string file = inputs + "/run.json";
-  std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "name": "deep-short", "model": ")" << toyModelDir()
-                      << R"(", "duration_s": 30, "controller": {"style": "deep"},
+  std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "name": "deep-short", "model": ")"
+                      << toyModelDir() << R"(", "duration_s": 30, "controller": {"style": "deep"},
       "overrides": {"settle_time_s": 0.5, "posture": "supine"}, "outputs": {"output_rate_hz": 10, "plots": false}})";
   auto r = runCli({"simulate", "--scenario", file, "--duration", "2", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -226,7 +245,8 @@ TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
   EXPECT_EQ(s["posture"], "upright");  // the command line wins
 
   // a bad scenario names the file and the JSON path, exit 2
-  std::ofstream(file) << R"({"format": "pneuma-scenario", "version": 1, "duration_s": 3, "controller": {"style": "deep"},
+  std::ofstream(file)
+      << R"({"format": "pneuma-scenario", "version": 1, "duration_s": 3, "controller": {"style": "deep"},
       "overrides": {"dt_s": -1}})";
   r = runCli({"simulate", "--scenario", file, "--out", out});
   EXPECT_EQ(r.exitCode, 2);
@@ -236,7 +256,8 @@ TEST(CliSimulate, ScenarioFileRunsAndCommandLineOverridesIt) {
 
 TEST(CliSimulate, SigintWritesValidPartialSummary) {
   const std::string out = freshOutDir("sigint");
-  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "3000", "--out", out}, 1.5);
+  auto r = runCli(
+      {"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "3000", "--out", out}, 1.5);
   EXPECT_EQ(r.exitCode, 130) << r.err;
   const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
   EXPECT_TRUE(s["partial"].get<bool>());
@@ -251,8 +272,9 @@ TEST(CliSimulate, SigintWritesValidPartialSummary) {
 // data loss: a second run into the same --out keeps the first run's results unless --force is given
 TEST(CliSimulate, EarlierRunIsReplacedOnlyWithForce) {
   const std::string out = freshOutDir("again");
-  const std::vector<std::string> run = {"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5",
-                                        "--settle", "0", "--output-rate", "10", "--out", out};
+  const std::vector<std::string> run = {
+      "simulate", "--model", toyModelDir(),   "--style", "calm",  "--duration", "0.5",
+      "--settle", "0",       "--output-rate", "10",      "--out", out};
   ASSERT_EQ(runCli(run).exitCode, 0);
   const std::string first = slurp(out + "/summary.json");
   std::vector<std::string> again = run;
@@ -267,35 +289,37 @@ TEST(CliSimulate, EarlierRunIsReplacedOnlyWithForce) {
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/summary.json"))["duration_s"].get<double>(), 1.0);
 }
 
-// data loss: an --out that holds files simulate does not write is refused, even with --force, and left as it was
+// data loss: an --out that holds files simulate does not write is refused, even with --force, and left as it
+// was
 TEST(CliSimulate, FolderOfOtherFilesIsRefused) {
   const std::string out = freshOutDir("foreign");
   fs::create_directories(out);
   std::ofstream(out + "/thesis.tex") << "chapter 1";
   for (const bool force : {false, true}) {
-    std::vector<std::string> run = {"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5",
-                                    "--settle", "0", "--out", out};
+    std::vector<std::string> run = {"simulate", "--model",  toyModelDir(), "--style", "calm", "--duration",
+                                    "0.5",      "--settle", "0",           "--out",   out};
     if (force) run.push_back("--force");
     const auto r = runCli(run);
     EXPECT_EQ(r.exitCode, 2) << r.err;
-    EXPECT_NE(r.err.find("holds 'thesis.tex', which pneuma-cli simulate does not write"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("holds 'thesis.tex', which pneuma-cli simulate does not write"), std::string::npos)
+        << r.err;
     EXPECT_EQ(pneuma::test::lineCount(r.err), 1) << r.err;
     EXPECT_EQ(slurp(out + "/thesis.tex"), "chapter 1");
     EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator()), 1);
   }
 }
 
-// messages: a run too short for a full breath reports its breath figures as null, not as 0 or as the range of a
-// fraction of a breath
+// messages: a run too short for a full breath reports its breath figures as null, not as 0 or as the range of
+// a fraction of a breath
 TEST(CliSimulate, NoFullBreathGivesNullBreathFigures) {
   const std::string out = freshOutDir("nobreath");
-  const auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--settle", "0",
-                         "--output-rate", "20", "--out", out});
+  const auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5",
+                         "--settle", "0", "--output-rate", "20", "--out", out});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json s = nlohmann::json::parse(slurp(out + "/summary.json"));
   EXPECT_EQ(s["cycles"].get<int>(), 0);
-  for (const char* key : {"tidal_volume_ml", "breaths_per_minute", "end_expiratory_volume_ml", "end_inspiratory_volume_ml",
-                          "dome_descent_mm", "rib_cage_fraction"})
+  for (const char* key : {"tidal_volume_ml", "breaths_per_minute", "end_expiratory_volume_ml",
+                          "end_inspiratory_volume_ml", "dome_descent_mm", "rib_cage_fraction"})
     EXPECT_TRUE(s[key].is_null()) << key << " = " << s[key];
   EXPECT_TRUE(s["max_gut_volume_error_pct"].is_number());  // measured whether or not it breathed
   EXPECT_NE(r.out.find("no full breath found"), std::string::npos) << r.out;
@@ -306,8 +330,8 @@ TEST(CliSimulate, NoFullBreathGivesNullBreathFigures) {
 TEST(CliSimulate, NegativeOrOverflowingSeedIsRejected) {
   for (const char* seed : {"-1", "18446744073709551616", "1.5"}) {
     const std::string out = freshOutDir("seed");
-    auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--seed", seed,
-                     "--out", out});
+    auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "0.5", "--seed",
+                     seed, "--out", out});
     EXPECT_EQ(r.exitCode, 2) << seed;
     EXPECT_NE(r.err.find(std::string("--seed: must be an integer in [0, 18446744073709551615], got ") + seed),
               std::string::npos)
@@ -317,7 +341,8 @@ TEST(CliSimulate, NegativeOrOverflowingSeedIsRejected) {
 }
 
 TEST(CliSimulate, UnknownStyleListsValidNames) {
-  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "yodel", "--duration", "1", "--out", freshOutDir("bad")});
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--style", "yodel", "--duration", "1", "--out",
+                   freshOutDir("bad")});
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("yodel"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("calm"), std::string::npos) << r.err;
@@ -326,7 +351,8 @@ TEST(CliSimulate, UnknownStyleListsValidNames) {
 }
 
 TEST(CliSimulate, UnknownAffectListsValidNames) {
-  auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "ennui", "--duration", "1", "--out", freshOutDir("bad")});
+  auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "ennui", "--duration", "1", "--out",
+                   freshOutDir("bad")});
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("ennui"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("startle"), std::string::npos) << r.err;
@@ -377,10 +403,12 @@ TEST(CliSimulate, BadInputIsOneLineErrorAndExit2) {
 
 TEST(CliScenario, CheckAcceptsTheExamplesAndNamesTheFailingPath) {
   std::vector<std::string> args{"scenario", "check"};
-  for (const auto& e : fs::directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios")) args.push_back(e.path().string());
+  for (const auto& e : fs::directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios"))
+    args.push_back(e.path().string());
   auto r = runCli(args);
   EXPECT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_EQ(pneuma::test::lineCount(r.out), static_cast<int>(args.size()) - 2) << r.out;  // one "ok" line per file
+  EXPECT_EQ(pneuma::test::lineCount(r.out), static_cast<int>(args.size()) - 2)
+      << r.out;  // one "ok" line per file
 
   const std::string dir = freshOutDir("scenario_check");
   fs::create_directories(dir);
@@ -388,7 +416,9 @@ TEST(CliScenario, CheckAcceptsTheExamplesAndNamesTheFailingPath) {
       "controller": {"style": "calm"}, "overrides": {"active_gain_scale": {"diaphram": 2}}})";
   r = runCli({"scenario", "check", dir + "/bad.json"});
   EXPECT_EQ(r.exitCode, 2);
-  EXPECT_NE(r.err.find("bad.json: overrides.active_gain_scale.diaphram: unknown muscle group"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bad.json: overrides.active_gain_scale.diaphram: unknown muscle group"),
+            std::string::npos)
+      << r.err;
 
   // show prints a scenario that parses back to itself
   r = runCli({"scenario", "show", std::string(PNEUMA_RESOURCE_DIR) + "/scenarios/calm.json"});

@@ -1,12 +1,11 @@
 // pneuma-cli validate: every check is reported with target, measured value, pass/fail and source, in
 // report.json, report.md and a self-contained report.html; the exit code says whether all passed.
-#include "CliRunner.h"
-#include "ToyModelDir.h"
-
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "CliRunner.h"
+#include "ToyModelDir.h"
 
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
@@ -18,10 +17,12 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   const std::string out = freshOutDir("validate");
   std::filesystem::create_directories(out);
   std::ofstream(out + "/report.json") << "earlier";
-  const std::vector<std::string> args = {"validate", "--quick", "--dt", "0.002", "--model", toyModelDir(), "--out", out};
+  const std::vector<std::string> args = {"validate", "--quick",     "--dt",  "0.002",
+                                         "--model",  toyModelDir(), "--out", out};
   auto r = runCli(args);
   EXPECT_EQ(r.exitCode, 2) << r.err;
-  EXPECT_NE(r.err.find("holds an earlier run (report.json); add --force to replace it"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("holds an earlier run (report.json); add --force to replace it"), std::string::npos)
+      << r.err;
   EXPECT_EQ(slurp(out + "/report.json"), "earlier");
   std::vector<std::string> forced = args;
   forced.push_back("--force");
@@ -33,11 +34,13 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   ASSERT_GE(checks.size(), 15u);  // four styles, impact, sway
   int failed = 0;
   for (const auto& c : checks) {
-    for (const char* key : {"id", "what", "target", "measured", "unit", "passed", "source"}) EXPECT_TRUE(c.contains(key)) << key;
+    for (const char* key : {"id", "what", "target", "measured", "unit", "passed", "source"})
+      EXPECT_TRUE(c.contains(key)) << key;
     EXPECT_FALSE(c["source"].get<std::string>().empty());
     // pass/fail agrees with the bounds
     const double m = c["measured"].get<double>();
-    const bool inside = (c["lower"].is_null() || m >= c["lower"].get<double>()) && (c["upper"].is_null() || m <= c["upper"].get<double>());
+    const bool inside = (c["lower"].is_null() || m >= c["lower"].get<double>()) &&
+                        (c["upper"].is_null() || m <= c["upper"].get<double>());
     EXPECT_EQ(c["passed"].get<bool>(), inside) << c["id"];
     failed += !c["passed"].get<bool>();
   }
@@ -59,8 +62,8 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   EXPECT_NE(html.find("data:image/png;base64,iVBORw0KGgo"), std::string::npos);  // PNG signature in base64
   EXPECT_EQ(html.find("src=\"figure"), std::string::npos);  // no external image references
   EXPECT_NE(slurp(out + "/figure6_lung_volume.svg").find("500 mL"), std::string::npos);
-  // the physiology section: every physiology check of report.json is a row of both reports, the calm dome descent
-  // beside its published range, its figure report.json's styles.calm.dome_descent_mm
+  // the physiology section: every physiology check of report.json is a row of both reports, the calm dome
+  // descent beside its published range, its figure report.json's styles.calm.dome_descent_mm
   const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
   ASSERT_TRUE(report["styles"]["calm"]["dome_descent_mm"].is_number());
   ASSERT_TRUE(report["physiology"].is_array());
@@ -72,10 +75,12 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
     within += c["passed"].get<bool>();
   }
   EXPECT_EQ(report["physiology_within"].get<int>(), within);
-  const std::string row = "| physiology.calm.dome_descent | dome descent (central tendon, craniocaudal), calm | ";
+  const std::string row =
+      "| physiology.calm.dome_descent | dome descent (central tendon, craniocaudal), calm | ";
   const std::size_t at = md.find(row);
   ASSERT_NE(at, std::string::npos);
-  EXPECT_NEAR(std::stod(md.substr(at + row.size())), report["styles"]["calm"]["dome_descent_mm"].get<double>(),
+  EXPECT_NEAR(std::stod(md.substr(at + row.size())),
+              report["styles"]["calm"]["dome_descent_mm"].get<double>(),
               1e-3 * std::max(1.0, std::abs(report["styles"]["calm"]["dome_descent_mm"].get<double>())));
   EXPECT_NE(md.find("12 - 25 mm"), std::string::npos);
   EXPECT_NE(html.find("<h2>Physiology</h2>"), std::string::npos);
@@ -83,7 +88,8 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   EXPECT_NE(r.out.find("calm.tidal_volume"), std::string::npos);
 }
 
-// data loss: validate writes only into a new or empty folder or over an earlier report, never over other files
+// data loss: validate writes only into a new or empty folder or over an earlier report, never over other
+// files
 TEST(CliValidate, FolderOfOtherFilesIsRefused) {
   const std::string out = freshOutDir("validate_foreign");
   std::filesystem::create_directories(out);
@@ -93,7 +99,8 @@ TEST(CliValidate, FolderOfOtherFilesIsRefused) {
     if (force) args.push_back("--force");
     const auto r = runCli(args);
     EXPECT_EQ(r.exitCode, 2) << r.err;
-    EXPECT_NE(r.err.find("holds 'report.txt', which pneuma-cli validate does not write"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("holds 'report.txt', which pneuma-cli validate does not write"), std::string::npos)
+        << r.err;
     EXPECT_EQ(slurp(out + "/report.txt"), "mine");
     EXPECT_FALSE(std::filesystem::exists(out + "/report.json"));
   }

@@ -2,8 +2,7 @@
 // Shared set-up of the gui tests: one QApplication per process, the toy torso written as a model
 // directory, and pixel counting on grabs.
 
-#include "../../sim/ToyTorso.h"
-#include "pneuma/sim/ModelIO.h"
+#include <QVTKOpenGLNativeWidget.h>
 
 #include <QApplication>
 #include <QColor>
@@ -11,9 +10,10 @@
 #include <QImage>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
-#include <QVTKOpenGLNativeWidget.h>
-
 #include <set>
+
+#include "../../sim/ToyTorso.h"
+#include "pneuma/sim/ModelIO.h"
 
 namespace pneuma::app::test {
 

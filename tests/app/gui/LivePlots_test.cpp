@@ -1,14 +1,16 @@
 // The live plots over long and fast runs (issue 15, class 12): memory and plotted points do not grow with the
-// output rate or the run length, every peak and trough stays visible, and at display rates the plots are exact.
-#include "GuiTestSupport.h"
+// output rate or the run length, every peak and trough stays visible, and at display rates the plots are
+// exact.
 #include "gui/LivePlots.h"
-#include "gui/PlotView.h"
 
 #include <gtest/gtest.h>
 #include <malloc.h>
 
 #include <algorithm>
 #include <cmath>
+
+#include "GuiTestSupport.h"
+#include "gui/PlotView.h"
 
 using namespace pneuma;
 using pneuma::app::PlotSample;
@@ -66,7 +68,8 @@ TEST(LivePlots, MemoryAndPlottedPointsStayBoundedAtAnyOutputRate) {
   t = feed(plots, t + 0.0015, 5.0, 2000.0);
   const std::size_t after = heapInUse();
   // the old history held every sample of 120 s: about 240,000 x 0.5 kB = 115 MB here
-  EXPECT_LT(after - std::min(after, before), 32u << 20) << "heap grew by " << (after - before) / 1024 << " kB";
+  EXPECT_LT(after - std::min(after, before), 32u << 20)
+      << "heap grew by " << (after - before) / 1024 << " kB";
 
   ASSERT_TRUE(plots.refresh());
   const app::PlotView& volume = *plots.volumePlot();

@@ -1,13 +1,13 @@
 // What the user sees in the main window, asserted on grabs, widgets and exported files under Xvfb.
 // The run uses the sim tests' toy torso (every part of the default model at a tenth of the size).
 
-#include "../cli/CliRunner.h"
-#include "GuiTestSupport.h"
-#include "gui/LivePlots.h"
 #include "gui/MainWindow.h"
-#include "gui/ParameterPanel.h"
-#include "gui/PlotView.h"
-#include "pneuma/sim/Metrics.h"
+
+#include <gtest/gtest.h>
+#include <vtkCaptionActor2D.h>
+#include <vtkCoordinate.h>
+#include <vtkPropCollection.h>
+#include <vtkRenderer.h>
 
 #include <QCheckBox>
 #include <QComboBox>
@@ -17,15 +17,15 @@
 #include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
-
-#include <gtest/gtest.h>
-#include <vtkCaptionActor2D.h>
-#include <vtkCoordinate.h>
-#include <vtkPropCollection.h>
-#include <vtkRenderer.h>
-
 #include <cmath>
 #include <set>
+
+#include "../cli/CliRunner.h"
+#include "GuiTestSupport.h"
+#include "gui/LivePlots.h"
+#include "gui/ParameterPanel.h"
+#include "gui/PlotView.h"
+#include "pneuma/sim/Metrics.h"
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -145,7 +145,8 @@ TEST_F(DefaultModelWindow, LungsAreDrawnAndTheirCheckBoxHidesThem) {
   for (int y = 0; y < with.height(); ++y)
     for (int x = 0; x < with.width(); ++x) {
       const QColor a = with.pixelColor(x, y), b = without.pixelColor(x, y);
-      covered += std::abs(a.red() - b.red()) + std::abs(a.green() - b.green()) + std::abs(a.blue() - b.blue()) > 30;
+      covered +=
+          std::abs(a.red() - b.red()) + std::abs(a.green() - b.green()) + std::abs(a.blue() - b.blue()) > 30;
     }
   EXPECT_GT(covered, with.width() * with.height() / 50);
 }
@@ -335,9 +336,9 @@ Eigen::Vector3d shownGutSag(const MainWindow& window) {
 
 }  // namespace
 
-// the Parameters panel's posture box lists sim's postures; lying on the back restarts the run, and what it shows
-// then has the viscera sinking posteriorly (-y) where upright they sink caudally (-z); an unknown name is refused
-// with the valid ones and a scenario keeps the posture
+// the Parameters panel's posture box lists sim's postures; lying on the back restarts the run, and what it
+// shows then has the viscera sinking posteriorly (-y) where upright they sink caudally (-z); an unknown name
+// is refused with the valid ones and a scenario keeps the posture
 TEST(MainWindow, PostureBoxRestartsTheRunWithGravityTurned) {
   ToyWindow w;
   QComboBox* box = w.window.parameters()->postureBox();
@@ -396,7 +397,8 @@ TEST(MainWindow, ClickingAMuscleSelectsItAndAddsItsForceTrace) {
   w.window.pickAt(hit);
   w.window.plots()->refresh();
   ASSERT_EQ(tension->series().size(), before + 1);
-  EXPECT_TRUE(tension->series().back().name.contains("element")) << tension->series().back().name.toStdString();
+  EXPECT_TRUE(tension->series().back().name.contains("element"))
+      << tension->series().back().name.toStdString();
   // its trace holds the element's tension: positive while it is coloured
   EXPECT_GT(tension->series().back().y.back(), 0.0);
 }
@@ -420,8 +422,9 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
 
 // the teaching view: no muscle group's caption covers another caption, from any camera preset
 TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
-  const std::set<std::string> groupNames = {"External intercostals", "Internal intercostals", "Diaphragm",
-                                            "Rectus abdominis", "Transversus / obliques", "Costal cartilage"};
+  const std::set<std::string> groupNames = {
+      "External intercostals", "Internal intercostals",  "Diaphragm",
+      "Rectus abdominis",      "Transversus / obliques", "Costal cartilage"};
   viz::DisplayOptions o = window.scene().options();
   o.showLabels = true;
   o.showLandmarks = true;
@@ -452,7 +455,8 @@ TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
       for (std::size_t j = 0; j < boxes.size(); ++j) {
         if (j == i) continue;
         EXPECT_FALSE(boxes[i].rect.intersects(boxes[j].rect))
-            << "camera " << static_cast<int>(preset) << ": '" << boxes[i].text << "' covers '" << boxes[j].text << "'";
+            << "camera " << static_cast<int>(preset) << ": '" << boxes[i].text << "' covers '"
+            << boxes[j].text << "'";
       }
     }
     EXPECT_EQ(groups, 6);
@@ -526,7 +530,8 @@ TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {
 
 // without a display the app says what to do and exits 2, instead of Qt's plugin abort
 TEST(App, WithoutADisplayExplainsAndExitsTwo) {
-  const test::CliResult r = test::runProgram("pneuma", {"--style", "calm"}, 0.0, {"DISPLAY=", "WAYLAND_DISPLAY="});
+  const test::CliResult r =
+      test::runProgram("pneuma", {"--style", "calm"}, 0.0, {"DISPLAY=", "WAYLAND_DISPLAY="});
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("no display"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pneuma-cli"), std::string::npos) << r.err;

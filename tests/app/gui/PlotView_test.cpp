@@ -1,14 +1,15 @@
 // PlotView and its export share one layout (viz::layoutPlot): the same ranges, ticks and legend on screen
 // and in the exported file.
 #include "gui/PlotView.h"
-#include "GuiTestSupport.h"
-#include "viz/PlotLayout.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "GuiTestSupport.h"
+#include "viz/PlotLayout.h"
 
 using namespace pneuma;
 using pneuma::app::PlotView;

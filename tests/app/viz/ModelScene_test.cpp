@@ -1,7 +1,6 @@
-// The 3D scene (viz::ModelScene) draws the posed model: after update(), each bone's actor carries its body's pose
-// [R x], and the drawn points (every actor's data through its matrix) hold every gut node, both ends of every
-// element and every cavity vertex where the state puts them, none left at rest.
-#include "VizTestSupport.h"
+// The 3D scene (viz::ModelScene) draws the posed model: after update(), each bone's actor carries its body's
+// pose [R x], and the drawn points (every actor's data through its matrix) hold every gut node, both ends of
+// every element and every cavity vertex where the state puts them, none left at rest.
 #include "viz/ModelScene.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +13,8 @@
 
 #include <limits>
 #include <vector>
+
+#include "VizTestSupport.h"
 
 namespace pneuma {
 namespace {
@@ -72,7 +73,8 @@ TEST(ModelScene, ActorsAreAtThePosedPositions) {
     EXPECT_LT(best, 1e-12) << "body " << b;
   }
   // gut nodes, element ends and cavity vertices where the state puts them
-  for (int i = 0; i < model.nodes.size(); ++i) EXPECT_LT(nearest(points, s.nodePosition.col(i)), tol) << "node " << i;
+  for (int i = 0; i < model.nodes.size(); ++i)
+    EXPECT_LT(nearest(points, s.nodePosition.col(i)), tol) << "node " << i;
   Eigen::Matrix3Xd a, b, cavity;
   sim::anchorPositions(model.elements.endA, s, a);
   sim::anchorPositions(model.elements.endB, s, b);
@@ -81,7 +83,8 @@ TEST(ModelScene, ActorsAreAtThePosedPositions) {
     EXPECT_LT(nearest(points, b.col(e)), tol) << "element " << e << " end B";
   }
   sim::anchorPositions(model.cavity.vertices, s, cavity);
-  for (Eigen::Index i = 0; i < cavity.cols(); ++i) EXPECT_LT(nearest(points, cavity.col(i)), tol) << "cavity " << i;
+  for (Eigen::Index i = 0; i < cavity.cols(); ++i)
+    EXPECT_LT(nearest(points, cavity.col(i)), tol) << "cavity " << i;
   // and nothing of the moved nodes is left at its rest position
   int atRest = 0;
   for (int i = 0; i < model.nodes.size(); ++i) atRest += nearest(points, model.nodes.rest.col(i)) < tol;

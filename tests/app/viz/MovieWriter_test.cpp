@@ -1,5 +1,5 @@
-// viz::MovieWriter: a PNG sequence holds each frame as given (top row first, colours in RGB order), an .ogv is an
-// Ogg stream, and a writer dropped before finish() leaves no file behind.
+// viz::MovieWriter: a PNG sequence holds each frame as given (top row first, colours in RGB order), an .ogv
+// is an Ogg stream, and a writer dropped before finish() leaves no file behind.
 #include "viz/MovieWriter.h"
 
 #include <gtest/gtest.h>
@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 // a w x h frame: red in the top-left pixel, blue in the bottom-left one, green elsewhere, brightness k
 std::vector<unsigned char> frame(int w, int h, int k) {
   std::vector<unsigned char> rgb(static_cast<std::size_t>(3 * w * h));
-  for (int i = 0; i < w * h; ++i) rgb[static_cast<std::size_t>(3 * i + 1)] = static_cast<unsigned char>(100 + k);
+  for (int i = 0; i < w * h; ++i)
+    rgb[static_cast<std::size_t>(3 * i + 1)] = static_cast<unsigned char>(100 + k);
   rgb[0] = 255, rgb[1] = 0;
   const std::size_t bottom = static_cast<std::size_t>(3 * w * (h - 1));
   rgb[bottom + 1] = 0, rgb[bottom + 2] = 255;
@@ -29,7 +30,8 @@ std::vector<unsigned char> frame(int w, int h, int k) {
 }
 
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / ("pneuma_movie_" + std::to_string(getpid()) + "_" + name);
+  const fs::path dir =
+      fs::path(testing::TempDir()) / ("pneuma_movie_" + std::to_string(getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -66,7 +68,8 @@ TEST(MovieWriter, OgvIsAnOggStreamAndAnUnfinishedWriterLeavesNothing) {
   {
     viz::MovieWriter writer((dir / "breath.ogv").string(), 25.0);
     EXPECT_TRUE(writer.isMovie());
-    for (int k = 0; k < 5; ++k) writer.writeFrame(frame(33, 17, 10 * k).data(), 33, 17);  // cropped to 32 x 16
+    for (int k = 0; k < 5; ++k)
+      writer.writeFrame(frame(33, 17, 10 * k).data(), 33, 17);  // cropped to 32 x 16
     writer.finish();
   }
   std::ifstream movie(dir / "breath.ogv", std::ios::binary);

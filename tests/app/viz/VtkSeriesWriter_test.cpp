@@ -1,8 +1,7 @@
-// The ParaView series (viz::VtkSeriesWriter) reproduces the posed geometry of every frame: read back with VTK's own
-// reader, the bones are their body-frame meshes moved by R p + x, each muscle a line between its two anchor
-// positions, the gut at the node positions with displacement x - x_rest, the cavity at its bound vertices, with the
-// frame's pressure, forces and time.
-#include "VizTestSupport.h"
+// The ParaView series (viz::VtkSeriesWriter) reproduces the posed geometry of every frame: read back with
+// VTK's own reader, the bones are their body-frame meshes moved by R p + x, each muscle a line between its
+// two anchor positions, the gut at the node positions with displacement x - x_rest, the cavity at its bound
+// vertices, with the frame's pressure, forces and time.
 #include "viz/VtkSeriesWriter.h"
 
 #include <gtest/gtest.h>
@@ -22,6 +21,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "VizTestSupport.h"
 
 namespace pneuma {
 namespace {
@@ -50,7 +51,8 @@ TEST(VtkSeriesWriter, FramesHoldThePosedGeometry) {
   sim::Model model = sim::test::makeToyTorso(2);
   int meshed = 0;
   while (model.bodies.isFixed[static_cast<std::size_t>(meshed)]) ++meshed;
-  const Eigen::Matrix3d triangle = (Eigen::Matrix3d() << 0.01, 0, 0, 0, 0.02, 0, 0, 0, 0.03).finished();  // [m] columns
+  const Eigen::Matrix3d triangle =
+      (Eigen::Matrix3d() << 0.01, 0, 0, 0, 0.02, 0, 0, 0, 0.03).finished();  // [m] columns
   {
     vtkNew<vtkPolyData> mesh;
     vtkNew<vtkPoints> pts;
@@ -135,7 +137,8 @@ TEST(VtkSeriesWriter, FramesHoldThePosedGeometry) {
     EXPECT_LT((point(gut, i) - s.nodePosition.col(i)).norm(), tol) << i;
     double d[3];
     displacement->GetTuple(i, d);
-    EXPECT_LT((Vector3d(d[0], d[1], d[2]) - (s.nodePosition.col(i) - model.nodes.rest.col(i))).norm(), tol) << i;
+    EXPECT_LT((Vector3d(d[0], d[1], d[2]) - (s.nodePosition.col(i) - model.nodes.rest.col(i))).norm(), tol)
+        << i;
   }
   EXPECT_EQ(gut->GetFieldData()->GetArray("pressure_Pa")->GetTuple1(0), 200.0);
 
@@ -144,7 +147,8 @@ TEST(VtkSeriesWriter, FramesHoldThePosedGeometry) {
   sim::anchorPositions(model.cavity.vertices, s, cavity);
   const auto cav = readPart((dir / "run" / "cavity_000001.vtp").string());
   ASSERT_EQ(cav->GetNumberOfPoints(), cavity.cols());
-  for (Eigen::Index i = 0; i < cavity.cols(); ++i) EXPECT_LT((point(cav, i) - cavity.col(i)).norm(), tol) << i;
+  for (Eigen::Index i = 0; i < cavity.cols(); ++i)
+    EXPECT_LT((point(cav, i) - cavity.col(i)).norm(), tol) << i;
   fs::remove_all(dir);
 }
 

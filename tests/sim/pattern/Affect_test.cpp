@@ -1,13 +1,13 @@
 // The affect presets, measured from v(t): rate, depth, pauses and event shapes (de Melo et al. 2010).
-#include "pneuma/sim/Error.h"
-#include "pneuma/sim/pattern/Pattern.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "pneuma/sim/Error.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 using namespace pneuma::sim;
 using namespace pneuma::sim::pattern;
@@ -79,15 +79,16 @@ double balanceOf(const std::string& affect, std::size_t layer) {
 }  // namespace
 
 TEST(AffectPresets, AllFifteenExistAndUnknownNamesListThem) {
-  const std::vector<std::string> expected = {"anger",  "boredom", "disgust", "excitement", "fear",
-                                             "focus",  "joy",     "neutral", "pain",       "panic",
-                                             "relaxation", "relief", "sadness", "startle", "surprise"};
+  const std::vector<std::string> expected = {"anger",      "boredom", "disgust", "excitement", "fear",
+                                             "focus",      "joy",     "neutral", "pain",       "panic",
+                                             "relaxation", "relief",  "sadness", "startle",    "surprise"};
   EXPECT_EQ(listAffects(kResources), expected);
   try {
     loadAffect("glee", kResources);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown affect 'glee' (valid: anger, boredom, disgust"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("unknown affect 'glee' (valid: anger, boredom, disgust"),
+              std::string::npos);
   }
 }
 
@@ -99,10 +100,10 @@ TEST(AffectPresets, SustainedStatesHaveThePapersRateAndDepth) {
     double rate, depthMin, depthMax, depthIrregularity;
   };
   const Expect table[] = {
-      {"neutral", "neutral", 15, 0.05, 0.25, 0},     {"excitement", "excitement", 40, 0.05, 0.40, 0},
+      {"neutral", "neutral", 15, 0.05, 0.25, 0},       {"excitement", "excitement", 40, 0.05, 0.40, 0},
       {"relaxation", "relaxation", 10, 0.05, 0.40, 0}, {"focus", "focus", 35, 0.05, 0.17, 0},
-      {"pain", "pain", 40, 0.05, 0.40, 0.15},        {"anger", "anger", 40, 0.05, 0.40, 0},
-      {"fear", "fear", 40, 0.05, 0.40, 0.10},        {"panic", "panic", 60, 0.05, 0.20, 0.10},
+      {"pain", "pain", 40, 0.05, 0.40, 0.15},          {"anger", "anger", 40, 0.05, 0.40, 0},
+      {"fear", "fear", 40, 0.05, 0.40, 0.10},          {"panic", "panic", 60, 0.05, 0.20, 0.10},
       {"sadness", "sadness", 11, 0.05, 0.40, 0},
   };
   for (const Expect& e : table) {

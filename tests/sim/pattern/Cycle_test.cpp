@@ -1,4 +1,3 @@
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/pattern/Cycle.h"
 
 #include <gtest/gtest.h>
@@ -6,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+
+#include "pneuma/sim/Error.h"
 
 using namespace pneuma::sim;
 using namespace pneuma::sim::pattern;

@@ -1,5 +1,4 @@
 // The pattern controller's feedback law on a first-order lung plant (no physics model needed).
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/pattern/PatternController.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <string>
+
+#include "pneuma/sim/Error.h"
 
 using namespace pneuma::sim;
 using namespace pneuma::sim::pattern;
@@ -16,7 +17,8 @@ namespace {
 const std::string kResources = PNEUMA_RESOURCE_DIR;
 std::size_t idx(ElementGroup g) { return static_cast<std::size_t>(g); }
 
-// a calibration with concave (saturating) responses, as muscles have: R_g(alpha) = g (1 - e^(-3 alpha)) / (1 - e^(-3))
+// a calibration with concave (saturating) responses, as muscles have: R_g(alpha) = g (1 - e^(-3 alpha)) / (1
+// - e^(-3))
 DriveCalibration plantCalibration() {
   std::array<double, kElementGroupCount> gain{};
   gain[idx(ElementGroup::IntercostalExternal)] = 0.3;
@@ -75,7 +77,8 @@ TEST(PatternController, TracksSustainedPresetsOnALaggingMiscalibratedPlant) {
     plant.run(*ctl, 30.0, c);
     EXPECT_GT(ctl->tracking().frames, 1700);
     EXPECT_LT(ctl->tracking().rmsPercentOfPeakToPeak(), 10.0);
-    RecordProperty(std::string("rms_pct_") + affect, std::to_string(ctl->tracking().rmsPercentOfPeakToPeak()));
+    RecordProperty(std::string("rms_pct_") + affect,
+                   std::to_string(ctl->tracking().rmsPercentOfPeakToPeak()));
     EXPECT_NEAR(ctl->measuredFraction(), ctl->targetFraction(), 0.05);
   }
 }
@@ -86,7 +89,8 @@ TEST(PatternController, GroupResponseInterpolatesTheCalibratedCurve) {
   EXPECT_DOUBLE_EQ(groupResponse(c, ElementGroup::Diaphragm, 0.0), 0.0);
   EXPECT_DOUBLE_EQ(groupResponse(c, ElementGroup::Diaphragm, 0.2), r[4]);
   EXPECT_DOUBLE_EQ(groupResponse(c, ElementGroup::Diaphragm, 1.0), r.back());
-  EXPECT_NEAR(groupResponse(c, ElementGroup::Diaphragm, 0.6), 0.6 * r[6] + 0.4 * r[7], 1e-15);  // 0.6 = 0.5 + 0.4 * 0.25
+  EXPECT_NEAR(groupResponse(c, ElementGroup::Diaphragm, 0.6), 0.6 * r[6] + 0.4 * r[7],
+              1e-15);  // 0.6 = 0.5 + 0.4 * 0.25
   EXPECT_DOUBLE_EQ(groupResponse(c, ElementGroup::Diaphragm, 2.0), r.back());
 }
 
@@ -137,7 +141,8 @@ TEST(PatternController, RejectsANegativeTimeConstant) {
     makeAffectController("neutral", kResources, 1, c);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("calibration.timeConstant.intercostal_internal"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("calibration.timeConstant.intercostal_internal"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -150,7 +155,8 @@ TEST(PatternController, BalanceSplitsTheDriveBetweenChestAndBelly) {
     double chest = 0.0, belly = 0.0;
     for (int k = 0; k < 20; ++k) {
       plant.run(*ctl, 0.5 * (k + 1), c);
-      chest += groupResponse(c, ElementGroup::IntercostalExternal, plant.last[idx(ElementGroup::IntercostalExternal)].alpha);
+      chest += groupResponse(c, ElementGroup::IntercostalExternal,
+                             plant.last[idx(ElementGroup::IntercostalExternal)].alpha);
       belly += groupResponse(c, ElementGroup::Diaphragm, plant.last[idx(ElementGroup::Diaphragm)].alpha);
     }
     return chest / (chest + belly);

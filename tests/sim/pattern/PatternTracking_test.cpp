@@ -1,14 +1,13 @@
 // Validation: the physical default model follows the affect presets (issue 7 targets): tracking RMS
 // < 10 % of the target's peak-to-peak, measured rate within 0.5 b/m, suspensions held within 5 %.
-#include "DefaultModel.h"
-
-#include "pneuma/sim/pattern/PatternController.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
+
+#include "DefaultModel.h"
+#include "pneuma/sim/pattern/PatternController.h"
 
 using namespace pneuma::sim;
 using namespace pneuma::sim::pattern;
@@ -26,23 +25,21 @@ const DriveCalibration& calibration() {
 
 class PatternTracking : public ::testing::TestWithParam<const char*> {
  protected:
-  void SetUp() override {
-    REQUIRE_DEFAULT_MODEL();
-  }
+  void SetUp() override { REQUIRE_DEFAULT_MODEL(); }
 };
 
 }  // namespace
 
 // the calibration staircase identifies each lever's lag: the rib friction (Eq. 3, 15 N m s/rad) makes the
-// external intercostals, which lift the ribs about their neck axes, a slower lever than the diaphragm, which mainly
-// pushes the gut down (0.18 s against 0.08 s); every lag is far below a breath (1 s at 60 b/m) and, but for the
-// internal layer's, above the 10 ms step: pulling the ribs down with the lungs' recoil (Cavity), the internal
-// intercostals move the volume within one step and then ease back a little, a lag of about 0
+// external intercostals, which lift the ribs about their neck axes, a slower lever than the diaphragm, which
+// mainly pushes the gut down (0.18 s against 0.08 s); every lag is far below a breath (1 s at 60 b/m) and,
+// but for the internal layer's, above the 10 ms step: pulling the ribs down with the lungs' recoil (Cavity),
+// the internal intercostals move the volume within one step and then ease back a little, a lag of about 0
 TEST(PatternDriveCalibration, IdentifiesTheRibcageAsTheSlowerLeverOnTheDefaultModel) {
   REQUIRE_DEFAULT_MODEL();
   const auto tau = [](ElementGroup g) { return calibration().timeConstant[static_cast<std::size_t>(g)]; };
-  for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal, ElementGroup::Diaphragm,
-                         ElementGroup::Rectus}) {
+  for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal,
+                         ElementGroup::Diaphragm, ElementGroup::Rectus}) {
     RecordProperty(std::string("tau_s_") + groupName(g), std::to_string(tau(g)));
     if (g != ElementGroup::IntercostalInternal) {
       EXPECT_GT(tau(g), 0.02) << groupName(g);
@@ -78,7 +75,8 @@ std::string presetName(const ::testing::TestParamInfo<const char*>& info) { retu
 }  // namespace
 
 INSTANTIATE_TEST_SUITE_P(Presets, PatternTracking,
-                         ::testing::Values("neutral", "excitement", "relaxation", "focus", "panic", "sadness"),
+                         ::testing::Values("neutral", "excitement", "relaxation", "focus", "panic",
+                                           "sadness"),
                          presetName);
 
 // the calibration belongs to the nominal model, the run to a model whose inspiratory and expiratory
@@ -89,7 +87,8 @@ class PatternTrackingRobustness : public ::testing::TestWithParam<double> {};
 TEST_P(PatternTrackingRobustness, FollowsExcitementWithMisCalibratedMuscleGains) {
   REQUIRE_DEFAULT_MODEL();
   SimulationOptions options;
-  for (ElementGroup g : {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal, ElementGroup::Diaphragm})
+  for (ElementGroup g :
+       {ElementGroup::IntercostalExternal, ElementGroup::IntercostalInternal, ElementGroup::Diaphragm})
     options.step.activeGainScale[static_cast<std::size_t>(g)] = GetParam();
   auto ctl = makeAffectController("excitement", kResources, 1, calibration());
   PatternController* live = ctl.get();
@@ -134,8 +133,9 @@ TEST_P(PatternSuspension, HoldsTheVolumeForTheWholeSuspension) {
   EXPECT_GT(holdEnd - holdStart, 0.9) << "the suspension lasts 1 s";
   const double held = (hi - lo) / (tmax - tmin);
   RecordProperty("hold_pct", std::to_string(100.0 * held));
-  EXPECT_LT(held, 0.05) << "held between " << lo << " and " << hi << " from " << holdStart << " to " << holdEnd << " s";
+  EXPECT_LT(held, 0.05) << "held between " << lo << " and " << hi << " from " << holdStart << " to "
+                        << holdEnd << " s";
 }
 
-INSTANTIATE_TEST_SUITE_P(Presets, PatternSuspension, ::testing::Values("disgust", "surprise", "startle", "pain"),
-                         presetName);
+INSTANTIATE_TEST_SUITE_P(Presets, PatternSuspension,
+                         ::testing::Values("disgust", "surprise", "startle", "pain"), presetName);

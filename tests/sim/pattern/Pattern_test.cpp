@@ -1,9 +1,10 @@
-#include "pneuma/sim/Error.h"
 #include "pneuma/sim/pattern/Pattern.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
+
+#include "pneuma/sim/Error.h"
 
 using namespace pneuma::sim;
 using namespace pneuma::sim::pattern;
@@ -15,7 +16,8 @@ const std::string kResources = PNEUMA_RESOURCE_DIR;
 // a valid two-layer pattern; `cycle` replaces the first layer's cycle
 std::string patternWith(const std::string& cycle) {
   return R"({"format": "pneuma-pattern", "version": 1, "name": "t", "layers": [
-    {"name": "first", "repeat": 2, "cycle": )" + cycle + R"(},
+    {"name": "first", "repeat": 2, "cycle": )" +
+         cycle + R"(},
     {"name": "base", "repeat": "infinite", "cycle": {"kind": "linear", "rate_bpm": 15, "depth": [0.05, 0.25]}}]})";
 }
 

@@ -7,11 +7,11 @@
 /// World frame (RAS): +x right, +y anterior, +z superior; z = 0 at the L5/S1 disc, y = 0 at the
 /// vertebral body centres of the lumbar spine.
 
-#include "pneuma/sim/Model.h"
-
 #include <array>
 #include <string>
 #include <vector>
+
+#include "pneuma/sim/Model.h"
 
 namespace pneuma::meshing {
 
@@ -25,11 +25,11 @@ struct RibLevel {
   double arcLength = 0.0;       ///< [m] centreline length, head to costochondral junction
   double posteriorRatio = 0.0;  ///< [-] posterior semi-axis / lateral semi-axis
   double anteriorRatio = 0.0;   ///< [-] anterior semi-axis / lateral semi-axis
-  double endAngle = 0.0;        ///< [rad] curve parameter of the costochondral junction (3 pi / 2 = most anterior)
-  double inclination = 0.0;     ///< [rad] anterior descent of the rib plane below horizontal
-  double lateralTilt = 0.0;     ///< [rad] lateral descent of the rib plane below horizontal
-  double height = 0.0;          ///< [m] cross-section height (superior-inferior)
-  double thickness = 0.0;       ///< [m] cross-section thickness (inner-outer)
+  double endAngle = 0.0;  ///< [rad] curve parameter of the costochondral junction (3 pi / 2 = most anterior)
+  double inclination = 0.0;  ///< [rad] anterior descent of the rib plane below horizontal
+  double lateralTilt = 0.0;  ///< [rad] lateral descent of the rib plane below horizontal
+  double height = 0.0;       ///< [m] cross-section height (superior-inferior)
+  double thickness = 0.0;    ///< [m] cross-section thickness (inner-outer)
   /// [rad] direction of the rib-neck axis (head to tubercle, the axis the rib turns about) in the horizontal
   /// plane, measured from the left-right axis toward posterior: 0 = transverse (pure pump handle), 90 deg =
   /// anteroposterior (pure bucket handle). resources/anatomy/README.md has the values and their sources.
@@ -38,16 +38,17 @@ struct RibLevel {
 
 /// Vertebral column: bodies stacked upward from z = 0 (L5 bottom).
 struct SpineParams {
-  std::vector<double> lumbarHeights;       ///< [m] vertebral body heights L5..L1 (5)
-  std::vector<double> thoracicHeights;     ///< [m] vertebral body heights T12..T1 (12)
-  double lumbarDisc = 0.0;                 ///< [m] lumbar disc height
-  double thoracicDisc = 0.0;               ///< [m] thoracic disc height
-  std::array<double, 2> lumbarBody{};      ///< [m] lumbar body width and depth
-  std::array<double, 2> thoracicBodyTop{}; ///< [m] T1 body width and depth
+  std::vector<double> lumbarHeights;           ///< [m] vertebral body heights L5..L1 (5)
+  std::vector<double> thoracicHeights;         ///< [m] vertebral body heights T12..T1 (12)
+  double lumbarDisc = 0.0;                     ///< [m] lumbar disc height
+  double thoracicDisc = 0.0;                   ///< [m] thoracic disc height
+  std::array<double, 2> lumbarBody{};          ///< [m] lumbar body width and depth
+  std::array<double, 2> thoracicBodyTop{};     ///< [m] T1 body width and depth
   std::array<double, 2> thoracicBodyBottom{};  ///< [m] T12 body width and depth
-  double kyphosis = 0.0;                   ///< [m] posterior bulge of the thoracic curve at its middle
-  double spinousLength = 0.0;              ///< [m] posterior reach of a spinous process behind its body
-  std::vector<std::array<int, 2>> thoracicSegments;  ///< first and last vertebra (1..12) of each articulated segment
+  double kyphosis = 0.0;                       ///< [m] posterior bulge of the thoracic curve at its middle
+  double spinousLength = 0.0;                  ///< [m] posterior reach of a spinous process behind its body
+  std::vector<std::array<int, 2>>
+      thoracicSegments;  ///< first and last vertebra (1..12) of each articulated segment
 };
 
 /// Sternum (Selthofer et al. 2006): a plate running down and forward from the jugular notch.
@@ -72,23 +73,23 @@ struct PelvisParams {
 
 /// Abdominal cavity (the gut body of Section 6) and the diaphragm dome on top of it.
 struct AbdomenParams {
-  double floorLevel = 0.0;       ///< [m] z of the pelvic floor (below L5/S1, negative)
-  double width = 0.0;            ///< [m] inner transverse diameter of the cavity at the umbilicus
-  double anteriorDepth = 0.0;    ///< [m] reach of the anterior wall in front of the lumbar body centre
-  double posteriorDepth = 0.0;   ///< [m] reach of the posterior wall (beside the spine) behind it
-  double domeHeight = 0.0;       ///< [m] rise of the diaphragm apex above the costal margin's mean level
-  double tendonFraction = 0.0;   ///< [-] radius fraction of the dome covered by the central tendon
-  double umbilicusLevel = 0.0;   ///< [m] z of the umbilicus
+  double floorLevel = 0.0;      ///< [m] z of the pelvic floor (below L5/S1, negative)
+  double width = 0.0;           ///< [m] inner transverse diameter of the cavity at the umbilicus
+  double anteriorDepth = 0.0;   ///< [m] reach of the anterior wall in front of the lumbar body centre
+  double posteriorDepth = 0.0;  ///< [m] reach of the posterior wall (beside the spine) behind it
+  double domeHeight = 0.0;      ///< [m] rise of the diaphragm apex above the costal margin's mean level
+  double tendonFraction = 0.0;  ///< [-] radius fraction of the dome covered by the central tendon
+  double umbilicusLevel = 0.0;  ///< [m] z of the umbilicus
 };
 
 /// Sampling resolution of the generated meshes and networks.
 struct Resolution {
-  double boneEdge = 0.0;        ///< [m] isotropic remeshing target edge length of the bones
-  int wallRings = 0;            ///< rings of gut nodes from the pelvic floor to the costal margin
-  int ringNodes = 0;            ///< nodes per wall ring
-  int domeRings = 0;            ///< rings of the diaphragm dome between the central tendon and the rim
-  int domeRimNodes = 0;         ///< nodes on the rim of the dome (costal margin)
-  int intercostalSamples = 0;   ///< elements per rib pair, side and intercostal layer
+  double boneEdge = 0.0;       ///< [m] isotropic remeshing target edge length of the bones
+  int wallRings = 0;           ///< rings of gut nodes from the pelvic floor to the costal margin
+  int ringNodes = 0;           ///< nodes per wall ring
+  int domeRings = 0;           ///< rings of the diaphragm dome between the central tendon and the rim
+  int domeRimNodes = 0;        ///< nodes on the rim of the dome (costal margin)
+  int intercostalSamples = 0;  ///< elements per rib pair, side and intercostal layer
 };
 
 /// Muscle and spring gains of one group. Each element gets k = gain * referenceLength / restLength
@@ -103,36 +104,37 @@ struct GroupGains {
 struct Gains {
   double referenceLength = 0.0;  ///< [m] element length at which the group gains apply unscaled
   std::array<GroupGains, sim::kElementGroupCount> group{};  ///< indexed by sim::ElementGroup
-  double gutKappa = 0.0;              ///< [Pa] bulk modulus of Eq. 4
-  double gutDrag = 0.0;               ///< [1/s] visceral drag rate beta (sim::Gut::drag)
-  double lungRecoil = 0.0;            ///< [Pa] lung recoil at the rest volume (sim::Cavity::recoilPressure)
-  double lungCompliance = 0.0;        ///< [m^3/Pa] lung compliance (sim::Cavity::compliance)
-  /// [-] stiffness and damping of the apposition springs (the outer dome held on the lower ribs' inner face) as a
-  /// fraction of the cartilage group's
+  double gutKappa = 0.0;                                    ///< [Pa] bulk modulus of Eq. 4
+  double gutDrag = 0.0;         ///< [1/s] visceral drag rate beta (sim::Gut::drag)
+  double lungRecoil = 0.0;      ///< [Pa] lung recoil at the rest volume (sim::Cavity::recoilPressure)
+  double lungCompliance = 0.0;  ///< [m^3/Pa] lung compliance (sim::Cavity::compliance)
+  /// [-] stiffness and damping of the apposition springs (the outer dome held on the lower ribs' inner face)
+  /// as a fraction of the cartilage group's
   double appositionFraction = 0.0;
   /// [-] scale of the external intercostals' kac in space k (between ribs k and k+1), k = 1..11, entry k - 1:
-  /// the neural drive of the external intercostals falls from the rostral to the caudal spaces, matching their
-  /// inspiratory mechanical advantage, and the caudal spaces are nearly silent in quiet breathing (De Troyer,
-  /// Kirkwood & Wilson 2005, Physiol Rev 85:717; De Troyer, Gorman & Gandevia 2002, J Physiol 546:943)
+  /// the neural drive of the external intercostals falls from the rostral to the caudal spaces, matching
+  /// their inspiratory mechanical advantage, and the caudal spaces are nearly silent in quiet breathing (De
+  /// Troyer, Kirkwood & Wilson 2005, Physiol Rev 85:717; De Troyer, Gorman & Gandevia 2002, J Physiol
+  /// 546:943)
   std::array<double, 11> externalIntercostalSpaceScale{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
-  double costovertebralFriction = 0.0;  ///< [N m s/rad] mu of Eq. 3
-  double costovertebralStiffness = 0.0; ///< [N m/rad] about the rib-neck axis
+  double costovertebralFriction = 0.0;   ///< [N m s/rad] mu of Eq. 3
+  double costovertebralStiffness = 0.0;  ///< [N m/rad] about the rib-neck axis
   /// [N m/rad] the costotransverse joint's resistance to rotation off the rib-neck axis (a rib with both its
   /// head and its tubercle articulated turns about the line through them)
   double costotransverseStiffness = 0.0;
-  double spineFriction = 0.0;           ///< [N m s/rad]
-  double spineStiffness = 0.0;          ///< [N m/rad]
-  double wallMass = 0.0;                ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
-  double diaphragmMass = 0.0;           ///< [kg] total mass of the diaphragm dome nodes
+  double spineFriction = 0.0;   ///< [N m s/rad]
+  double spineStiffness = 0.0;  ///< [N m/rad]
+  double wallMass = 0.0;        ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
+  double diaphragmMass = 0.0;   ///< [kg] total mass of the diaphragm dome nodes
 };
 
 /// A whole anatomy preset.
 struct AnatomyParams {
-  std::string name;             ///< preset name, e.g. "adult_male"
-  std::string source;           ///< file it was read from
-  double boneDensity = 0.0;     ///< [kg/m^3] uniform bone density for mass properties
+  std::string name;                    ///< preset name, e.g. "adult_male"
+  std::string source;                  ///< file it was read from
+  double boneDensity = 0.0;            ///< [kg/m^3] uniform bone density for mass properties
   bool areFloatingRibsMoving = false;  ///< ribs 11-12: moving bodies (true) or fixed (false)
-  std::vector<RibLevel> ribs;   ///< rib levels 1..12 (index 0 = rib 1)
+  std::vector<RibLevel> ribs;          ///< rib levels 1..12 (index 0 = rib 1)
   SpineParams spine;
   SternumParams sternum;
   PelvisParams pelvis;
@@ -142,7 +144,8 @@ struct AnatomyParams {
 };
 
 /// Reads and validates an anatomy preset and the gains file it names ("gains", relative to the preset).
-/// @throws sim::Error naming the file and field, e.g. "male.json: ribs[3].arc_length_mm: must be > 0, got -5".
+/// @throws sim::Error naming the file and field, e.g. "male.json: ribs[3].arc_length_mm: must be > 0, got
+/// -5".
 AnatomyParams loadAnatomy(const std::string& path);
 
 /// Parses an anatomy preset from JSON text; `gainsText` is the text of its gains file. The names are

@@ -3,19 +3,19 @@
 /// The CGAL side of meshing (all CGAL code lives in MeshTools.cpp): mesh checks, isotropic
 /// remeshing, convex hulls and Boolean difference.
 
-#include "pneuma/meshing/TriangleMesh.h"
-
 #include <string>
 #include <vector>
+
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 
 /// Result of checkMesh().
 struct MeshCheck {
-  bool isManifold = false;           ///< every face could be added to a halfedge mesh
-  bool isClosed = false;             ///< CGAL::is_closed: no border edges
-  bool isSelfIntersecting = true;    ///< CGAL::Polygon_mesh_processing::does_self_intersect
-  bool isOutward = false;            ///< positive enclosed volume
+  bool isManifold = false;         ///< every face could be added to a halfedge mesh
+  bool isClosed = false;           ///< CGAL::is_closed: no border edges
+  bool isSelfIntersecting = true;  ///< CGAL::Polygon_mesh_processing::does_self_intersect
+  bool isOutward = false;          ///< positive enclosed volume
   bool isValid() const { return isManifold && isClosed && !isSelfIntersecting && isOutward; }
 };
 

@@ -3,24 +3,24 @@
 /// Builds the simulation model of a torso (Zordan et al. 2004, Sections 4-6) from an anatomy preset,
 /// and writes it as a model directory (model.json plus body render meshes).
 
+#include <string>
+#include <vector>
+
 #include "pneuma/meshing/AnatomyParams.h"
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/meshing/TriangleMesh.h"
 #include "pneuma/sim/Model.h"
 
-#include <string>
-#include <vector>
-
 namespace pneuma::meshing {
 
 /// Numbers measured while building (beyond the model's own summary).
 struct BuildReport {
-  ModelSummary summary;            ///< counts, volumes and masses of the built model
-  int tetrahedra = 0;              ///< TetGen tetrahedra of the gut volume
-  double tetVolume = 0.0;          ///< [m^3] TetGen volume of the gut
-  double gutQualityMin = 0.0;      ///< [-] smallest pressure-surface triangle quality (1 = equilateral)
-  double gutQualityMean = 0.0;     ///< [-] mean pressure-surface triangle quality
-  int boneTriangles = 0;           ///< triangles of all remeshed bones
+  ModelSummary summary;         ///< counts, volumes and masses of the built model
+  int tetrahedra = 0;           ///< TetGen tetrahedra of the gut volume
+  double tetVolume = 0.0;       ///< [m^3] TetGen volume of the gut
+  double gutQualityMin = 0.0;   ///< [-] smallest pressure-surface triangle quality (1 = equilateral)
+  double gutQualityMean = 0.0;  ///< [-] mean pressure-surface triangle quality
+  int boneTriangles = 0;        ///< triangles of all remeshed bones
 };
 
 /// A built model with its render meshes.

@@ -2,10 +2,10 @@
 /// @file ModelSummary.h
 /// The headline numbers of a model, as `pneuma-cli model build` and `model info` print them.
 
-#include "pneuma/sim/Model.h"
-
 #include <array>
 #include <string>
+
+#include "pneuma/sim/Model.h"
 
 namespace pneuma::meshing {
 
@@ -17,10 +17,10 @@ struct ModelSummary {
   int nodes = 0;
   int fixedNodes = 0;
   std::array<int, sim::kElementGroupCount> elements{};  ///< per sim::ElementGroup
-  double gutVolume = 0.0;     ///< [m^3] enclosed by the gut surface at rest
-  double cavityVolume = 0.0;  ///< [m^3] enclosed by the lung-cavity surface at rest
-  double gutWallMass = 0.0;   ///< [kg] mass of the moving abdominal-wall nodes (region Wall)
-  double boneMass = 0.0;      ///< [kg] mass of all bodies
+  double gutVolume = 0.0;                               ///< [m^3] enclosed by the gut surface at rest
+  double cavityVolume = 0.0;                            ///< [m^3] enclosed by the lung-cavity surface at rest
+  double gutWallMass = 0.0;  ///< [kg] mass of the moving abdominal-wall nodes (region Wall)
+  double boneMass = 0.0;     ///< [kg] mass of all bodies
 };
 
 /// World rest positions of the points of `set` (3 x #P) [m]: body points at com + local (body axes are

@@ -3,20 +3,19 @@
 /// Generalised tubes: an elliptical cross-section swept along a centreline. Ribs, sternum, vertebral
 /// bodies and the pelvis are built from them.
 
-#include "pneuma/meshing/TriangleMesh.h"
-
 #include <Eigen/Core>
-
 #include <vector>
+
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 
 /// One cross-section of a swept tube.
 struct SweepStation {
   Eigen::Vector3d centre{0, 0, 0};  ///< [m] centreline point
-  Eigen::Vector3d up{0, 0, 1};      ///< direction of the cross-section's height axis (made normal to the tangent)
-  double halfHeight = 0.0;          ///< [m] semi-axis along `up`
-  double halfWidth = 0.0;           ///< [m] semi-axis along tangent x up
+  Eigen::Vector3d up{0, 0, 1};  ///< direction of the cross-section's height axis (made normal to the tangent)
+  double halfHeight = 0.0;      ///< [m] semi-axis along `up`
+  double halfWidth = 0.0;       ///< [m] semi-axis along tangent x up
 };
 
 /// Sweeps ellipses through `stations` (at least 2; 3 for a loop) with `around` points each.

@@ -2,18 +2,18 @@
 /// @file Tetrahedralizer.h
 /// The TetGen side of meshing (all TetGen code lives in Tetrahedralizer.cpp).
 
-#include "pneuma/meshing/TriangleMesh.h"
-
 #include <string>
+
+#include "pneuma/meshing/TriangleMesh.h"
 
 namespace pneuma::meshing {
 
 /// A tetrahedral mesh of the volume a closed surface bounds.
 struct TetMesh {
-  Eigen::Matrix3Xd vertices;   ///< [m] (3 x #V): the surface vertices first, then interior Steiner points
-  Eigen::Matrix4Xi tets;       ///< vertex indices (4 x #T)
-  double volume = 0.0;         ///< [m^3] sum of the tetrahedra volumes
-  int boundaryTriangles = 0;   ///< triangles on the boundary (equals the input's: the surface is kept)
+  Eigen::Matrix3Xd vertices;  ///< [m] (3 x #V): the surface vertices first, then interior Steiner points
+  Eigen::Matrix4Xi tets;      ///< vertex indices (4 x #T)
+  double volume = 0.0;        ///< [m^3] sum of the tetrahedra volumes
+  int boundaryTriangles = 0;  ///< triangles on the boundary (equals the input's: the surface is kept)
 };
 
 /// Quality tetrahedralisation of the volume bounded by a closed outward `surface` with TetGen

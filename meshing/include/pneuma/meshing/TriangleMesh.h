@@ -27,9 +27,9 @@ struct TriangleMesh {
 
 /// Mass properties of a homogeneous solid.
 struct MassProperties {
-  double volume = 0.0;               ///< [m^3]
-  double mass = 0.0;                 ///< [kg]
-  Eigen::Vector3d com{0, 0, 0};      ///< [m] centre of mass
+  double volume = 0.0;                                ///< [m^3]
+  double mass = 0.0;                                  ///< [kg]
+  Eigen::Vector3d com{0, 0, 0};                       ///< [m] centre of mass
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  ///< [kg m^2] inertia tensor about the com, mesh axes
 };
 

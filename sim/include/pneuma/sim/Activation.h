@@ -3,9 +3,9 @@
 /// Per-group control input of the muscle law (Zordan et al. 2004, Eq. 2 and Section 7):
 ///   F = min[-alpha kac (l - r l0) - kpe (l - l0) - b dl/dt, 0].
 
-#include "pneuma/sim/Model.h"
-
 #include <array>
+
+#include "pneuma/sim/Model.h"
 
 namespace pneuma::sim {
 

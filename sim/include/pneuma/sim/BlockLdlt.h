@@ -30,11 +30,11 @@ class BlockLdlt {
   /// allowed; the diagonal is always included.
   void analyze(int blocks, const std::vector<std::array<int, 2>>& pattern);
 
-  /// Slot of block (r, c) of A, r >= c (block row and column, 0 <= r < #blocks), for value(); the block must be in
-  /// the analysed pattern.
+  /// Slot of block (r, c) of A, r >= c (block row and column, 0 <= r < #blocks), for value(); the block must
+  /// be in the analysed pattern.
   int slot(int r, int c) const;
-  /// Block (r, c) of A's lower triangle at `slot` (rows of block row r, columns of block column c); of a diagonal
-  /// block only the lower triangle is read.
+  /// Block (r, c) of A's lower triangle at `slot` (rows of block row r, columns of block column c); of a
+  /// diagonal block only the lower triangle is read.
   Eigen::Matrix3d& value(int slot) { return m_a[static_cast<std::size_t>(slot)]; }
   const Eigen::Matrix3d& value(int slot) const { return m_a[static_cast<std::size_t>(slot)]; }
   /// Number of stored blocks of A (slots 0 .. valueBlocks() - 1).
@@ -43,8 +43,8 @@ class BlockLdlt {
   void clearValues();
 
   /// Kernels of the inner loops of factorize() and solve(): AVX2 + FMA when allowed (the default) and the CPU
-  /// has it, else portable Eigen loops. Both agree up to rounding (FMA rounds once per multiply-add); a machine
-  /// gives bit-identical runs either way.
+  /// has it, else portable Eigen loops. Both agree up to rounding (FMA rounds once per multiply-add); a
+  /// machine gives bit-identical runs either way.
   void setVectorKernel(bool allowed);
   /// True when factorize() and solve() run the AVX2 + FMA kernels.
   bool vectorKernel() const { return m_avx2; }
@@ -69,11 +69,11 @@ class BlockLdlt {
   std::vector<int> m_lp, m_li;       ///< L's blocks below the diagonal, column-compressed
   /// a 3x3 block padded to 4 rows (row 3 zero), so that a column is one SIMD register
   using Block = Eigen::Matrix<double, 4, 3>;
-  std::vector<Block> m_l;            ///< their values (padded)
+  std::vector<Block> m_l;                   ///< their values (padded)
   std::vector<Eigen::Matrix3d> m_dInverse;  ///< D_k^-1 (#blocks)
   // factorization workspace (#blocks)
   std::vector<Block> m_y;
-  bool m_avx2 = false;               ///< run the AVX2 + FMA kernel (BlockLdltKernels.h)
+  bool m_avx2 = false;  ///< run the AVX2 + FMA kernel (BlockLdltKernels.h)
   std::vector<int> m_flag, m_pattern, m_lnz;
   mutable Eigen::VectorXd m_x;  ///< permuted right-hand side of solve()
 };

@@ -4,12 +4,12 @@
 /// ratio r(t) and an activation alpha(t) that enter the muscle law, Eq. 2:
 ///   F = min[-alpha kac (l - r l0) - kpe (l - l0) - b dl/dt, 0].
 
-#include "pneuma/sim/Activation.h"
-#include "pneuma/sim/Metrics.h"
-
 #include <limits>
 #include <memory>
 #include <string>
+
+#include "pneuma/sim/Activation.h"
+#include "pneuma/sim/Metrics.h"
 
 namespace pneuma::sim {
 

@@ -6,7 +6,6 @@
 /// d = (xB - xA) / l the unit direction from A to B.
 
 #include <Eigen/Core>
-
 #include <algorithm>
 
 namespace pneuma::sim {
@@ -64,10 +63,11 @@ double enclosedVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangl
 
 /// Volume [m^3] of the cone from `origin` over the faces `triangles` (an open patch allowed):
 ///   V = sum_f (a - o) . ((b - o) x (e - o)) / 6.
-/// For a closed surface it is enclosedVolume() for any origin; for a patch whose rim hardly moves, its change is
-/// the volume the patch sweeps (the abdominal wall's displacement of Konno & Mead 1967).
+/// For a closed surface it is enclosedVolume() for any origin; for a patch whose rim hardly moves, its change
+/// is the volume the patch sweeps (the abdominal wall's displacement of Konno & Mead 1967).
 /// @param x  3 x #V vertex positions [m];  @param triangles 3 x #F vertex indices;  @param origin [m].
-double coneVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles, const Eigen::Vector3d& origin);
+double coneVolume(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles,
+                  const Eigen::Vector3d& origin);
 
 /// Gut pressure, Eq. 4: P = kappa (V0 / V - 1) [Pa], with kappa [Pa], V0 and V [m^3].
 double gutPressure(double kappa, double restVolume, double volume);

@@ -12,28 +12,27 @@
 ///  - heavy impact (Section 6.2, Figure 4): the relaxed torso's anterior abdominal wall around the
 ///    umbilicus is struck posteriorly; the gut deforms while its volume error stays small.
 
-#include "pneuma/sim/BreathStyleController.h"
-#include "pneuma/sim/Metrics.h"
-#include "pneuma/sim/Model.h"
-#include "pneuma/sim/Simulation.h"
-
 #include <Eigen/Core>
-
 #include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Model.h"
+#include "pneuma/sim/Simulation.h"
+
 namespace pneuma::sim {
 
 /// One check of a claim: passes when lower <= measured <= upper.
 struct Check {
-  std::string id;          ///< stable identifier, e.g. "calm.tidal_volume"
-  std::string what;        ///< what is measured, e.g. "tidal volume, calm"
-  std::string target;      ///< the target as text, e.g. "500 +/- 50 mL"
-  std::string source;      ///< paper, section, table or figure, e.g. "Zordan et al. 2004, Sec. 8.1, Fig. 6"
-  std::string unit;        ///< unit of measured, lower and upper, e.g. "mL"
-  double measured = 0.0;   ///< in `unit`
+  std::string id;         ///< stable identifier, e.g. "calm.tidal_volume"
+  std::string what;       ///< what is measured, e.g. "tidal volume, calm"
+  std::string target;     ///< the target as text, e.g. "500 +/- 50 mL"
+  std::string source;     ///< paper, section, table or figure, e.g. "Zordan et al. 2004, Sec. 8.1, Fig. 6"
+  std::string unit;       ///< unit of measured, lower and upper, e.g. "mL"
+  double measured = 0.0;  ///< in `unit`
   double lower = -std::numeric_limits<double>::infinity();  ///< in `unit`
   double upper = std::numeric_limits<double>::infinity();   ///< in `unit`
   bool isPassed() const { return measured >= lower && measured <= upper; }
@@ -41,9 +40,9 @@ struct Check {
 
 /// Durations and the simulation options shared by the experiments.
 struct ExperimentSettings {
-  SimulationOptions simulation;       ///< integrator, dt, settle time; output rate 30 Hz; 1 s recorder window (the
-                                      ///< experiments read the trace, not the recorder's timeline)
-  double styleDuration = 12.0;        ///< [s] periodic styles after settling (>= 2 cycles of deep breathing)
+  SimulationOptions simulation;  ///< integrator, dt, settle time; output rate 30 Hz; 1 s recorder window (the
+                                 ///< experiments read the trace, not the recorder's timeline)
+  double styleDuration = 12.0;   ///< [s] periodic styles after settling (>= 2 cycles of deep breathing)
   double forcedExhaleDuration = 8.0;  ///< [s] the single 6 s forced-exhale manoeuvre and its end
   double impactSettle = 2.0;          ///< [s] relaxed settling before the impact
   double impactDuration = 1.5;        ///< [s] simulated after the impact
@@ -64,28 +63,30 @@ struct StyleRun {
   double settleTime = 0.0;     ///< [s]
   std::string spineBody;       ///< name of the highest moving thoracic body ("" when the model has none)
   std::vector<Eigen::Vector3d> spineTop;  ///< [m] its com at every frame of `trace`
-  int umbilicus = -1;          ///< column of the "umbilicus" landmark in trace.landmarks, -1 if missing
-  int xiphoid = -1;            ///< column of the "xiphoid" landmark in trace.landmarks, -1 if missing
+  int umbilicus = -1;  ///< column of the "umbilicus" landmark in trace.landmarks, -1 if missing
+  int xiphoid = -1;    ///< column of the "xiphoid" landmark in trace.landmarks, -1 if missing
 };
 
 /// Plays `style` on `model` for settings.styleDuration after settling (forcedExhaleDuration when the style
 /// is not periodic), with every joint's friction scaled by `frictionScale`.
 /// @throws Error on a blow-up (the message names the time and the cause).
-StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& style, const ExperimentSettings& settings,
-                        double frictionScale = 1.0);
+StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& style,
+                        const ExperimentSettings& settings, double frictionScale = 1.0);
 
 /// Checks of Section 8.1, Table 2 and Figures 4-6 on runs named "calm", "deep", "panting" and
 /// "forced-exhale" (checks whose runs are missing are left out): gut volume error < 2 % in every style;
 /// calm tidal volume 500 +/- 50 mL at 15 +/- 0.5 b/m, its exhales without a rebound above 10 mL
-/// (expirationRebound()); deep above calm, 0.6-3 L, 12 +/- 0.5 b/m; panting 60 +/- 1 b/m, below calm, chest-dominant (the ratio of the xiphoid's to the umbilicus's anterior-posterior
-/// excursion, the motion seen from the side as in Fig. 5, above calm's); forced exhale
-/// below calm end-expiration, umbilicus >= 1 cm posterior, xiphoid down.
+/// (expirationRebound()); deep above calm, 0.6-3 L, 12 +/- 0.5 b/m; panting 60 +/- 1 b/m, below calm,
+/// chest-dominant (the ratio of the xiphoid's to the umbilicus's anterior-posterior excursion, the motion
+/// seen from the side as in Fig. 5, above calm's); forced exhale below calm end-expiration, umbilicus >= 1 cm
+/// posterior, xiphoid down.
 std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 
-/// The breath's motion in anatomical axes (Summary::motion) against published physiology, on runs named "calm"
-/// and "deep" (ids "physiology.<style>.<figure>"; checks whose runs are missing are left out), each with its source:
-/// calm dome descent 12-25 mm (M-mode ultrasound, Boussuges et al. 2009); deep dome descent >= 2 x calm and
-/// 20-35 mm per litre inspired; the umbilicus forward on every calm inhale; rib 8's lateral distance growing
+/// The breath's motion in anatomical axes (Summary::motion) against published physiology, on runs named
+/// "calm" and "deep" (ids "physiology.<style>.<figure>"; checks whose runs are missing are left out), each
+/// with its source: calm dome descent 12-25 mm (M-mode ultrasound, Boussuges et al. 2009); deep dome descent
+/// >= 2 x calm and 20-35 mm per litre inspired; the umbilicus forward on every calm inhale; rib 8's lateral
+/// distance growing
 /// >= 2 mm calm and >= 10 mm deep; the calm rib-cage share 55-85 % upright; calm rib-cage / abdomen phase
 /// < 30 deg; two flow reversals per calm breath and no frame-to-frame flow jump above 20 % of peak flow.
 std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs);
@@ -122,11 +123,11 @@ std::vector<Check> postureChecks(const StyleRun& upright, const StyleRun& supine
 
 /// The heavy-impact run (Figure 4).
 struct ImpactRun {
-  int struckNodes = 0;            ///< wall nodes given the impact speed
-  std::vector<double> time;       ///< [s] since the impact, every step
+  int struckNodes = 0;                 ///< wall nodes given the impact speed
+  std::vector<double> time;            ///< [s] since the impact, every step
   std::vector<double> gutVolumeError;  ///< [-] signed (V - V0)/V0, every step
-  double maxVolumeError = 0.0;    ///< [-] max |(V - V0)/V0| after the impact
-  double maxDent = 0.0;           ///< [m] largest posterior displacement of the umbilicus landmark
+  double maxVolumeError = 0.0;         ///< [-] max |(V - V0)/V0| after the impact
+  double maxDent = 0.0;                ///< [m] largest posterior displacement of the umbilicus landmark
 };
 
 /// Settles the relaxed torso for settings.impactSettle, gives the wall nodes within impactRadius of the

@@ -8,7 +8,6 @@
 /// The JSON library stays private to the sim library: this header only exposes std and Eigen types.
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <initializer_list>
 #include <memory>
@@ -28,7 +27,8 @@ std::string excerptOf(const std::string& s, std::size_t maxChars = 60);
 constexpr unsigned long long kMaxInputFileBytes = 256ull << 20;
 
 /// The whole text of a file a loader reads (model, anatomy, gains, preset, scenario, pattern).
-/// @throws Error "<path>: cannot open" (missing or unreadable), "<path>: not a regular file" (a directory, a device
+/// @throws Error "<path>: cannot open" (missing or unreadable), "<path>: not a regular file" (a directory, a
+/// device
 ///         such as /dev/zero, a pipe) or "<path>: larger than 256 MiB"; `hint` is appended to the first.
 std::string readInputFile(const std::string& path, const std::string& hint = "");
 

@@ -14,7 +14,6 @@
 ///  - structures of arrays: one column (or entry) per item, Eigen::Matrix3X* for 3-vectors.
 
 #include <Eigen/Core>
-
 #include <array>
 #include <cstdint>
 #include <string>
@@ -36,7 +35,8 @@ enum class ElementGroup : int {
 constexpr int kElementGroupCount = static_cast<int>(ElementGroup::Count);
 
 /// Stable snake_case name of a group as used in model.json, presets and CSV headers
-/// ("intercostal_external", "intercostal_internal", "diaphragm", "rectus", "transversus_obliques", "cartilage").
+/// ("intercostal_external", "intercostal_internal", "diaphragm", "rectus", "transversus_obliques",
+/// "cartilage").
 const char* groupName(ElementGroup g);
 /// Inverse of groupName(); returns false when the name is unknown.
 bool groupFromName(const std::string& name, ElementGroup& out);
@@ -46,10 +46,10 @@ inline bool isMuscleGroup(ElementGroup g) { return g != ElementGroup::Cartilage;
 /// A set of points, each bound either to a rigid body (a fixed point in that body's frame) or to up to
 /// three gut nodes (barycentric weights). Used for element endpoints, cavity vertices and landmarks.
 struct AnchorSet {
-  std::vector<int> body;      ///< rigid-body index, or -1 when the point is bound to nodes   (#P)
-  Eigen::Matrix3Xd local;     ///< [m] point in the body frame, used when body >= 0            (3 x #P)
-  Eigen::Matrix3Xi nodes;     ///< gut node indices, -1 marks an unused slot; used when body < 0 (3 x #P)
-  Eigen::Matrix3Xd weights;   ///< [-] barycentric weights of `nodes`, summing to 1             (3 x #P)
+  std::vector<int> body;     ///< rigid-body index, or -1 when the point is bound to nodes   (#P)
+  Eigen::Matrix3Xd local;    ///< [m] point in the body frame, used when body >= 0            (3 x #P)
+  Eigen::Matrix3Xi nodes;    ///< gut node indices, -1 marks an unused slot; used when body < 0 (3 x #P)
+  Eigen::Matrix3Xd weights;  ///< [-] barycentric weights of `nodes`, summing to 1             (3 x #P)
 
   int size() const { return static_cast<int>(body.size()); }
   /// Appends a point fixed in body `b` at body-frame position `p` [m].
@@ -60,12 +60,13 @@ struct AnchorSet {
 
 /// Rigid bodies: bones. Fixed bodies (lumbar spine, pelvis) never move.
 struct Bodies {
-  std::vector<std::string> name;           ///< unique names, e.g. "rib3_left", "sternum", "thoracic_1" (#B)
-  std::vector<std::uint8_t> isFixed;       ///< 1 when the body never moves                            (#B)
-  Eigen::VectorXd mass;                    ///< [kg]                                                    (#B)
-  Eigen::Matrix3Xd com;                    ///< [m] rest-pose centre of mass in world = frame origin    (3 x #B)
-  std::vector<Eigen::Matrix3d> inertia;    ///< [kg m^2] inertia tensor about the com, body frame       (#B)
-  std::vector<std::string> mesh;           ///< render mesh (.vtp, body-frame coordinates [m]) relative to the model dir; may be empty (#B)
+  std::vector<std::string> name;         ///< unique names, e.g. "rib3_left", "sternum", "thoracic_1" (#B)
+  std::vector<std::uint8_t> isFixed;     ///< 1 when the body never moves                            (#B)
+  Eigen::VectorXd mass;                  ///< [kg]                                                    (#B)
+  Eigen::Matrix3Xd com;                  ///< [m] rest-pose centre of mass in world = frame origin    (3 x #B)
+  std::vector<Eigen::Matrix3d> inertia;  ///< [kg m^2] inertia tensor about the com, body frame       (#B)
+  std::vector<std::string>
+      mesh;  ///< render mesh (.vtp, body-frame coordinates [m]) relative to the model dir; may be empty (#B)
 
   int size() const { return static_cast<int>(name.size()); }
 };
@@ -75,18 +76,18 @@ struct Bodies {
 /// A passive rotational spring acts on the rotation vector theta of the child relative to the parent (world):
 ///   tau = -K theta,  K = k I + k_lock (I - a a^T),  a = R_parent axis,
 /// so k holds every direction (the spine) and k_lock adds a resistance to turning off the axis: a rib whose
-/// head (costovertebral joint) and tubercle (costotransverse joint) both articulate turns about its neck axis,
-/// the line through the two (De Troyer & Boriek 2011, Compr Physiol 1:1273; Jordanoglou 1969, Thorax 24:407).
-/// k_lock = 0 is a plain ball joint.
+/// head (costovertebral joint) and tubercle (costotransverse joint) both articulate turns about its neck
+/// axis, the line through the two (De Troyer & Boriek 2011, Compr Physiol 1:1273; Jordanoglou 1969, Thorax
+/// 24:407). k_lock = 0 is a plain ball joint.
 struct Joints {
-  std::vector<std::string> name;   ///< e.g. "costovertebral_rib3_left"        (#J)
-  std::vector<int> parent;         ///< body index of the parent (may be fixed) (#J)
-  std::vector<int> child;          ///< body index of the child                 (#J)
-  Eigen::Matrix3Xd anchor;         ///< [m] rest-pose joint centre, world       (3 x #J)
-  Eigen::VectorXd friction;        ///< [N m s/rad] mu of Eq. 3                 (#J)
-  Eigen::VectorXd stiffness;       ///< [N m/rad] passive rotational stiffness k, every direction (#J)
-  Eigen::Matrix3Xd axis;           ///< [-] unit hinge axis a in the parent frame (= world at rest)   (3 x #J)
-  Eigen::VectorXd lockStiffness;   ///< [N m/rad] k_lock against rotation off the axis, 0 = ball joint (#J)
+  std::vector<std::string> name;  ///< e.g. "costovertebral_rib3_left"        (#J)
+  std::vector<int> parent;        ///< body index of the parent (may be fixed) (#J)
+  std::vector<int> child;         ///< body index of the child                 (#J)
+  Eigen::Matrix3Xd anchor;        ///< [m] rest-pose joint centre, world       (3 x #J)
+  Eigen::VectorXd friction;       ///< [N m s/rad] mu of Eq. 3                 (#J)
+  Eigen::VectorXd stiffness;      ///< [N m/rad] passive rotational stiffness k, every direction (#J)
+  Eigen::Matrix3Xd axis;          ///< [-] unit hinge axis a in the parent frame (= world at rest)   (3 x #J)
+  Eigen::VectorXd lockStiffness;  ///< [N m/rad] k_lock against rotation off the axis, 0 = ball joint (#J)
 
   int size() const { return static_cast<int>(parent.size()); }
 };
@@ -100,9 +101,9 @@ enum class NodeRegion : std::uint8_t {
 
 /// Point masses of the deformable gut surface (Section 6.1).
 struct Nodes {
-  Eigen::Matrix3Xd rest;                  ///< [m] rest positions, world   (3 x #N)
-  Eigen::VectorXd mass;                   ///< [kg] point masses; moving wall masses add up to 8 kg (#N)
-  std::vector<NodeRegion> region;         ///< role of each node           (#N)
+  Eigen::Matrix3Xd rest;           ///< [m] rest positions, world   (3 x #N)
+  Eigen::VectorXd mass;            ///< [kg] point masses; moving wall masses add up to 8 kg (#N)
+  std::vector<NodeRegion> region;  ///< role of each node           (#N)
 
   int size() const { return static_cast<int>(rest.cols()); }
   bool isFixed(int i) const { return region[static_cast<std::size_t>(i)] == NodeRegion::Fixed; }
@@ -111,8 +112,9 @@ struct Nodes {
 /// The sealed, volume-preserving gut (Section 6.2): P = kappa (V0/V - 1) (Eq. 4), with V0 the volume
 /// enclosed by `triangles` at the nodes' rest positions.
 struct Gut {
-  Eigen::Matrix3Xi triangles;   ///< node indices, counter-clockwise seen from outside (outward normals) (3 x #F)
-  double kappa = 0.0;           ///< [Pa] bulk "volumetric" modulus of Eq. 4
+  Eigen::Matrix3Xi
+      triangles;       ///< node indices, counter-clockwise seen from outside (outward normals) (3 x #F)
+  double kappa = 0.0;  ///< [Pa] bulk "volumetric" modulus of Eq. 4
   /// [1/s] beta of the visceral drag f_n = -beta m_n v_n on every free node: the viscosity of the viscera and
   /// abdominal tissue, which the paper's model lacks (our addition, docs/model-format.md). Without it the
   /// gut and the relaxing diaphragm bounce at the end of each inhale (calm: a 120 mL rebound). >= 0.
@@ -138,47 +140,52 @@ struct Elements {
 /// Closed lung-cavity surface (Figure 6): its vertices are anchors, so its volume can be recomputed
 /// from the current bone poses and diaphragm nodes at every step.
 ///
-/// The lungs' elastic recoil acts on the cavity's walls as a pleural pressure (our addition; the paper has none):
+/// The lungs' elastic recoil acts on the cavity's walls as a pleural pressure (our addition; the paper has
+/// none):
 ///   Ppl = min(0, -(P0 + (V - Vr) / C)),  f_i = Ppl dV/dx_i  (suction: the walls are pulled inward),
-/// with V the cavity volume, Vr its rest volume, P0 = recoilPressure the recoil at rest and C = compliance the lung
-/// compliance. It holds the diaphragm's dome up against the weight it carries (upright, resting Pdi is about
-/// 3 cmH2O) and is the force of passive expiration. Relaxed FRC: lung recoil +5 cmH2O (Ppl -5 cmH2O); lung
-/// compliance about 0.2 L/cmH2O (Naimark & Cherniack 1960, J Appl Physiol 15:377; Guyton & Hall).
-/// compliance 0 turns it off (models written before it).
+/// with V the cavity volume, Vr its rest volume, P0 = recoilPressure the recoil at rest and C = compliance
+/// the lung compliance. It holds the diaphragm's dome up against the weight it carries (upright, resting Pdi
+/// is about 3 cmH2O) and is the force of passive expiration. Relaxed FRC: lung recoil +5 cmH2O (Ppl -5
+/// cmH2O); lung compliance about 0.2 L/cmH2O (Naimark & Cherniack 1960, J Appl Physiol 15:377; Guyton &
+/// Hall). compliance 0 turns it off (models written before it).
 struct Cavity {
-  AnchorSet vertices;            ///< (#C points)
-  Eigen::Matrix3Xi triangles;    ///< vertex indices, outward normals (3 x #T)
-  double recoilPressure = 0.0;   ///< [Pa] P0, the lungs' elastic recoil at the rest volume, >= 0
-  double compliance = 0.0;       ///< [m^3/Pa] C, the lung compliance; 0 = no pleural pressure
+  AnchorSet vertices;           ///< (#C points)
+  Eigen::Matrix3Xi triangles;   ///< vertex indices, outward normals (3 x #T)
+  double recoilPressure = 0.0;  ///< [Pa] P0, the lungs' elastic recoil at the rest volume, >= 0
+  double compliance = 0.0;      ///< [m^3/Pa] C, the lung compliance; 0 = no pleural pressure
 };
 
 constexpr int kLungVertexSlots = 6;  ///< cavity vertices one lung vertex may combine (LungSurface)
 
-/// One lung's closed surface, embedded in the lung cavity (ArtiSynth-style embedding): each vertex is a convex
-/// combination of up to six cavity vertices, x_v = sum_k w_k c_{i_k}, with c the posed cavity vertices (Cavity).
-/// A vertex on a cavity wall takes the three corners of the cavity triangle it lies on, so the lung's costal and
-/// diaphragmatic faces move with the walls exactly; a vertex on the mediastinal face takes the two cavity points
-/// straight above and below it (three corners each), so that face follows the ribs above and the diaphragm below.
+/// One lung's closed surface, embedded in the lung cavity (ArtiSynth-style embedding): each vertex is a
+/// convex combination of up to six cavity vertices, x_v = sum_k w_k c_{i_k}, with c the posed cavity vertices
+/// (Cavity). A vertex on a cavity wall takes the three corners of the cavity triangle it lies on, so the
+/// lung's costal and diaphragmatic faces move with the walls exactly; a vertex on the mediastinal face takes
+/// the two cavity points straight above and below it (three corners each), so that face follows the ribs
+/// above and the diaphragm below.
 struct LungSurface {
-  Eigen::Matrix<int, 6, Eigen::Dynamic> cavityVertex;  ///< cavity vertex indices, -1 marks an unused slot (6 x #V)
-  Eigen::Matrix<double, 6, Eigen::Dynamic> weights;    ///< [-] >= 0, summing to 1; 0 in unused slots     (6 x #V)
-  Eigen::Matrix3Xi triangles;                          ///< vertex indices, outward normals             (3 x #T)
+  Eigen::Matrix<int, 6, Eigen::Dynamic>
+      cavityVertex;  ///< cavity vertex indices, -1 marks an unused slot (6 x #V)
+  Eigen::Matrix<double, 6, Eigen::Dynamic>
+      weights;                 ///< [-] >= 0, summing to 1; 0 in unused slots     (6 x #V)
+  Eigen::Matrix3Xi triangles;  ///< vertex indices, outward normals             (3 x #T)
 
   int vertexCount() const { return static_cast<int>(cavityVertex.cols()); }
 };
 
-/// The two lungs: the lung cavity minus the mediastinum (heart, great vessels, trachea, oesophagus, the vertebral
-/// bodies' bulge), split at the midline. The heart and the mediastinum are incompressible, so the lungs' volume is
-/// the cavity's volume minus a constant:
+/// The two lungs: the lung cavity minus the mediastinum (heart, great vessels, trachea, oesophagus, the
+/// vertebral bodies' bulge), split at the midline. The heart and the mediastinum are incompressible, so the
+/// lungs' volume is the cavity's volume minus a constant:
 ///   V_lungs = V_cavity - V_med,  V_right = V_lungs s_R,  V_left = V_lungs (1 - s_R),
-/// with s_R = V(right surface) / (V(right surface) + V(left surface)) of the posed surfaces, about 0.535 at rest
-/// (right 53.5 %, left 46.5 %: Yamada et al. 2020, "Lung volumes on CT, upright and supine", Sci Rep 10:19434).
-/// The tidal swing of V_lungs is thus exactly the cavity's. The surfaces are for display, export and the split.
-/// An empty Lungs (no surfaces, V_med = 0) makes the lungs the cavity (in-memory test models).
+/// with s_R = V(right surface) / (V(right surface) + V(left surface)) of the posed surfaces, about 0.535 at
+/// rest (right 53.5 %, left 46.5 %: Yamada et al. 2020, "Lung volumes on CT, upright and supine", Sci Rep
+/// 10:19434). The tidal swing of V_lungs is thus exactly the cavity's. The surfaces are for display, export
+/// and the split. An empty Lungs (no surfaces, V_med = 0) makes the lungs the cavity (in-memory test models).
 struct Lungs {
-  LungSurface right;              ///< the right lung (x > 0: world RAS, +x toward the subject's right)
-  LungSurface left;               ///< the left lung
-  double mediastinumVolume = 0.0; ///< [m^3] V_med, the part of the cavity's rest volume the lungs do not fill, >= 0
+  LungSurface right;  ///< the right lung (x > 0: world RAS, +x toward the subject's right)
+  LungSurface left;   ///< the left lung
+  double mediastinumVolume =
+      0.0;  ///< [m^3] V_med, the part of the cavity's rest volume the lungs do not fill, >= 0
 };
 
 /// Named points for measurement, bound like cavity vertices.
@@ -193,9 +200,9 @@ struct Landmarks {
 
 /// The whole immutable model.
 struct Model {
-  std::string name;                         ///< e.g. "adult_male"
-  std::string anatomy;                      ///< anatomy preset it was built from
-  Eigen::Vector3d gravity{0.0, 0.0, -9.81}; ///< [m/s^2] upright (postureGravity() turns it)
+  std::string name;                          ///< e.g. "adult_male"
+  std::string anatomy;                       ///< anatomy preset it was built from
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};  ///< [m/s^2] upright (postureGravity() turns it)
   Bodies bodies;
   Joints joints;
   Nodes nodes;

@@ -2,9 +2,9 @@
 /// @file ModelIO.h
 /// Reading, writing and validating model directories (format: docs/model-format.md).
 
-#include "pneuma/sim/Model.h"
-
 #include <string>
+
+#include "pneuma/sim/Model.h"
 
 namespace pneuma::sim {
 
@@ -12,7 +12,8 @@ namespace pneuma::sim {
 constexpr int kModelFormatVersion = 1;
 
 /// Reads `<dir>/model.json`. Validates it fully (see validateModel()).
-/// @throws Error naming the JSON path and the reason, e.g. "model.json: elements.rest_length[3]: must be > 0".
+/// @throws Error naming the JSON path and the reason, e.g. "model.json: elements.rest_length[3]: must be >
+/// 0".
 Model loadModel(const std::string& dir);
 
 /// Parses a model from the text of a model.json (no file access). Same validation as loadModel().

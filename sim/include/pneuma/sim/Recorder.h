@@ -6,24 +6,24 @@
 /// forces are stored as float (half the memory of double, ample for display); a bounded capacity keeps the
 /// most recent frames. Resuming a run is Simulation::checkpoint() / save(), not this.
 
-#include "pneuma/sim/Metrics.h"
-#include "pneuma/sim/State.h"
-
 #include <cstddef>
 #include <deque>
 #include <vector>
+
+#include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/State.h"
 
 namespace pneuma::sim {
 
 /// One recorded output frame.
 struct RecordedFrame {
-  double time = 0.0;                 ///< [s]
-  std::vector<float> bodyPose;       ///< per body: x, y, z [m], then qw, qx, qy, qz [-]   (7 #B)
-  std::vector<float> nodePosition;   ///< [m] per node x, y, z                             (3 #N)
-  std::vector<float> elementForce;   ///< [N] signed scalar force per element              (#E)
-  double lungVolume = 0.0;           ///< [m^3]
-  double gutVolumeError = 0.0;       ///< [-]
-  double gutPressure = 0.0;          ///< [Pa] Metrics::gutPressure, with the kappa of the run at that frame
+  double time = 0.0;                ///< [s]
+  std::vector<float> bodyPose;      ///< per body: x, y, z [m], then qw, qx, qy, qz [-]   (7 #B)
+  std::vector<float> nodePosition;  ///< [m] per node x, y, z                             (3 #N)
+  std::vector<float> elementForce;  ///< [N] signed scalar force per element              (#E)
+  double lungVolume = 0.0;          ///< [m^3]
+  double gutVolumeError = 0.0;      ///< [-]
+  double gutPressure = 0.0;         ///< [Pa] Metrics::gutPressure, with the kappa of the run at that frame
 };
 
 class Recorder {

@@ -17,12 +17,12 @@
 ///     "outputs": {"output_rate_hz": 60, "csv": true, "plots": true, "vtk": false}
 ///   }
 
-#include "pneuma/sim/Simulation.h"
-
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
+
+#include "pneuma/sim/Simulation.h"
 
 namespace pneuma::sim {
 
@@ -37,22 +37,23 @@ const char* controllerKindName(ControllerKind k);
 
 /// Which files a run writes (at SimulationOptions::outputRate, the file's outputs.output_rate_hz).
 struct ScenarioOutputs {
-  bool csv = true;           ///< timeseries.csv
-  bool plots = true;         ///< PNG + SVG plots
-  bool vtk = false;          ///< .pvd series of .vtp frames
+  bool csv = true;    ///< timeseries.csv
+  bool plots = true;  ///< PNG + SVG plots
+  bool vtk = false;   ///< .pvd series of .vtp frames
 };
 
 /// One run.
 struct Scenario {
-  std::string name;                 ///< short identifier
-  std::string description;          ///< free text
-  std::string model = "default";    ///< "default" (the built default model) or a model directory path
-  double duration = 0.0;            ///< [s] simulated time after the settling phase, > 0
-  std::uint64_t seed = 0;           ///< seed of the pattern irregularity streams
+  std::string name;               ///< short identifier
+  std::string description;        ///< free text
+  std::string model = "default";  ///< "default" (the built default model) or a model directory path
+  double duration = 0.0;          ///< [s] simulated time after the settling phase, > 0
+  std::uint64_t seed = 0;         ///< seed of the pattern irregularity streams
   ControllerKind controller = ControllerKind::Style;
-  std::string controllerName;       ///< Style: preset name; Affect: affect name; Pattern: pattern file path ("" when inline)
-  std::string patternText;          ///< Pattern given inline: the pattern file's JSON text ("" otherwise)
-  SimulationOptions options;        ///< overrides: step options, dt, settle time; outputs.output_rate_hz
+  std::string controllerName;  ///< Style: preset name; Affect: affect name; Pattern: pattern file path (""
+                               ///< when inline)
+  std::string patternText;     ///< Pattern given inline: the pattern file's JSON text ("" otherwise)
+  SimulationOptions options;   ///< overrides: step options, dt, settle time; outputs.output_rate_hz
   ScenarioOutputs outputs;
 };
 
@@ -60,7 +61,8 @@ struct Scenario {
 /// `baseDir` (the scenario file's directory). Checks every field's type and range, the integrator,
 /// group and posture names; the style, affect or pattern itself is checked when the controller is made.
 /// @throws Error "<sourceName>: <json path>: <reason>", e.g. "run.json: overrides.dt_s: must be > 0, got -1".
-Scenario parseScenario(const std::string& jsonText, const std::string& sourceName, const std::string& baseDir);
+Scenario parseScenario(const std::string& jsonText, const std::string& sourceName,
+                       const std::string& baseDir);
 
 /// Reads and parses a scenario file. @throws Error as parseScenario(), or when the file cannot be read.
 Scenario loadScenario(const std::string& path);

@@ -29,22 +29,24 @@ namespace pneuma::sim {
 
 /// Run settings (validated by validateSimulationOptions()).
 struct SimulationOptions {
-  StepOptions step;             ///< integrator, gravity and posture, friction scale, kappa override, gain scales
-  std::optional<double> dt;     ///< [s] time step in kTimeStepRange; unset: resolveOptions() picks it
-  double settleTime = 2.0;  ///< [s] settling phase before the controller starts, in kSettleTimeRange
-  double outputRate = 60.0;     ///< [Hz] metrics and recording rate, in kOutputRateRange
-  double recordSeconds = 300.0; ///< [s] recorder window (older frames dropped); 0 = unlimited
+  StepOptions step;          ///< integrator, gravity and posture, friction scale, kappa override, gain scales
+  std::optional<double> dt;  ///< [s] time step in kTimeStepRange; unset: resolveOptions() picks it
+  double settleTime = 2.0;   ///< [s] settling phase before the controller starts, in kSettleTimeRange
+  double outputRate = 60.0;  ///< [Hz] metrics and recording rate, in kOutputRateRange
+  double recordSeconds = 300.0;  ///< [s] recorder window (older frames dropped); 0 = unlimited
 };
 
 /// What a run takes where its options leave the choice to the model, the integrator or the controller.
 struct ResolvedOptions {
-  double kappa = 0.0;  ///< [Pa] gut bulk modulus of Eq. 4: effectiveKappa(), StepOptions::kappa else Model::gut.kappa
-  double dt = 0.0;     ///< [s] SimulationOptions::dt, else min(defaultTimeStep(integrator), maxTimeStep)
+  double kappa =
+      0.0;  ///< [Pa] gut bulk modulus of Eq. 4: effectiveKappa(), StepOptions::kappa else Model::gut.kappa
+  double dt = 0.0;  ///< [s] SimulationOptions::dt, else min(defaultTimeStep(integrator), maxTimeStep)
 };
 
-/// The one place where unset options get their values: the Simulation, the CLI (simulate, bench) and the app's
-/// parameter panel all call it. `maxTimeStep` [s] is the controller's Controller::maxTimeStep() (infinity for
-/// an open-loop controller): a feedback controller tuned at a step caps the default one, never a given dt.
+/// The one place where unset options get their values: the Simulation, the CLI (simulate, bench) and the
+/// app's parameter panel all call it. `maxTimeStep` [s] is the controller's Controller::maxTimeStep()
+/// (infinity for an open-loop controller): a feedback controller tuned at a step caps the default one, never
+/// a given dt.
 ResolvedOptions resolveOptions(const Model& model, const SimulationOptions& options,
                                double maxTimeStep = std::numeric_limits<double>::infinity());
 
@@ -151,7 +153,7 @@ class Simulation {
   std::shared_ptr<const Model> m_model;
   std::unique_ptr<Controller> m_controller;
   SimulationOptions m_options;
-  double m_dt = 0.0;            // [s]
+  double m_dt = 0.0;  // [s]
   State m_state;
   StepWork m_work;
   Activations m_activations{};
@@ -160,8 +162,8 @@ class Simulation {
   long long m_frameIndex = 0;   // output frames emitted since reset()
   long long m_traceStride = 1;  // the trace records frames whose index is a multiple of this
   Recorder m_recorder;
-  double m_nextFrameTime = 0.0; // [s]
-  double m_wallSeconds = 0.0;   // [s] wall-clock time spent stepping, measuring and recording
+  double m_nextFrameTime = 0.0;     // [s]
+  double m_wallSeconds = 0.0;       // [s] wall-clock time spent stepping, measuring and recording
   double m_simulatedSeconds = 0.0;  // [s] simulated while timed
   const std::atomic<bool>* m_stopFlag = nullptr;  // checked before every step of advance(); may be null
   bool m_wasStopped = false;

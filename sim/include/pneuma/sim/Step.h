@@ -14,18 +14,17 @@
 /// a step works with into model constants, the solver memory a restart saves with the State, scratch and
 /// outputs.
 
+#include <Eigen/Core>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
 #include "pneuma/sim/Activation.h"
 #include "pneuma/sim/BlockLdlt.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/State.h"
-
-#include <Eigen/Core>
-
-#include <array>
-#include <optional>
-#include <string>
-#include <vector>
 
 namespace pneuma::sim {
 
@@ -39,9 +38,10 @@ std::string integratorNames();
 /// Inverse of integratorName(); returns false when unknown.
 bool integratorFromName(const std::string& name, IntegratorKind& out);
 /// Default time step [s] of each integrator: stable on the default model (see the validation tests).
-/// symplectic-euler 10 us (the paper's explicit scheme needs it for the stiffest spring); implicit-euler-joints
-/// 1/60 s, one step per 60 Hz display and output frame: with the smoothed diaphragm step the breath styles' tidal
-/// volumes agree within 1 % with dt 5 ms (docs/validation figures), and it is the real-time factor's budget.
+/// symplectic-euler 10 us (the paper's explicit scheme needs it for the stiffest spring);
+/// implicit-euler-joints 1/60 s, one step per 60 Hz display and output frame: with the smoothed diaphragm
+/// step the breath styles' tidal volumes agree within 1 % with dt 5 ms (docs/validation figures), and it is
+/// the real-time factor's budget.
 double defaultTimeStep(IntegratorKind k);
 
 /// The body's posture: which way gravity points in the body (model) frame, RAS (+x right, +y anterior,
@@ -65,28 +65,34 @@ bool postureFromName(const std::string& name, Posture& out);
 /// Per-run physical switches and solver settings.
 struct StepOptions {
   IntegratorKind integrator = IntegratorKind::ImplicitEulerJoints;
-  bool gravity = true;                ///< apply gravity (postureGravity()) to bodies and nodes
-  Posture posture = Posture::Upright; ///< direction of gravity relative to the body
-  double jointFrictionScale = 1.0;    ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
-  double gutDragScale = 1.0;          ///< [-] multiplies the visceral drag Model::gut.drag; 0 = none
-  std::optional<double> kappa;        ///< [Pa] gut bulk modulus of Eq. 4, > 0; unset: Model::gut.kappa
-  std::array<double, kElementGroupCount> activeGainScale{1, 1, 1, 1, 1, 1};   ///< [-] multiplies kac per group
-  std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kpe and b per group
-  int jointIterations = 30;           ///< [-] max Gauss-Seidel sweeps of the joint solver
-  double jointTolerance = 1e-5;       ///< [m] position projection stops below this joint error
-  int cgMaxIterations = 200;          ///< [-] implicit Euler: max CG iterations (typically 0-8; up to ~90 in the step
-                                      ///< where many muscles go slack at once, before the refactorization)
-  int preconditionerRefresh = 10;     ///< [-] implicit Euler: refactor the preconditioner at least every n steps
-  int refactorIterations = 4;         ///< [-] implicit Euler: refactor when the last solve needed more CG iterations
-  int refactorElementChanges = 4;     ///< [-] implicit Euler: refactor when the 3x3 stiffness of more elements changed
-                                      ///< by a quarter (slack/taut, activation, rotation) since the last factorization
-  double cgTolerance = 1e-2;          ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm);
-                                      ///< 1e-2 changes validate figures by at most 0.3 % against 1e-4 (docs/cli.md)
+  bool gravity = true;                 ///< apply gravity (postureGravity()) to bodies and nodes
+  Posture posture = Posture::Upright;  ///< direction of gravity relative to the body
+  double jointFrictionScale = 1.0;     ///< [-] multiplies every joint's mu (Eq. 3); 0 = frictionless
+  double gutDragScale = 1.0;           ///< [-] multiplies the visceral drag Model::gut.drag; 0 = none
+  std::optional<double> kappa;         ///< [Pa] gut bulk modulus of Eq. 4, > 0; unset: Model::gut.kappa
+  std::array<double, kElementGroupCount> activeGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kac per group
+  std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1,
+                                                          1, 1, 1};  ///< [-] multiplies kpe and b per group
+  int jointIterations = 30;      ///< [-] max Gauss-Seidel sweeps of the joint solver
+  double jointTolerance = 1e-5;  ///< [m] position projection stops below this joint error
+  int cgMaxIterations = 200;  ///< [-] implicit Euler: max CG iterations (typically 0-8; up to ~90 in the step
+                              ///< where many muscles go slack at once, before the refactorization)
+  int preconditionerRefresh = 10;  ///< [-] implicit Euler: refactor the preconditioner at least every n steps
+  int refactorIterations = 4;  ///< [-] implicit Euler: refactor when the last solve needed more CG iterations
+  int refactorElementChanges =
+      4;  ///< [-] implicit Euler: refactor when the 3x3 stiffness of more elements changed
+          ///< by a quarter (slack/taut, activation, rotation) since the last factorization
+  double cgTolerance =
+      1e-2;  ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm);
+             ///< 1e-2 changes validate figures by at most 0.3 % against 1e-4 (docs/cli.md)
 };
 
-/// [Pa] The gut's bulk modulus kappa of Eq. 4 a step uses: StepOptions::kappa when set, else Model::gut.kappa.
-/// The one rule for it; resolveOptions() (Simulation.h) reports it with the time step to the CLI and the app.
-inline double effectiveKappa(const Model& model, const StepOptions& o) { return o.kappa.value_or(model.gut.kappa); }
+/// [Pa] The gut's bulk modulus kappa of Eq. 4 a step uses: StepOptions::kappa when set, else
+/// Model::gut.kappa. The one rule for it; resolveOptions() (Simulation.h) reports it with the time step to
+/// the CLI and the app.
+inline double effectiveKappa(const Model& model, const StepOptions& o) {
+  return o.kappa.value_or(model.gut.kappa);
+}
 
 /// [m/s^2] The gravity a run applies, in the body frame: zero when `o.gravity` is off, else Model::gravity
 /// (the upright gravity) turned by a quarter turn for the lying postures, g = R(o.posture) Model::gravity:
@@ -102,11 +108,11 @@ void validateStepOptions(const StepOptions& o);
 /// the endpoint classification, the joint tree and the sparsity of the implicit system. Never written while
 /// stepping.
 struct StepConstants {
-  double restGutVolume = 0.0;          ///< [m^3] V0, gut volume at the rest pose
+  double restGutVolume = 0.0;                                 ///< [m^3] V0, gut volume at the rest pose
   Eigen::Vector3d restGutCentroid = Eigen::Vector3d::Zero();  ///< [m] centroid of the gut nodes at rest
   /// gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
   Eigen::Matrix3Xi wallTriangles;
-  double restCavityVolume = 0.0;       ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
+  double restCavityVolume = 0.0;  ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
   /// body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
   Eigen::Matrix2Xi endpointBody;
   /// the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
@@ -115,11 +121,11 @@ struct StepConstants {
   Eigen::VectorXi fixedDofs;
   /// [1/(kg m^2)] I^-1 in the body frame, zero for fixed bodies (#B)
   std::vector<Eigen::Matrix3d> inverseInertiaBody;
-  Eigen::Matrix3Xd jointLocalParent;   ///< [m] joint anchor in the parent's body frame (3 x #J)
-  Eigen::Matrix3Xd jointLocalChild;    ///< [m] joint anchor in the child's body frame (3 x #J)
-  std::vector<int> treeJoints;         ///< joints solved exactly by the implicit step, parents first (#tree)
-  std::vector<int> attachedNodes;      ///< nodes sharing an element with a body (#attached)
-  Eigen::VectorXi attachedColumn;      ///< node -> its index in attachedNodes, or -1 (#N)
+  Eigen::Matrix3Xd jointLocalParent;  ///< [m] joint anchor in the parent's body frame (3 x #J)
+  Eigen::Matrix3Xd jointLocalChild;   ///< [m] joint anchor in the child's body frame (3 x #J)
+  std::vector<int> treeJoints;        ///< joints solved exactly by the implicit step, parents first (#tree)
+  std::vector<int> attachedNodes;     ///< nodes sharing an element with a body (#attached)
+  Eigen::VectorXi attachedColumn;     ///< node -> its index in attachedNodes, or -1 (#N)
   /// (row, col) of the 3 x 3 blocks of bodyBlock that can be nonzero, first entries in free coordinates,
   /// lower triangle (2 x #blocks)
   Eigen::Matrix2Xi bodyEntries;
@@ -128,16 +134,16 @@ struct StepConstants {
   Eigen::Matrix3Xi couplingEntries;
   /// implicit solver entry -> free coordinate, or -1 (fixed or dependent)
   Eigen::VectorXi freeIndex;
-  Eigen::VectorXi freeCoordinates;     ///< free coordinate -> implicit solver entry (#free)
+  Eigen::VectorXi freeCoordinates;  ///< free coordinate -> implicit solver entry (#free)
   /// SolverMemory::system's value slot of every streamed 3 x 3 block, -1 if dropped (see StepImplicit.cpp)
   std::vector<int> systemPattern;
 };
 
 /// What the implicit solver (ImplicitEulerJoints) carries from one step to the next: the preconditioner's
 /// factorization, the element stiffness it was made with, its age and dt, and the last solve's CG iterations,
-/// which together decide when it is refreshed. The next step depends on the State and on this, nothing else, so
-/// a restart that saves the State and this continues bit-identically (Simulation::checkpoint(), Checkpoint.h). Empty
-/// (hasFactorization false) in a fresh StepWork: the first implicit step then factors.
+/// which together decide when it is refreshed. The next step depends on the State and on this, nothing else,
+/// so a restart that saves the State and this continues bit-identically (Simulation::checkpoint(),
+/// Checkpoint.h). Empty (hasFactorization false) in a fresh StepWork: the first implicit step then factors.
 struct SolverMemory {
   bool hasFactorization = false;  ///< a factorization is held (false until the first implicit step)
   /// the preconditioner's matrix A0 and its factorization (#free / 3 blocks square); its symbolic analysis is
@@ -145,18 +151,18 @@ struct SolverMemory {
   BlockLdlt system;
   /// [kg^1/2] u = dt sqrt(kappa V0) / V g over the free coordinates, at the factorization
   Eigen::VectorXd rankOne;
-  Eigen::VectorXd rankOneSolve;        ///< [1/kg^1/2] A0^-1 u (#free)
-  double rankOneScale = 1.0;           ///< [-] 1 / (1 + u^T A0^-1 u)
+  Eigen::VectorXd rankOneSolve;  ///< [1/kg^1/2] A0^-1 u (#free)
+  double rankOneScale = 1.0;     ///< [-] 1 / (1 + u^T A0^-1 u)
   /// [kg^1/2] v = dt J^T g_c / sqrt(C) over the free coordinates, the pleural stiffness at the factorization;
   /// empty when it had none
   Eigen::VectorXd rankTwo;
-  Eigen::VectorXd rankTwoSolve;        ///< [1/kg^1/2] (A0 + u u^T)^-1 v (#free)
-  double rankTwoScale = 1.0;           ///< [-] 1 / (1 + v^T (A0 + u u^T)^-1 v)
-  double factorDt = 0.0;               ///< [s] dt of the factorization
-  Eigen::VectorXd factorAxial;         ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
-  Eigen::VectorXd factorTransverse;    ///< [kg] dt^2 |F| / l at the factorization (#E)
-  Eigen::Matrix3Xd factorDirection;    ///< [-] elementDirection at the factorization (3 x #E)
-  int factorAge = 0;                   ///< [-] steps solved with the current factorization
+  Eigen::VectorXd rankTwoSolve;      ///< [1/kg^1/2] (A0 + u u^T)^-1 v (#free)
+  double rankTwoScale = 1.0;         ///< [-] 1 / (1 + v^T (A0 + u u^T)^-1 v)
+  double factorDt = 0.0;             ///< [s] dt of the factorization
+  Eigen::VectorXd factorAxial;       ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
+  Eigen::VectorXd factorTransverse;  ///< [kg] dt^2 |F| / l at the factorization (#E)
+  Eigen::Matrix3Xd factorDirection;  ///< [-] elementDirection at the factorization (3 x #E)
+  int factorAge = 0;                 ///< [-] steps solved with the current factorization
   /// [-] CG iterations of the last implicit step (0 after a refactorization)
   int cgIterations = 0;
 };
@@ -254,8 +260,8 @@ void step(const Model& model, State& state, double dt, const Activations& act, c
 
 /// Metrics of `state` (lung and gut volume, element forces of the last step, energies, landmarks).
 /// Element forces come from `work.outputs` (the last step); call after step().
-void computeMetrics(const Model& model, const State& state, const Activations& act, const StepOptions& options,
-                    const StepWork& work, Metrics& out);
+void computeMetrics(const Model& model, const State& state, const Activations& act,
+                    const StepOptions& options, const StepWork& work, Metrics& out);
 
 /// Checks `state` for NaN/Inf and blow-up (speeds above 100 m/s, joint error above 1 cm).
 /// @throws Error naming the time, the body / node / element and a likely cause, e.g.

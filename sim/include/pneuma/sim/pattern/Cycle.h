@@ -34,20 +34,25 @@ struct Keyframe {
 /// Parameters of a cycle, as written in a pattern file (docs/patterns.md).
 struct CycleSpec {
   CycleKind kind = CycleKind::Linear;
-  bool isRelative = true;              ///< relative: time-warped to `rate`; absolute: keyframe times in [s]
-  double rate = 15.0;                  ///< [breaths/min] relative cycles only; in kBreathRateRange (Limits.h)
-  double depthMin = 0.05;              ///< [-] volume fraction at shape 0, in [0, 1]
-  double depthMax = 0.25;              ///< [-] volume fraction at shape 1, in [depthMin, 1]
-  double ieRatio = 1.0 / 1.5;          ///< [-] inspiration:expiration duration ratio, > 0; generated shapes only
-  double postInspiratoryPause = 0.0;   ///< [s] hold at the peak before expiration, >= 0
-  double postExpiratoryPause = 0.0;    ///< [s] hold at the end of expiration, >= 0
-  double rateIrregularity = 0.0;       ///< [-] half-width of the uniform relative variation of the moving duration, [0, 0.5]
-  double depthIrregularity = 0.0;      ///< [-] half-width of the uniform relative variation of depthMax - depthMin, [0, 0.5]
-  double balance = 0.5;                ///< [-] thoraco-abdominal balance: 0 all abdomen (diaphragm), 1 all chest (intercostals)
-  std::vector<Keyframe> keyframes;     ///< explicit shape; required for `keyframe`, optional for `spline`, none for `linear`
+  bool isRelative = true;      ///< relative: time-warped to `rate`; absolute: keyframe times in [s]
+  double rate = 15.0;          ///< [breaths/min] relative cycles only; in kBreathRateRange (Limits.h)
+  double depthMin = 0.05;      ///< [-] volume fraction at shape 0, in [0, 1]
+  double depthMax = 0.25;      ///< [-] volume fraction at shape 1, in [depthMin, 1]
+  double ieRatio = 1.0 / 1.5;  ///< [-] inspiration:expiration duration ratio, > 0; generated shapes only
+  double postInspiratoryPause = 0.0;  ///< [s] hold at the peak before expiration, >= 0
+  double postExpiratoryPause = 0.0;   ///< [s] hold at the end of expiration, >= 0
+  double rateIrregularity =
+      0.0;  ///< [-] half-width of the uniform relative variation of the moving duration, [0, 0.5]
+  double depthIrregularity =
+      0.0;  ///< [-] half-width of the uniform relative variation of depthMax - depthMin, [0, 0.5]
+  double balance =
+      0.5;  ///< [-] thoraco-abdominal balance: 0 all abdomen (diaphragm), 1 all chest (intercostals)
+  std::vector<Keyframe>
+      keyframes;  ///< explicit shape; required for `keyframe`, optional for `spline`, none for `linear`
 };
 
-/// Checks a spec. @throws Error naming the field, e.g. "depth: min 0.4 > max 0.2" or "keyframes[2].time: ...".
+/// Checks a spec. @throws Error naming the field, e.g. "depth: min 0.4 > max 0.2" or "keyframes[2].time:
+/// ...".
 void validateCycle(const CycleSpec& spec);
 
 /// The random draw for one breath: both factors are 1 for a regular breath.

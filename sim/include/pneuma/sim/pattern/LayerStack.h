@@ -13,13 +13,13 @@
 /// Irregularity draws one BreathVariation per breath from a SplitMix64 stream seeded explicitly; the same
 /// seed and the same pushes give bit-identical volumes.
 
-#include "pneuma/sim/pattern/Cycle.h"
-#include "pneuma/sim/pattern/SplitMix64.h"
-
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "pneuma/sim/pattern/Cycle.h"
+#include "pneuma/sim/pattern/SplitMix64.h"
 
 namespace pneuma::sim {
 class CheckpointWriter;
@@ -33,7 +33,7 @@ constexpr int kInfinite = -1;
 
 /// One respiration layer.
 struct Layer {
-  std::string name;        ///< for display and CSV/plots, e.g. "sigh"
+  std::string name;  ///< for display and CSV/plots, e.g. "sigh"
   CycleSpec cycle;
   int repetitions = kInfinite;  ///< number of breaths before the layer pops, >= 1, or kInfinite
 };
@@ -56,8 +56,10 @@ class LayerStack {
   explicit LayerStack(std::uint64_t seed = 0);
 
   /// Pushes `playOrder` (first entry plays first, i.e. ends on top) to take effect at time `atTime` [s]
-  /// (default: the time of the last sample) in the given mode. Pushes due at the same time apply in call order.
-  /// @throws Error when a layer is invalid (the message names "layers[i].<field>") or a repetition count is < 1.
+  /// (default: the time of the last sample) in the given mode. Pushes due at the same time apply in call
+  /// order.
+  /// @throws Error when a layer is invalid (the message names "layers[i].<field>") or a repetition count is
+  /// < 1.
   void push(const std::vector<Layer>& playOrder, SwitchMode mode,
             double atTime = -std::numeric_limits<double>::infinity());
 
@@ -103,27 +105,27 @@ class LayerStack {
     std::vector<Active> layers;  // play order, validated
   };
 
-  double evaluate(double t) const;                      // volume at t with the current state, no transitions
-  void startBreath(double t, double fromVolume);        // start a new breath of the top layer at t
-  void pushNow(const std::vector<Active>& layers);      // place layers on top (first entry on top)
-  void endBreath(double t);                             // completes the top breath at t: next breath, push or pop
+  double evaluate(double t) const;                  // volume at t with the current state, no transitions
+  void startBreath(double t, double fromVolume);    // start a new breath of the top layer at t
+  void pushNow(const std::vector<Active>& layers);  // place layers on top (first entry on top)
+  void endBreath(double t);                         // completes the top breath at t: next breath, push or pop
 
   SplitMix64 m_random;
-  std::vector<Active> m_layers;         // bottom first, top last
-  std::vector<Pending> m_scheduled;     // due in the future, sorted by time (stable)
-  std::vector<Pending> m_atCycleEnd;    // due, waiting for the end of the current breath
-  double m_time = 0.0;                  // [s] last sample
-  double m_volume = 0.0;                // [-] volume at m_time
-  double m_hold = 0.0;                  // [-] volume held while nothing plays
-  bool m_hasVolume = false;             // false until a breath started or setStartVolume(): the first breath
-                                        // then starts without cross-fade
+  std::vector<Active> m_layers;       // bottom first, top last
+  std::vector<Pending> m_scheduled;   // due in the future, sorted by time (stable)
+  std::vector<Pending> m_atCycleEnd;  // due, waiting for the end of the current breath
+  double m_time = 0.0;                // [s] last sample
+  double m_volume = 0.0;              // [-] volume at m_time
+  double m_hold = 0.0;                // [-] volume held while nothing plays
+  bool m_hasVolume = false;           // false until a breath started or setStartVolume(): the first breath
+                                      // then starts without cross-fade
   // the playing breath
-  double m_breathStart = 0.0;           // [s]
+  double m_breathStart = 0.0;  // [s]
   BreathVariation m_variation;
   // cross-fade from a held volume
-  double m_blendFrom = 0.0;             // [-] volume held at the switch
-  double m_blendStart = 0.0;            // [s]
-  double m_blendDuration = 0.0;         // [s] 0 when not blending
+  double m_blendFrom = 0.0;      // [-] volume held at the switch
+  double m_blendStart = 0.0;     // [s]
+  double m_blendDuration = 0.0;  // [s] 0 when not blending
 };
 
 }  // namespace pneuma::sim::pattern

@@ -33,16 +33,16 @@
 /// Zordan's binary alpha with a varying r, alpha is graded and r fixed (contractionR): force then grows
 /// with the command and an idle antagonist adds no stiffness, which a feedback loop needs.
 
-#include "pneuma/sim/Controller.h"
-#include "pneuma/sim/Simulation.h"
-#include "pneuma/sim/pattern/Pattern.h"
-
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "pneuma/sim/Controller.h"
+#include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 namespace pneuma::sim::pattern {
 
@@ -61,15 +61,15 @@ using GroupResponse = std::array<double, kCalibrationAlphas.size()>;
 
 /// Static response of a model to each muscle group, and the volume mapping.
 struct DriveCalibration {
-  double restVolume = 0.0;        ///< [m^3] V_rest; 0 = take the settled volume when control starts
+  double restVolume = 0.0;            ///< [m^3] V_rest; 0 = take the settled volume when control starts
   double volumePerFraction = 2.5e-3;  ///< [m^3] S, lung volume per unit volume fraction
-  double restFraction = 0.05;     ///< [-] v_rest, the fraction the relaxed torso represents
+  double restFraction = 0.05;         ///< [-] v_rest, the fraction the relaxed torso represents
   /// R_g: per ElementGroup, the volume-fraction change with that group alone held at each of
   /// kCalibrationAlphas (r = contractionR), positive when the group raises the volume. Inspiratory
   /// groups (external intercostals, diaphragm) should raise it, expiratory ones lower it; a group
   /// acting the other way is not used. Linear interpolation between the levels.
   std::array<GroupResponse, kElementGroupCount> response{};
-  double contractionR = 0.6;      ///< [-] r of every driven group (Eq. 2)
+  double contractionR = 0.6;  ///< [-] r of every driven group (Eq. 2)
   /// [s] tau_g: per ElementGroup, the time constant of the lung volume's answer to a step of that
   /// group's activation, identified on the calibration staircase (0 = an instantaneous group); the
   /// controller's feed-forward asks tau_g dv_T/dt ahead of the target. In [0, 10) s.
@@ -88,17 +88,17 @@ struct PatternControllerOptions {
   /// 12 %). K_p 2 / 1.5 / 1 / 0.7 give focus 11.7 / 8.6 / 4.9 / 4.0 % and panic 9.2 / 8.0 / 5.2 / 4.8 %,
   /// with every hold within 0.8 % (pneuma_sim_pattern_tracking_test); K_i 100 /s carries the slow lag.
   double kp = 1.0;
-  double ki = 100.0;              ///< [1/s] integral gain
-  double integralLimit = 0.2;     ///< [-] clamp of the integral term I, in fraction units
+  double ki = 100.0;                 ///< [1/s] integral gain
+  double integralLimit = 0.2;        ///< [-] clamp of the integral term I, in fraction units
   double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
 };
 
 /// Target-versus-measured statistics over the frames seen after control started.
 struct TrackingStats {
-  long long frames = 0;           ///< [-] frames compared
-  double sumSquaredError = 0.0;   ///< [-] sum of (v_T - v_M)^2
-  double targetMin = 1.0;         ///< [-]
-  double targetMax = 0.0;         ///< [-]
+  long long frames = 0;          ///< [-] frames compared
+  double sumSquaredError = 0.0;  ///< [-] sum of (v_T - v_M)^2
+  double targetMin = 1.0;        ///< [-]
+  double targetMax = 0.0;        ///< [-]
   /// [%] RMS error as a percentage of the target's peak-to-peak (0 when nothing was compared).
   double rmsPercentOfPeakToPeak() const;
 };
@@ -114,7 +114,8 @@ struct TrackingStats {
 /// settles within the level.
 /// The first group's baseline is V_rest. 5 x 9 s of simulated time, about 8 s of wall time on the
 /// default model.
-/// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run; an unset dt
+/// @param options  simulation options (integrator, dt, settleTime, gain scales) to use for the run; an unset
+/// dt
 ///                 steps at kDriveTimeStep, as the drive itself
 /// @param stop     checked before every step (Simulation::setStopFlag()); may be null
 /// @throws Interrupted when `*stop` became true before the calibration finished.
@@ -163,33 +164,34 @@ class PatternController : public Controller {
  private:
   // demand d [-], target rate [1/s] and balance b [-] -> alphas
   Activations distribute(double demand, double rate, double balance) const;
-  void restart();                                               // back to the state at construction
+  void restart();  // back to the state at construction
 
   LayerStack m_stack;
-  LayerStack m_initialStack;       // for restart()
+  LayerStack m_initialStack;  // for restart()
   DriveCalibration m_calibration;
   DriveCalibration m_givenCalibration;  // as passed in (restVolume may be learned later)
   PatternControllerOptions m_options;
   std::string m_description;
-  bool m_isControlling = false;   // false during settling (t = 0 calls)
-  double m_restVolumeSeen = 0.0;  // [m^3] latest lung volume seen while settling
-  double m_lastTime = 0.0;        // [s] control time of the last call
-  double m_startTime = 0.0;       // [s] control time at which control (and the pattern clock) started
-  double m_lastFrameTime = -1.0;  // [s] Metrics::time of the last frame used
+  bool m_isControlling = false;         // false during settling (t = 0 calls)
+  double m_restVolumeSeen = 0.0;        // [m^3] latest lung volume seen while settling
+  double m_lastTime = 0.0;              // [s] control time of the last call
+  double m_startTime = 0.0;             // [s] control time at which control (and the pattern clock) started
+  double m_lastFrameTime = -1.0;        // [s] Metrics::time of the last frame used
   double m_lastFrameControlTime = 0.0;  // [s] control time at which that frame arrived
-  double m_target = 0.0;          // [-] v_T at m_lastTime
-  double m_targetRate = 0.0;      // [1/s] dv_T/dt, backward difference over the last step
-  double m_measured = 0.0;        // [-] v_M of the last frame
-  double m_error = 0.0;           // [-] e of the last frame
-  double m_integral = 0.0;        // [-] I = ki * integral(e dt), clamped
-  double m_balance = 0.5;         // [-] smoothed balance
+  double m_target = 0.0;                // [-] v_T at m_lastTime
+  double m_targetRate = 0.0;            // [1/s] dv_T/dt, backward difference over the last step
+  double m_measured = 0.0;              // [-] v_M of the last frame
+  double m_error = 0.0;                 // [-] e of the last frame
+  double m_integral = 0.0;              // [-] I = ki * integral(e dt), clamped
+  double m_balance = 0.5;               // [-] smoothed balance
   TrackingStats m_tracking;
 };
 
 /// A PatternController playing the affect preset NAME from `resourceDir` (resources/) on `model`.
 /// @throws Error "unknown affect 'NAME' (valid: ...)" or a preset/calibration error.
-std::unique_ptr<PatternController> makeAffectController(const std::string& name, const std::string& resourceDir,
-                                                        std::uint64_t seed, const DriveCalibration& calibration);
+std::unique_ptr<PatternController> makeAffectController(const std::string& name,
+                                                        const std::string& resourceDir, std::uint64_t seed,
+                                                        const DriveCalibration& calibration);
 
 /// A PatternController playing a pattern file (layers and timeline) on `model`.
 std::unique_ptr<PatternController> makePatternController(const Pattern& pattern, std::uint64_t seed,
