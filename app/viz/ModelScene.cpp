@@ -324,10 +324,11 @@ struct ModelScene::Impl {
       bodyPose.push_back(pose);
     }
 
-    // muscle elements by group
+    // muscle elements by group; the apposition springs (the pleural fluid's hold) are not drawn
     for (int e = 0; e < model.elements.size(); ++e)
-      groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(
-          e);
+      if (!sim::isApposition(model.elements, e))
+        groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(
+            e);
     for (int gi = 0; gi < kGroups; ++gi) {
       Group& g = groups[static_cast<std::size_t>(gi)];
       const int n = static_cast<int>(g.element.size());

@@ -174,6 +174,8 @@ struct VtkSeriesWriter::Impl {
     group->SetName("group");
     vtkNew<vtkUnsignedCharArray> slack;
     slack->SetName("is_slack");
+    vtkNew<vtkUnsignedCharArray> apposition;  // 1: an apposition spring, anchored beyond the rib face
+    apposition->SetName("is_apposition");
     for (int e = 0; e < el.size(); ++e) {
       x.col(2 * e) = a.col(e);
       x.col(2 * e + 1) = b.col(e);
@@ -183,6 +185,7 @@ struct VtkSeriesWriter::Impl {
       force->SetValue(e, f);
       tension->SetValue(e, f < 0.0 ? -f : 0.0);
       group->InsertNextValue(static_cast<int>(el.group[static_cast<std::size_t>(e)]));
+      apposition->InsertNextValue(sim::isApposition(el, e) ? 1 : 0);
       slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size()
                                  ? metrics.isSlack[static_cast<std::size_t>(e)]
                                  : 0);
@@ -193,6 +196,7 @@ struct VtkSeriesWriter::Impl {
     pd->GetCellData()->AddArray(force);
     pd->GetCellData()->AddArray(tension);
     pd->GetCellData()->AddArray(group);
+    pd->GetCellData()->AddArray(apposition);
     pd->GetCellData()->AddArray(slack);
     return pd;
   }
