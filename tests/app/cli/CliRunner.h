@@ -77,6 +77,22 @@ inline CliResult runCli(const std::vector<std::string>& args, double sigintAfter
   return runProgram("pneuma-cli", args, sigintAfterSeconds, env);
 }
 
+/// Runs pneuma-cli with `args` into an --out that holds an earlier run's `file` (its path in `out`): expects
+/// the run refused with exit 2, naming the file and asking for --force, and the file untouched; then reruns
+/// with --force and returns that result.
+inline CliResult runReplacingEarlierRun(std::vector<std::string> args, const std::string& out,
+                                        const std::string& file) {
+  const std::string before = slurp(out + "/" + file);
+  const CliResult refused = runCli(args);
+  EXPECT_EQ(refused.exitCode, 2) << refused.err;
+  EXPECT_NE(refused.err.find("holds an earlier run (" + file + "); add --force to replace it"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_EQ(slurp(out + "/" + file), before);
+  args.push_back("--force");
+  return runCli(args);
+}
+
 /// Number of lines in `s` (a final line without newline counts).
 inline int lineCount(const std::string& s) {
   int n = 0;

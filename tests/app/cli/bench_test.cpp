@@ -8,6 +8,7 @@
 
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
+using pneuma::test::runReplacingEarlierRun;
 using pneuma::test::slurp;
 using pneuma::test::toyModelDir;
 
@@ -18,14 +19,7 @@ TEST(CliBench, ReportsEveryStyleAndIncreasingElementCounts) {
   std::ofstream(out + "/bench.json") << "earlier";
   const std::vector<std::string> args = {"bench",     "--model", toyModelDir(), "--seconds", "0.3",
                                          "--posture", "supine",  "--out",       out};
-  auto r = runCli(args);
-  EXPECT_EQ(r.exitCode, 2) << r.err;
-  EXPECT_NE(r.err.find("holds an earlier run (bench.json); add --force to replace it"), std::string::npos)
-      << r.err;
-  EXPECT_EQ(slurp(out + "/bench.json"), "earlier");
-  std::vector<std::string> forced = args;
-  forced.push_back("--force");
-  r = runCli(forced);
+  const auto r = runReplacingEarlierRun(args, out, "bench.json");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/bench.json"));
   EXPECT_EQ(j["posture"], "supine");

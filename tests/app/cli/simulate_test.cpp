@@ -17,6 +17,7 @@
 
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
+using pneuma::test::runReplacingEarlierRun;
 using pneuma::test::slurp;
 using pneuma::test::toyModelDir;
 namespace fs = std::filesystem;
@@ -276,15 +277,9 @@ TEST(CliSimulate, EarlierRunIsReplacedOnlyWithForce) {
       "simulate", "--model", toyModelDir(),   "--style", "calm",  "--duration", "0.5",
       "--settle", "0",       "--output-rate", "10",      "--out", out};
   ASSERT_EQ(runCli(run).exitCode, 0);
-  const std::string first = slurp(out + "/summary.json");
   std::vector<std::string> again = run;
   again[6] = "1";  // a different run
-  auto r = runCli(again);
-  EXPECT_EQ(r.exitCode, 2);
-  EXPECT_NE(r.err.find("holds an earlier run (summary.json); add --force"), std::string::npos) << r.err;
-  EXPECT_EQ(slurp(out + "/summary.json"), first);
-  again.push_back("--force");
-  r = runCli(again);
+  const auto r = runReplacingEarlierRun(again, out, "summary.json");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/summary.json"))["duration_s"].get<double>(), 1.0);
 }

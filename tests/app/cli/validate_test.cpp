@@ -9,6 +9,7 @@
 
 using pneuma::test::freshOutDir;
 using pneuma::test::runCli;
+using pneuma::test::runReplacingEarlierRun;
 using pneuma::test::slurp;
 using pneuma::test::toyModelDir;
 
@@ -19,14 +20,7 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
   std::ofstream(out + "/report.json") << "earlier";
   const std::vector<std::string> args = {"validate", "--quick",     "--dt",  "0.002",
                                          "--model",  toyModelDir(), "--out", out};
-  auto r = runCli(args);
-  EXPECT_EQ(r.exitCode, 2) << r.err;
-  EXPECT_NE(r.err.find("holds an earlier run (report.json); add --force to replace it"), std::string::npos)
-      << r.err;
-  EXPECT_EQ(slurp(out + "/report.json"), "earlier");
-  std::vector<std::string> forced = args;
-  forced.push_back("--force");
-  r = runCli(forced);
+  const auto r = runReplacingEarlierRun(args, out, "report.json");
   ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 1) << r.err;
 
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/report.json"));
