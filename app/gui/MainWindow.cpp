@@ -75,6 +75,27 @@ const std::vector<std::pair<const char*, sim::pattern::SwitchMode>> kAffectModes
     {"at end of cycle", sim::pattern::SwitchMode::EndOfCycle},
     {"immediately", sim::pattern::SwitchMode::Immediate}};
 
+// the Breathing read-out: the last breaths' figures (sim::Summary, SI) in people's units, one per line; a
+// figure the breath does not define (a landmark the model lacks) reads "n/a"
+QString breathingText(const sim::Summary* b) {
+  if (!b) return "Measured after the first full breath.";
+  auto value = [](double v, double scale, int decimals, const char* unit) {
+    return std::isfinite(v) ? QString("%1 %2").arg(v * scale, 0, 'f', decimals).arg(unit) : QString("n/a");
+  };
+  const sim::Motion& m = b->motion;
+  const double ribCageShare = m.ribCageTidal / b->tidalVolume;
+  return QStringList{QString("Tidal volume %1 at %2")
+                         .arg(value(b->tidalVolume, 1e6, 0, "mL"), value(b->breathsPerMinute, 1.0, 1, "b/m")),
+                     "Dome descent " + value(m.domeDescent, 1e3, 1, "mm"),
+                     "Rib 8 widening " + value(m.lowerRibExpansion, 1e3, 1, "mm"),
+                     "Sternum forward " + value(m.sternumAnterior, 1e3, 1, "mm") + ", up " +
+                         value(m.sternumCranial, 1e3, 1, "mm"),
+                     "Belly forward " + value(m.umbilicusAnterior, 1e3, 1, "mm"),
+                     "Rib cage share " + value(ribCageShare, 100.0, 0, "%"),
+                     "Rib cage-abdomen phase " + value(m.phaseAngle, 180.0 / M_PI, 0, "\u00b0")}
+      .join('\n');
+}
+
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make_unique<viz::ModelScene>()) {
@@ -316,6 +337,19 @@ void MainWindow::buildDocks() {
   // left: display options and parameters
   auto* display = new QWidget(this);
   auto* displayLayout = new QVBoxLayout(display);
+  // the last breaths' figures first: what a lecturer reads off
+  auto* breathingBox = new QGroupBox("Breathing", display);
+  breathingBox->setToolTip(
+      QString("The last breaths' figures (the last %1 s of the run after settling), measured as pneuma-cli "
+              "validate measures them: docs/cli.md")
+          .arg(kBreathingWindow, 0, 'f', 0));
+  auto* breathingLayout = new QVBoxLayout(breathingBox);
+  m_breathing = new QLabel(breathingBox);
+  m_breathing->setTextFormat(Qt::PlainText);
+  m_breathing->setText(breathingText(nullptr));
+  breathingLayout->addWidget(m_breathing);
+  displayLayout->addWidget(breathingBox);
+
   auto* camera = new QGroupBox("Camera", display);
   auto* cameraLayout = new QGridLayout(camera);
   const std::vector<std::pair<QString, viz::CameraPreset>> presets{{"Anterior", viz::CameraPreset::Anterior},
@@ -671,6 +705,8 @@ void MainWindow::refresh() {
   }
 }
 
+QString MainWindow::breathingReadout() const { return m_breathing->text(); }
+
 void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   m_shown = std::move(snapshot);
   const Snapshot& s = *m_shown;
@@ -694,6 +730,7 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
     m_playAction->setIcon(style()->standardIcon(QStyle::SP_MediaPlay));
   }
   updateTimeline();
+  m_breathing->setText(breathingText(s.breathing.get()));
 
   // keep the selection read-out live
   if (m_selected.kind != viz::Pick::Kind::None) select(m_selected);

@@ -88,6 +88,8 @@ class MainWindow : public QMainWindow {
   viz::ModelScene& scene() { return *m_scene; }
   LivePlots* plots() const { return m_plots; }
   ParameterPanel* parameters() const { return m_params; }
+  /// The Breathing read-out's text: the last breaths' figures in people's units (Snapshot::breathing).
+  QString breathingReadout() const;
   /// The snapshot on screen (null before the first one).
   const Snapshot* shown() const { return m_shown.get(); }
   const sim::Model* model() const { return m_document.model().get(); }
@@ -156,6 +158,7 @@ class MainWindow : public QMainWindow {
   std::vector<QCheckBox*> m_groupChecks;
   std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique
   QLabel* m_selection = nullptr;
+  QLabel* m_breathing = nullptr;  // Snapshot::breathing, in people's units
   QSlider* m_timeline = nullptr;
   QLabel* m_timeLabel = nullptr;
   QLabel* m_statusModel = nullptr;

@@ -119,6 +119,8 @@ void SimWorker::sync() {
     m_rtf = 0.0;
     m_samples.clear();
     ++m_generation;
+    m_breathing = nullptr;
+    m_breathingAt = -1.0;
   }
   // a new posture turns gravity: the run starts over from the rest pose and settles in it
   const bool isNewPosture = p.settings && p.settings->options.step.posture != m_settings.options.step.posture;
@@ -133,6 +135,8 @@ void SimWorker::sync() {
     m_runUntil = -1.0;
     m_samples.clear();
     ++m_generation;
+    m_breathing = nullptr;
+    m_breathingAt = -1.0;
   }
   if (p.speed) m_speed = *p.speed;
   if (p.runUntil) {
@@ -279,6 +283,16 @@ void SimWorker::publish(bool isScrubbed) {
     snap->recordedTo = rec.frame(rec.size() - 1).time;
   }
   snap->metrics = m_sim->latestMetrics();
+  // the last breaths' figures, once per simulated second
+  const double now = m_sim->state().time;
+  if (now < m_breathingAt || now >= m_breathingAt + 1.0) {
+    const double from = std::max(m_sim->options().settleTime, now - kBreathingWindow);
+    auto breathing =
+        std::make_shared<sim::Summary>(sim::summarize(m_sim->trace(), m_model->landmarks.name, from));
+    m_breathing = breathing->cycles > 0 ? std::move(breathing) : nullptr;
+    m_breathingAt = now;
+  }
+  snap->breathing = m_breathing;
   if (isScrubbed && !rec.empty()) {
     // the recorded frame nearest to the requested time, for display
     restoreRecorded(rec.indexAt(m_scrubTime), snap->state, snap->metrics);

@@ -55,7 +55,14 @@ struct Snapshot {
   double recordedFrom = 0.0;  ///< [s] oldest recorded frame
   double recordedTo = 0.0;    ///< [s] newest recorded frame
   long long generation = 0;   ///< increments on reset and model change: plots restart
+  /// The breath's figures over the last kBreathingWindow simulated seconds after settling (sim::summarize:
+  /// tidal volume, rate and the motion in anatomical axes), refreshed once per simulated second; null before
+  /// the first full breath.
+  std::shared_ptr<const sim::Summary> breathing;
 };
+
+/// [s] span of the run that Snapshot::breathing measures: two breaths at 10 b/m.
+constexpr double kBreathingWindow = 12.0;
 
 /// What the GUI takes from the worker at each display refresh.
 struct Frame {
@@ -157,6 +164,8 @@ class SimWorker : public QObject {
   double m_debt = 0.0;       // [s] simulated time owed to real-time pacing
   double m_rtf = 0.0;        // [-]
   long long m_generation = 0;
+  std::shared_ptr<const sim::Summary> m_breathing;  // Snapshot::breathing
+  double m_breathingAt = -1.0;                      // [s] simulated time it was measured at
   std::chrono::steady_clock::time_point m_lastTick;
   std::vector<PlotSample> m_samples;  // collected since the last publish
 

@@ -139,8 +139,9 @@ Resolution readResolution(const Reader& r) {
 
 Gains readGains(const Reader& r) {
   r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s",
-               "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o", "apposition_stiffness_fraction",
-               "intercostal_external_space_scale", "gut_wall_mass_kg", "diaphragm_mass_kg", "joints"});
+               "abdominal_wall_tone_upright", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
+               "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
+               "diaphragm_mass_kg", "joints"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -160,6 +161,9 @@ Gains readGains(const Reader& r) {
     groups.at("cartilage").at("kpe").fail("must be > 0 (cartilage holds the ribs to the sternum)");
   g.gutKappa = r.at("gut_kappa_pa").positiveAtMost(1e9);
   g.gutDrag = r.at("gut_drag_per_s").numberIn(0.0, 1e3);
+  // optional: no postural tone when absent
+  if (r.has("abdominal_wall_tone_upright"))
+    g.wallToneUpright = r.at("abdominal_wall_tone_upright").numberIn(0.0, 0.5);
   g.lungRecoil = r.at("lung_recoil_cmh2o").numberIn(0.0, 30.0) * kPaPerCmH2O;
   g.lungCompliance = r.at("lung_compliance_l_per_cmh2o").numberIn(0.0, 2.0) * 1e-3 / kPaPerCmH2O;
   g.appositionFraction = r.at("apposition_stiffness_fraction").numberIn(0.0, 10.0);

@@ -88,6 +88,7 @@ void buildGutNodes(const AnatomyParams& a, const GutSurface& g, BuiltModel& out)
   m.gut.triangles = g.triangles;
   m.gut.kappa = a.gains.gutKappa;
   m.gut.drag = a.gains.gutDrag;
+  m.gut.wallToneUpright = a.gains.wallToneUpright;
 
   // tetrahedralise the enclosed volume and check it against the surface volume
   TriangleMesh surface{g.rest, g.triangles};

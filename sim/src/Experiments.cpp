@@ -147,10 +147,12 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
       out.push_back(check("panting.below_calm", "tidal volume calm minus panting", "> 0 mL (small breaths)",
                           kZordan + ", Sec. 8.1 'panting breathing'", "mL",
                           (calm->summary.tidalVolume - panting->summary.tidalVolume) * kMl, 1e-9, kBig));
-      // the motion seen from the side (Fig. 5's silhouette): anterior-posterior excursions of chest and belly
+      // the motion seen from the side (Fig. 5's silhouette): the breath's anterior excursions of chest and
+      // belly, end-inspiration minus end-expiration over the full cycles (Motion), not ranges over the run,
+      // which would count the slow drift after settling as breathing
       const auto apRatio = [](const StyleRun& r) {
-        return landmarkRange(r.trace, r.xiphoid, r.settleTime).y() /
-               std::max(landmarkRange(r.trace, r.umbilicus, r.settleTime).y(), 1e-12);
+        const Motion& m = r.summary.motion;
+        return m.xiphoidAnterior / std::max(m.umbilicusAnterior, 1e-12);
       };
       const double pantRatio = apRatio(*panting), calmRatio = apRatio(*calm);
       out.push_back(check("panting.chest_dominant",

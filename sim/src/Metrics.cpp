@@ -137,17 +137,6 @@ Motion measureMotion(const Trace& t, const std::vector<std::string>& names,
 
 }  // namespace
 
-Eigen::Vector3d landmarkRange(const Trace& trace, int index, double from) {
-  const std::size_t i0 = firstIndex(trace, from);
-  if (index < 0 || i0 >= trace.size()) return Eigen::Vector3d::Zero();
-  Eigen::Vector3d lo = trace.landmarks[i0].col(index), hi = lo;
-  for (std::size_t i = i0; i < trace.size(); ++i) {
-    lo = lo.cwiseMin(trace.landmarks[i].col(index));
-    hi = hi.cwiseMax(trace.landmarks[i].col(index));
-  }
-  return hi - lo;
-}
-
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from) {
   Summary s;
   s.measuredFrom = from;

@@ -371,6 +371,8 @@ void validateModel(const Model& m) {
   }
   validateTriangles(m.gut.triangles, "gut.triangles", nN);
   requireNonNegative(m.gut.drag, "gut.drag");
+  if (!(m.gut.wallToneUpright >= 0.0 && m.gut.wallToneUpright <= 0.5))
+    invalid("gut.wall_tone_upright", "must be in [0, 0.5], got " + num(m.gut.wallToneUpright));
   if (m.gut.triangles.cols() > 0) {
     validateClosedSurface(m.gut.triangles, "gut.triangles");
     requirePositive(m.gut.kappa, "gut.kappa");
@@ -539,9 +541,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
 
   // gut
   const Reader gut = root.at("gut");
-  gut.allowKeys({"kappa", "drag", "triangles"});
+  gut.allowKeys({"kappa", "drag", "wall_tone_upright", "triangles"});
   m.gut.kappa = gut.at("kappa").number();
   if (gut.has("drag")) m.gut.drag = gut.at("drag").number();  // optional: models written before it have none
+  if (gut.has("wall_tone_upright"))                           // optional likewise: no tone
+    m.gut.wallToneUpright = gut.at("wall_tone_upright").numberIn(0.0, 0.5);
   const Reader gutTris = gut.at("triangles");
   m.gut.triangles.resize(3, static_cast<Eigen::Index>(gutTris.size()));
   for (std::size_t i = 0; i < gutTris.size(); ++i)
@@ -676,7 +680,10 @@ std::string serializeModel(const Model& m) {
     for (int i = 0; i < t.cols(); ++i) a.push_back({t(0, i), t(1, i), t(2, i)});
     return a;
   };
-  doc["gut"] = {{"kappa", m.gut.kappa}, {"drag", m.gut.drag}, {"triangles", triangles(m.gut.triangles)}};
+  doc["gut"] = {{"kappa", m.gut.kappa},
+                {"drag", m.gut.drag},
+                {"wall_tone_upright", m.gut.wallToneUpright},
+                {"triangles", triangles(m.gut.triangles)}};
 
   json elements = json::array();
   for (int i = 0; i < m.elements.size(); ++i) {

@@ -33,7 +33,7 @@ inline MuscleParams muscleParams(const Model& model, int e, const Activations& a
   const int g = static_cast<int>(model.elements.group[at(e)]);
   const GroupActivation& ga = act[at(g)];
   MuscleParams p;
-  p.restLength = model.elements.restLength(e);
+  p.restLength = effectiveRestLength(model, e, o);
   p.kac = model.elements.kac(e) * o.activeGainScale[at(g)];
   p.kpe = model.elements.kpe(e) * o.passiveGainScale[at(g)];
   p.damping = model.elements.damping(e) * o.passiveGainScale[at(g)];

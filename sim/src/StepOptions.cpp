@@ -58,6 +58,13 @@ const char* postureName(Posture p) { return nameIn(kPostureNames, p); }
 std::string postureNames() { return namesIn(kPostureNames); }
 bool postureFromName(const std::string& name, Posture& out) { return valueIn(kPostureNames, name, out); }
 
+double effectiveRestLength(const Model& model, int e, const StepOptions& o) {
+  const double l0 = model.elements.restLength(e);
+  const bool isToned = o.posture == Posture::Upright &&
+                       model.elements.group[static_cast<std::size_t>(e)] == ElementGroup::TransversusObliques;
+  return isToned ? (1.0 - model.gut.wallToneUpright) * l0 : l0;
+}
+
 Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o) {
   if (!o.gravity) return Eigen::Vector3d::Zero();
   // the upright gravity turned into the body frame: quarter turns, exact in floating point

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pneuma/meshing/MeshTools.h"
+#include "pneuma/sim/Elements.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/State.h"
@@ -286,11 +287,24 @@ TEST(ModelBuilder, BuildIsDeterministicAndDirectoryIsReplacedWhole) {
   const BuiltModel two = buildModel(a);
   // bodies, joints, nodes, gut, elements and landmarks are bit-identical; the cavity's triangulation
   // comes from CGAL corefinement, whose tie-breaking follows heap addresses inside one process (separate
-  // processes, as at build time, give identical bytes), so it is compared by its volume
+  // processes, as at build time, give identical bytes), so it and the lungs carved from it are compared by
+  // their volumes
   EXPECT_NEAR(two.report.summary.cavityVolume, one.report.summary.cavityVolume,
               1e-9 * one.report.summary.cavityVolume);
+  const auto lungVolumes = [](const sim::Model& m) {
+    Eigen::Matrix3Xd cavity, right, left;
+    sim::anchorPositions(m.cavity.vertices, sim::makeInitialState(m), cavity);
+    sim::lungPositions(m.lungs.right, cavity, right);
+    sim::lungPositions(m.lungs.left, cavity, left);
+    return Eigen::Vector2d(sim::enclosedVolume(right, m.lungs.right.triangles),
+                           sim::enclosedVolume(left, m.lungs.left.triangles));
+  };
+  const Eigen::Vector2d v1 = lungVolumes(one.model), v2 = lungVolumes(two.model);
+  EXPECT_GT(v1.minCoeff(), 1e-3);  // [m^3] a litre at least
+  EXPECT_LT((v2 - v1).cwiseAbs().maxCoeff(), 1e-6 * v1.maxCoeff());
   sim::Model a1 = one.model, a2 = two.model;
   a2.cavity = a1.cavity;
+  a2.lungs = a1.lungs;
   EXPECT_TRUE(sim::serializeModel(a1) == sim::serializeModel(a2)) << "two builds differ";
 
   const fs::path dir = fs::temp_directory_path() / ("pneuma_mesh_test_" + std::to_string(::getpid()));

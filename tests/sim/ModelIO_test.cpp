@@ -50,6 +50,7 @@ Model tinyModel() {
   m.nodes.region = {NodeRegion::Fixed, NodeRegion::Fixed, NodeRegion::Fixed, NodeRegion::Wall};
   m.gut.kappa = 1e4;
   m.gut.drag = 20.0;
+  m.gut.wallToneUpright = 0.03;
   m.gut.triangles.resize(3, 4);
   m.gut.triangles << 0, 0, 0, 1,  //
       2, 1, 3, 2,                 //
@@ -122,6 +123,8 @@ TEST(ModelIO, RejectsCorruptedFilesNamingTheField) {
             "model.json: elements[0].group: unknown group 'biceps'");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["gut"]["drag"] = -1.0; }),
             "model.json: gut.drag: must be >= 0, got -1");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["gut"]["wall_tone_upright"] = 0.9; }),
+            "model.json: gut.wall_tone_upright: must be in [0, 0.5], got 0.9");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["version"] = 7; }),
             "model.json: version: unsupported version 7 (this build reads 1)");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["landmarks"].erase(0); }),
@@ -208,6 +211,14 @@ TEST(ModelIO, ModelWithoutGutDragLoadsWithNone) {
   EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.drag, 20.0);
   j["gut"].erase("drag");
   EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.drag, 0.0);
+}
+
+// gut.wall_tone_upright is optional too: a model written before the postural tone has none
+TEST(ModelIO, ModelWithoutWallToneLoadsWithNone) {
+  nlohmann::json j = nlohmann::json::parse(serializeModel(tinyModel()));
+  EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.wallToneUpright, 0.03);
+  j["gut"].erase("wall_tone_upright");
+  EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.wallToneUpright, 0.0);
 }
 
 TEST(ModelIO, RejectsTruncatedJson) {

@@ -9,11 +9,13 @@
 #include <vtkPropCollection.h>
 #include <vtkRenderer.h>
 
+#include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFile>
 #include <QLabel>
 #include <QLineEdit>
+#include <QRegularExpression>
 #include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
@@ -255,6 +257,35 @@ TEST_F(DefaultModelWindow, FrequencyEditChangesTheMeasuredBreathingRate) {
   emit panel->frequencyField()->editingFinished();
   ASSERT_TRUE(window.runUntil(21.0));
   EXPECT_NEAR(plottedRate(*window.plots()->volumePlot(), 11.0), 12.0, 1.5);
+}
+
+// the figure after `label` in the Breathing read-out, e.g. "Dome descent 14.6 mm" -> 14.6 (NaN if absent)
+double readoutFigure(const QString& text, const QString& label) {
+  const QRegularExpressionMatch m =
+      QRegularExpression(QRegularExpression::escape(label) + " (-?[0-9.]+) ").match(text + " ");
+  return m.hasMatch() ? m.captured(1).toDouble() : std::nan("");
+}
+
+TEST_F(DefaultModelWindow, BreathingReadOutShowsTheCalmBreathsMotion) {
+  EXPECT_EQ(window.breathingReadout(), "Measured after the first full breath.");
+  // three calm breaths after the 2 s settling
+  ASSERT_TRUE(window.runUntil(14.5)) << window.lastError().toStdString();
+  const QString text = window.breathingReadout();
+  // the calm figures validate checks (docs/cli.md): 500 mL +/- 10 % at 15 b/m; the dome descending 12-25 mm
+  // (Boussuges et al. 2009); the lower ribs widening >= 2 mm; the belly moving forward; the rib cage and
+  // abdomen in phase (< 30 deg)
+  EXPECT_NEAR(readoutFigure(text, "Tidal volume"), 500.0, 50.0) << text.toStdString();
+  EXPECT_NEAR(readoutFigure(text, "at"), 15.0, 0.5) << text.toStdString();
+  EXPECT_GE(readoutFigure(text, "Dome descent"), 12.0) << text.toStdString();
+  EXPECT_LE(readoutFigure(text, "Dome descent"), 25.0) << text.toStdString();
+  EXPECT_GE(readoutFigure(text, "Rib 8 widening"), 2.0) << text.toStdString();
+  EXPECT_GT(readoutFigure(text, "Belly forward"), 0.0) << text.toStdString();
+  EXPECT_LT(readoutFigure(text, "Rib cage-abdomen phase"), 30.0) << text.toStdString();
+  // a reset clears it until the next full breath
+  for (QAction* a : window.findChildren<QAction*>())
+    if (a->text() == "Reset") a->trigger();
+  ASSERT_TRUE(window.runUntil(1.0)) << window.lastError().toStdString();
+  EXPECT_EQ(window.breathingReadout(), "Measured after the first full breath.");
 }
 
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {

@@ -105,8 +105,10 @@ struct Gains {
   double referenceLength = 0.0;  ///< [m] element length at which the group gains apply unscaled
   std::array<GroupGains, sim::kElementGroupCount> group{};  ///< indexed by sim::ElementGroup
   double gutKappa = 0.0;                                    ///< [Pa] bulk modulus of Eq. 4
-  double gutDrag = 0.0;         ///< [1/s] visceral drag rate beta (sim::Gut::drag)
-  double lungRecoil = 0.0;      ///< [Pa] lung recoil at the rest volume (sim::Cavity::recoilPressure)
+  double gutDrag = 0.0;  ///< [1/s] visceral drag rate beta (sim::Gut::drag)
+  double wallToneUpright =
+      0.0;                  ///< [-] abdominal wall's upright set-point shortening (sim::Gut::wallToneUpright)
+  double lungRecoil = 0.0;  ///< [Pa] lung recoil at the rest volume (sim::Cavity::recoilPressure)
   double lungCompliance = 0.0;  ///< [m^3/Pa] lung compliance (sim::Cavity::compliance)
   /// [-] stiffness and damping of the apposition springs (the outer dome held on the lower ribs' inner face)
   /// as a fraction of the cartilage group's

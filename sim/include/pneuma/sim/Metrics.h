@@ -113,8 +113,4 @@ struct Summary {
 /// Fills the volume, rate, gut-error and motion fields; the caller sets rtf, steps and dt.
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from);
 
-/// Range [m] of landmark `index`'s x, y and z over frames with time >= `from`: max - min per coordinate
-/// (zero when the index or the frames are missing).
-Eigen::Vector3d landmarkRange(const Trace& trace, int index, double from);
-
 }  // namespace pneuma::sim

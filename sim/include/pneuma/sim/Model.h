@@ -119,6 +119,12 @@ struct Gut {
   /// abdominal tissue, which the paper's model lacks (our addition, docs/model-format.md). Without it the
   /// gut and the relaxing diaphragm bounce at the end of each inhale (calm: a 120 mL rebound). >= 0.
   double drag = 0.0;
+  /// [-] postural tone of the abdominal wall: in the upright posture the transversus and obliques
+  /// (ElementGroup::TransversusObliques) work at a set-point shortened by this fraction, l0' = (1 - tone) l0;
+  /// lying down they are at rest (effectiveRestLength(), Step.h). Abdominal muscles are silent supine and
+  /// tonically active upright (De Troyer 1983, Respir Physiol 53:341; Loring & Mead 1982, J Appl Physiol
+  /// 52:700), which stiffens the wall and shifts breathing toward the rib cage. Our addition, in [0, 0.5].
+  double wallToneUpright = 0.0;
 };
 
 /// Spring elements: muscles (Eq. 2) and structural springs (cartilage).

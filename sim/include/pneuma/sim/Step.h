@@ -94,6 +94,12 @@ inline double effectiveKappa(const Model& model, const StepOptions& o) {
   return o.kappa.value_or(model.gut.kappa);
 }
 
+/// [m] The rest length l0 element `e` works at in a run: Elements::restLength, shortened by the abdominal
+/// wall's postural tone for the transversus and obliques upright, l0' = (1 - Gut::wallToneUpright) l0; lying
+/// postures (supine, prone, lateral) have no tone. The one rule for it (the step's forces, the elastic energy
+/// of computeMetrics()).
+double effectiveRestLength(const Model& model, int e, const StepOptions& o);
+
 /// [m/s^2] The gravity a run applies, in the body frame: zero when `o.gravity` is off, else Model::gravity
 /// (the upright gravity) turned by a quarter turn for the lying postures, g = R(o.posture) Model::gravity:
 /// supine R_x(-90 deg), prone R_x(+90 deg), left-lateral R_y(+90 deg), right-lateral R_y(-90 deg). The one
