@@ -31,20 +31,22 @@ constexpr double kBoneClearance = 0.006;  // [m] least distance from skin to bon
 constexpr double kGutClearance = 0.010;   // [m] least distance from skin to the gut surface
 constexpr double kThighCut = 0.10;        // [m] legs cut this far below the crotch
 constexpr double kPerineumDepth = 0.07;   // [m] crotch (perineum) below the pelvic floor
-constexpr double kThighCutSlack = 0.03;   // [m] a surface ending less than this below the cut is not cut again
+constexpr double kThighCutSlack = 0.03;  // [m] a surface ending less than this below the cut is not cut again
 constexpr double kAnchorSpacing = 0.012;  // [m] one bone-surface anchor per cell of this size
-// [m] a skin vertex takes all of its anchors' motion within kFollowNear of them through the tissue, none beyond
-// kFollowFar (linear between): the soft tissue over the chest and belly (10-60 mm) moves with them, a head or a
-// hand with no bone of its own stays still instead of being dragged by a rib it hangs near
+// [m] a skin vertex takes all of its anchors' motion within kFollowNear of them through the tissue, none
+// beyond kFollowFar (linear between): the soft tissue over the chest and belly (10-60 mm) moves with them, a
+// head or a hand with no bone of its own stays still instead of being dragged by a rib it hangs near
 constexpr double kFollowNear = 0.06;
 constexpr double kFollowFar = 0.12;
-constexpr double kAcromionToRib8 = 1.4;   // [-] acromion half-breadth / rib-8 lateral half-breadth
+constexpr double kAcromionToRib8 = 1.4;      // [-] acromion half-breadth / rib-8 lateral half-breadth
 constexpr int kBindingSmoothingPasses = 10;  // smoothing of the skin's binding weights over the surface
-constexpr int kSlabs = 240;               // horizontal sections of the source mesh
+constexpr int kSlabs = 240;                  // horizontal sections of the source mesh
 
 using Points = std::vector<Eigen::Vector3d>;
 
-[[noreturn]] void fail(const std::string& file, const std::string& what) { throw sim::Error(file + ": " + what); }
+[[noreturn]] void fail(const std::string& file, const std::string& what) {
+  throw sim::Error(file + ": " + what);
+}
 
 // ---------------------------------------------------------------------------------------------
 // sections of the source mesh
@@ -99,7 +101,8 @@ struct ThinPlateSpline {
     Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n + 4, n + 4);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n + 4, 3);
     for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j) L(i, j) = (from[static_cast<std::size_t>(i)] - from[static_cast<std::size_t>(j)]).norm();
+      for (int j = 0; j < n; ++j)
+        L(i, j) = (from[static_cast<std::size_t>(i)] - from[static_cast<std::size_t>(j)]).norm();
       L(i, n) = L(n, i) = 1.0;
       for (int k = 0; k < 3; ++k) L(i, n + 1 + k) = L(n + 1 + k, i) = from[static_cast<std::size_t>(i)][k];
       rhs.row(i) = to[static_cast<std::size_t>(i)].transpose();
@@ -146,7 +149,8 @@ class PointGrid {
 
  private:
   std::array<long long, 3> cellOf(const Eigen::Vector3d& x) const {
-    return {static_cast<long long>(std::floor(x.x() / m_cell)), static_cast<long long>(std::floor(x.y() / m_cell)),
+    return {static_cast<long long>(std::floor(x.x() / m_cell)),
+            static_cast<long long>(std::floor(x.y() / m_cell)),
             static_cast<long long>(std::floor(x.z() / m_cell))};
   }
   static long long pack(long long i, long long j, long long k) {
@@ -227,7 +231,8 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
   auto add = [&](const std::string& n, const Eigen::Vector3d& p, const Eigen::Vector3d& depth) {
     out.push_back({n, p, p + depth});
   };
-  const Eigen::Vector3d jugular = at("jugular_notch"), r8r = at("rib8_lateral_right"), r8l = at("rib8_lateral_left");
+  const Eigen::Vector3d jugular = at("jugular_notch"), r8r = at("rib8_lateral_right"),
+                        r8l = at("rib8_lateral_left");
   add("jugular_notch", jugular, {0, kDepthSternum, 0});
   add("xiphoid", at("xiphoid"), {0, kDepthSternum, 0});
   add("umbilicus", at("umbilicus"), {0, kDepthAbdomen, 0});
@@ -236,7 +241,8 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
 
   // bone surfaces in world
   auto worldMesh = [&](int b) {
-    return Eigen::Matrix3Xd(built.bodyMeshes[static_cast<std::size_t>(b)].vertices.colwise() + m.bodies.com.col(b));
+    return Eigen::Matrix3Xd(built.bodyMeshes[static_cast<std::size_t>(b)].vertices.colwise() +
+                            m.bodies.com.col(b));
   };
   auto bodyNamed = [&](const std::string& n) {
     for (int b = 0; b < m.bodies.size(); ++b)
@@ -250,7 +256,8 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
   for (int side : {1, -1}) {
     int best = -1;
     for (int i = 0; i < pv.cols(); ++i)
-      if (side * pv(0, i) > 0.02 && pv(2, i) > a.abdomen.floorLevel + 0.04 && (best < 0 || pv(1, i) > pv(1, best)))
+      if (side * pv(0, i) > 0.02 && pv(2, i) > a.abdomen.floorLevel + 0.04 &&
+          (best < 0 || pv(1, i) > pv(1, best)))
         best = i;
     add(side > 0 ? "asis_right" : "asis_left", pv.col(best), {0, kDepthAsis, 0});
   }
@@ -265,7 +272,8 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
         if (side * sv(0, i) + sv(2, i) > side * sv(0, best) + sv(2, best)) best = i;
       p = sv.col(best);
     } else {
-      p = Eigen::Vector3d(kAcromionToRib8 * (side > 0 ? r8r.x() : r8l.x()), jugular.y() - 0.05, jugular.z() + 0.01);
+      p = Eigen::Vector3d(kAcromionToRib8 * (side > 0 ? r8r.x() : r8l.x()), jugular.y() - 0.05,
+                          jugular.z() + 0.01);
     }
     add(side > 0 ? "acromion_right" : "acromion_left", p, {0, 0, kDepthAcromion});
   }
@@ -276,7 +284,8 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
     for (int b = 0; b < m.bodies.size(); ++b) {
       const Eigen::Matrix3Xd bv = worldMesh(b);
       for (int i = 0; i < bv.cols(); ++i)
-        if (std::abs(bv(0, i)) < 0.02 && std::abs(bv(2, i) - z) < 0.015 && bv(1, i) < best.y()) best = bv.col(i);
+        if (std::abs(bv(0, i)) < 0.02 && std::abs(bv(2, i) - z) < 0.015 && bv(1, i) < best.y())
+          best = bv.col(i);
     }
     if (best.y() > 1e8) throw sim::Error(std::string("skin: no spine behind the ") + level);
     add(std::string("spine_at_") + level, best, {0, -kDepthSpine, 0});
@@ -302,7 +311,8 @@ Points sourceLandmarks(const TriangleMesh& s, const std::vector<Landmark>& targe
   // section k: the plane z = zHi - (k + 0.5) slab, cut through every triangle that spans it
   std::vector<std::vector<std::array<Eigen::Vector3d, 2>>> cuts(kSlabs);
   for (int f = 0; f < s.triangleCount(); ++f) {
-    std::array<Eigen::Vector3d, 3> c{v.col(s.triangles(0, f)), v.col(s.triangles(1, f)), v.col(s.triangles(2, f))};
+    std::array<Eigen::Vector3d, 3> c{v.col(s.triangles(0, f)), v.col(s.triangles(1, f)),
+                                     v.col(s.triangles(2, f))};
     const double lo = std::min({c[0].z(), c[1].z(), c[2].z()}), hi = std::max({c[0].z(), c[1].z(), c[2].z()});
     const int k0 = std::max(0, static_cast<int>(std::ceil((zHi - hi) / slab - 0.5)));
     const int k1 = std::min(kSlabs - 1, static_cast<int>(std::floor((zHi - lo) / slab - 0.5)));
@@ -319,7 +329,9 @@ Points sourceLandmarks(const TriangleMesh& s, const std::vector<Landmark>& targe
   }
   std::vector<Section> sec;
   for (const auto& cut : cuts) sec.push_back(centralPiece(cut, x0, gap));
-  auto width = [&](int i) { return sec[static_cast<std::size_t>(i)].xMax - sec[static_cast<std::size_t>(i)].xMin; };
+  auto width = [&](int i) {
+    return sec[static_cast<std::size_t>(i)].xMax - sec[static_cast<std::size_t>(i)].xMin;
+  };
 
   // from the top down: the head widens to its widest, narrows by a fifth (chin and neck), the neck narrows to
   // its narrowest, then the shoulders widen to twice that
@@ -352,7 +364,9 @@ Points sourceLandmarks(const TriangleMesh& s, const std::vector<Landmark>& targe
   // the neck-to-crotch span, 0.13: adult stature ratios, neck 0.87, notch 0.82, crotch 0.47)
   const double jugularT = target[0].skin.z();
   const double neckT = jugularT + 0.13 / 0.87 * (jugularT - targetCrotchZ);
-  auto zOf = [&](double zt) { return crotchZ + (zt - targetCrotchZ) / (neckT - targetCrotchZ) * (zNeck - crotchZ); };
+  auto zOf = [&](double zt) {
+    return crotchZ + (zt - targetCrotchZ) / (neckT - targetCrotchZ) * (zNeck - crotchZ);
+  };
   auto slabAt = [&](double z) { return std::clamp(static_cast<int>((zHi - z) / slab), 0, kSlabs - 1); };
   // lateral scale: the rib-8 breadth
   const double r8z = zOf(0.5 * (target[3].skin.z() + target[4].skin.z()));
@@ -435,7 +449,9 @@ TriangleMesh cutLegs(const TriangleMesh& s, double zCut, const std::string& file
   std::vector<Eigen::Vector3i> tris;
   for (int f = 0; f < s.triangleCount(); ++f) {
     const Eigen::Vector3i t = s.triangles.col(f);
-    if (!isCut[static_cast<std::size_t>(t[0])] && !isCut[static_cast<std::size_t>(t[1])] && !isCut[static_cast<std::size_t>(t[2])]) tris.push_back(t);
+    if (!isCut[static_cast<std::size_t>(t[0])] && !isCut[static_cast<std::size_t>(t[1])] &&
+        !isCut[static_cast<std::size_t>(t[2])])
+      tris.push_back(t);
   }
   // boundary loops: directed edges without their reverse, followed head to tail
   std::map<std::pair<int, int>, int> directed;
@@ -465,7 +481,8 @@ TriangleMesh cutLegs(const TriangleMesh& s, double zCut, const std::string& file
     c /= static_cast<double>(loop.size());
     const int centre = static_cast<int>(verts.size());
     verts.push_back(c);
-    for (std::size_t k = 0; k < loop.size(); ++k) tris.emplace_back(loop[k], loop[(k + 1) % loop.size()], centre);
+    for (std::size_t k = 0; k < loop.size(); ++k)
+      tris.emplace_back(loop[k], loop[(k + 1) % loop.size()], centre);
     ++loops;
   }
   if (loops != 0 && loops != 2) fail(file, "the leg cut gives " + std::to_string(loops) + " cuts, not 2");
@@ -481,7 +498,8 @@ TriangleMesh cutLegs(const TriangleMesh& s, double zCut, const std::string& file
     if (index[i] >= 0) out.vertices.col(index[i]) = verts[i];
   out.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
   for (std::size_t f = 0; f < tris.size(); ++f)
-    for (int k = 0; k < 3; ++k) out.triangles(k, static_cast<Eigen::Index>(f)) = index[static_cast<std::size_t>(tris[f][k])];
+    for (int k = 0; k < 3; ++k)
+      out.triangles(k, static_cast<Eigen::Index>(f)) = index[static_cast<std::size_t>(tris[f][k])];
   return out;
 }
 
@@ -549,7 +567,8 @@ double pushOut(TriangleMesh& s, const Obstacles& o) {
       Eigen::Matrix3Xd spread = push;
       for (int i = 0; i < s.vertexCount(); ++i) {
         for (int j : nb[static_cast<std::size_t>(i)])
-          if (push.col(j).squaredNorm() > spread.col(i).squaredNorm()) spread.col(i) = 0.5 * (spread.col(i) + push.col(j));
+          if (push.col(j).squaredNorm() > spread.col(i).squaredNorm())
+            spread.col(i) = 0.5 * (spread.col(i) + push.col(j));
       }
       push = spread;
     }
@@ -563,7 +582,8 @@ double pushOut(TriangleMesh& s, const Obstacles& o) {
 
 constexpr int kK = sim::kSkinVertexSlots - 1;  // nearest anchors per vertex; the last slot for the still body
 
-void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o, sim::Skin& out, int& tetCount) {
+void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o, sim::Skin& out,
+          int& tetCount) {
   const sim::Model& m = built.model;
   // anchors: bone-surface points thinned to one per cell and body, and every gut node
   std::vector<int> anchorSource;  // obstacle index per interior point
@@ -571,10 +591,12 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
     std::map<std::array<long long, 4>, int> seen;
     for (std::size_t i = 0; i < o.point.size(); ++i) {
       const Eigen::Vector3d& p = o.point[i];
-      const std::array<long long, 4> key{o.body[i], static_cast<long long>(std::floor(p.x() / kAnchorSpacing)),
+      const std::array<long long, 4> key{o.body[i],
+                                         static_cast<long long>(std::floor(p.x() / kAnchorSpacing)),
                                          static_cast<long long>(std::floor(p.y() / kAnchorSpacing)),
                                          static_cast<long long>(std::floor(p.z() / kAnchorSpacing))};
-      if (o.body[i] < 0 || seen.emplace(key, static_cast<int>(i)).second) anchorSource.push_back(static_cast<int>(i));
+      if (o.body[i] < 0 || seen.emplace(key, static_cast<int>(i)).second)
+        anchorSource.push_back(static_cast<int>(i));
     }
   }
   Eigen::Matrix3Xd interior(3, static_cast<Eigen::Index>(anchorSource.size()));
@@ -629,7 +651,8 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
       if (b >= 0)
         out.anchors.addBodyPoint(b, o.point[static_cast<std::size_t>(src)] - m.bodies.com.col(b));
       else
-        out.anchors.addNodePoint({src - static_cast<int>(o.point.size()) + m.nodes.size(), -1, -1}, {1, 0, 0});
+        out.anchors.addNodePoint({src - static_cast<int>(o.point.size()) + m.nodes.size(), -1, -1},
+                                 {1, 0, 0});
     }
     return simAnchor[static_cast<std::size_t>(a)];
   };
@@ -650,7 +673,8 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
   for (int v = 0; v < nV; ++v) {
     const auto& f = found[static_cast<std::size_t>(v)];
     if (f.empty())
-      throw sim::Error("skin: vertex " + std::to_string(v) + " reaches no bone or gut node through the tissue");
+      throw sim::Error("skin: vertex " + std::to_string(v) +
+                       " reaches no bone or gut node through the tissue");
     const double share =
         still < 0 ? 1.0 : std::clamp((kFollowFar - f.front().first) / (kFollowFar - kFollowNear), 0.0, 1.0);
     double sum = 0.0;
@@ -689,7 +713,8 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
       for (const auto& [a, x] : binding[static_cast<std::size_t>(v)]) w[a] += 0.5 * x;
       const auto& n = nb[static_cast<std::size_t>(v)];
       for (int u : n)
-        for (const auto& [a, x] : binding[static_cast<std::size_t>(u)]) w[a] += 0.5 * x / static_cast<double>(n.size());
+        for (const auto& [a, x] : binding[static_cast<std::size_t>(u)])
+          w[a] += 0.5 * x / static_cast<double>(n.size());
       next[static_cast<std::size_t>(v)] = prune(w);
     }
     binding.swap(next);
@@ -698,12 +723,18 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
   for (int v = 0; v < nV; ++v) {
     const Eigen::Vector3d x = skin.vertices.col(v);
     const Binding& b = binding[static_cast<std::size_t>(v)];
-    // one bone only: the vertex follows it rigidly (a point of that bone at the vertex itself); the still body
-    // only: it stays
-    const int firstBody = b.front().first < 0 ? still : o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(b.front().first)])];
+    // one bone only: the vertex follows it rigidly (a point of that bone at the vertex itself); the still
+    // body only: it stays
+    const int firstBody =
+        b.front().first < 0
+            ? still
+            : o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(b.front().first)])];
     bool isOneBody = firstBody >= 0;
     for (const auto& [a, w] : b)
-      isOneBody = isOneBody && (a < 0 ? still : o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(a)])]) == firstBody;
+      isOneBody =
+          isOneBody &&
+          (a < 0 ? still : o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(a)])]) ==
+              firstBody;
     if (isOneBody) {
       out.anchor(0, v) = out.anchors.size();
       out.anchors.addBodyPoint(firstBody, x - m.bodies.com.col(firstBody));
@@ -770,9 +801,10 @@ void buildSkin(const AnatomyParams& a, const std::string& file, BuiltModel& out)
 
   const MeshCheck check = checkMesh(skin);
   if (!check.isValid())
-    fail(file, std::string("the registered skin is not a valid closed surface: manifold ") + (check.isManifold ? "yes" : "no") +
-                   ", closed " + (check.isClosed ? "yes" : "no") + ", self-intersecting " +
-                   (check.isSelfIntersecting ? "yes" : "no") + ", outward " + (check.isOutward ? "yes" : "no"));
+    fail(file, std::string("the registered skin is not a valid closed surface: manifold ") +
+                   (check.isManifold ? "yes" : "no") + ", closed " + (check.isClosed ? "yes" : "no") +
+                   ", self-intersecting " + (check.isSelfIntersecting ? "yes" : "no") + ", outward " +
+                   (check.isOutward ? "yes" : "no"));
   bind(skin, out, obstacles, out.model.skin, out.report.skinTetrahedra);
 }
 

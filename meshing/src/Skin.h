@@ -25,8 +25,10 @@ namespace pneuma::meshing {
 ///  4. vertices inside a bone or closer than 6 mm to one (or 10 mm to the gut) pushed out along the skin's
 ///     normal, the push spread over the neighbours;
 ///  5. TetGen tetrahedralises the volume inside the skin with bone-surface points and gut nodes as vertices;
-///     each skin vertex takes its 4 nearest of those anchors through the tissue (Dijkstra on tetrahedron
-///     edges) with inverse-square-distance weights, or follows one bone rigidly when all 4 lie on it.
+///     each skin vertex takes its 3 nearest of those anchors through the tissue (Dijkstra on tetrahedron
+///     edges) with inverse-square-distance weights, all of their motion within 6 cm and none beyond 12 cm
+///     (the rest of the weight on a fixed body), the weights averaged over the surface; a vertex bound to one
+///     bone only follows it rigidly.
 /// Fills out.model.skin and out.report's skin figures.
 /// @throws sim::Error "<file>: <problem>" when the file cannot be read, is not closed, a landmark cannot be
 ///         found, or the registered surface intersects itself.

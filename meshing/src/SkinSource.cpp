@@ -22,7 +22,8 @@ constexpr double kWeldTolerance = 1e-6;  // [-] of the bounding-box diagonal
 
 int findRoot(std::vector<int>& parent, int i) {
   while (parent[static_cast<std::size_t>(i)] != i) {
-    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    parent[static_cast<std::size_t>(i)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
     i = parent[static_cast<std::size_t>(i)];
   }
   return i;
@@ -34,8 +35,8 @@ TriangleMesh readSkinSource(const std::string& path) {
   auto fail = [&](const std::string& what) { throw sim::Error(path + ": " + what); };
   if (!std::filesystem::is_regular_file(path)) fail("no such file");
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                                                     aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr) fail(std::string("assimp cannot read it: ") + importer.GetErrorString());
 
   // every triangle of every mesh, in world axes (-X, +Z, +Y)
@@ -89,12 +90,13 @@ TriangleMesh readSkinSource(const std::string& path) {
   std::vector<int> parent(welded.size());
   std::iota(parent.begin(), parent.end(), 0);
   for (const auto& t : tris)
-    for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(findRoot(parent, t[k]))] = findRoot(parent, t[0]);
+    for (int k = 1; k < 3; ++k)
+      parent[static_cast<std::size_t>(findRoot(parent, t[k]))] = findRoot(parent, t[0]);
   std::map<int, int> size;
   for (const auto& t : tris) ++size[findRoot(parent, t[0])];
-  const int root =
-      std::max_element(size.begin(), size.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
-          ->first;
+  const int root = std::max_element(size.begin(), size.end(), [](const auto& a, const auto& b) {
+                     return a.second < b.second;
+                   })->first;
   std::vector<int> index(welded.size(), -1);
   TriangleMesh out;
   std::vector<Eigen::Vector3i> kept;
@@ -122,7 +124,8 @@ TriangleMesh readSkinSource(const std::string& path) {
     if (directed.count({e.second, e.first}) == 0) ++border;
   }
   if (border > 0)
-    fail("the body surface is not closed (" + std::to_string(border) + " edges without a neighbouring triangle)");
+    fail("the body surface is not closed (" + std::to_string(border) +
+         " edges without a neighbouring triangle)");
   if (repeated > 0)
     fail("the body surface is not consistently oriented or not manifold (" + std::to_string(repeated) +
          " edges shared the same way by two triangles)");

@@ -16,7 +16,9 @@ namespace {
 
 using test::defaultModel;
 
-// [-] |dV_skin - dV_lungs| / dV_lungs allowed; measured KMEASURED on the male default model (deep breath)
+// [-] |dV_skin / dV_lungs - 1| allowed. Measured on the male default model, deep breath: 1336 / 1537 mL =
+// 0.87 (the tissue far from the moving bones, 6-12 cm through it, takes only part of their motion: Skin.cpp
+// kFollowNear)
 constexpr double kVolumeTolerance = 0.20;
 
 double enclosed(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& t) {

@@ -22,7 +22,7 @@ struct PosedGeometry {
   Eigen::Matrix3Xd lungRight;           ///< [m] right lung vertices (lungPositions())           (3 x #VR)
   Eigen::Matrix3Xd lungLeft;            ///< [m] left lung vertices                              (3 x #VL)
   Eigen::Matrix3Xd landmarks;           ///< [m] named landmarks (Landmarks::points)             (3 x #L)
-  Eigen::Matrix3Xd skin;                ///< [m] skin vertices (skinPositions()); empty without a skin (3 x #V)
+  Eigen::Matrix3Xd skin;  ///< [m] skin vertices (skinPositions()); empty without a skin (3 x #V)
 };
 
 /// Poses `model` for `state` into `out` (every member resized): bones by their rigid transforms, anchored
