@@ -76,7 +76,7 @@ set(CPACK_DEBIAN_PACKAGE_LICENSE AGPL-3.0-or-later)
 set(pneuma_deb_depends
     "libc6 (>= 2.36)" "libgcc-s1" "libstdc++6 (>= 12)"
     "libqt5core5a (>= 5.15)" "libqt5gui5 (>= 5.15)" "libqt5widgets5 (>= 5.15)" "libqt5svg5 (>= 5.15)"
-    "libvtk9.1" "libvtk9.1-qt" "libtet1.5" "libgmp10" "libmpfr6")
+    "libvtk9.1" "libvtk9.1-qt" "libtet1.5" "libassimp5" "libgmp10" "libmpfr6")
 list(JOIN pneuma_deb_depends ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
 # the plots' font (viz::Plot falls back to VTK's Arial without it)
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "fonts-dejavu-core")

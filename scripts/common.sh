@@ -10,7 +10,7 @@ PNEUMA_JOBS="${PNEUMA_JOBS:-$(nproc)}"
 PNEUMA_PACKAGES=(
   cmake ninja-build g++ pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev
-  libcgal-dev libtet1.5-dev
+  libcgal-dev libtet1.5-dev libassimp-dev assimp-testmodels
   qtbase5-dev libqt5svg5-dev libqt5opengl5-dev
   libvtk9-dev libvtk9-qt-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -22,6 +22,7 @@ constexpr int kBadInput = 2;
 struct BuildOptions {
   std::string anatomy = sim::resourceDir() + "/anatomy/male.json";
   std::string out;
+  std::string skin = meshing::kDefaultSkinFile;
   bool isPreviewSkipped = false;
 };
 
@@ -33,7 +34,7 @@ struct InfoOptions {
 void runBuild(const BuildOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const meshing::AnatomyParams anatomy = meshing::loadAnatomy(o.anatomy);
-  const meshing::BuiltModel built = meshing::buildModel(anatomy);
+  const meshing::BuiltModel built = meshing::buildModel(anatomy, o.skin);
   meshing::writeModelDirectory(built, o.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -42,8 +43,11 @@ void runBuild(const BuildOptions& o) {
             << meshing::summaryText(r.summary) << "gut tetrahedra:  " << r.tetrahedra << " (TetGen volume "
             << r.tetVolume * 1e6 << " mL)\n"
             << "gut triangle quality: min " << r.gutQualityMin << ", mean " << r.gutQualityMean << "\n"
-            << "bone triangles:  " << r.boneTriangles << "\n"
-            << "build time:      " << seconds << " s\n";
+            << "bone triangles:  " << r.boneTriangles << "\n";
+  if (r.skinTetrahedra > 0)
+    std::cout << "skin registration: largest landmark residual " << r.skinLandmarkResidual * 1e3
+              << " mm, least skin-to-bone distance " << r.skinBoneClearance * 1e3 << " mm\n";
+  std::cout << "build time:      " << seconds << " s\n";
 
   if (o.isPreviewSkipped) return;
   std::string why;
@@ -91,6 +95,11 @@ void addModelCommand(CLI::App& app) {
   b->add_option("--out", build->out,
                 "Output model directory: new, empty or an earlier model (replaced as a whole)")
       ->required();
+  b->add_option(
+       "--skin", build->skin,
+       "Body surface mesh (any format assimp reads: OBJ, STL, PLY, glTF, Collada), registered to the "
+       "anatomy")
+      ->capture_default_str();
   b->add_flag("--no-preview", build->isPreviewSkipped, "Do not render preview_front.png / preview_side.png");
   b->callback([build] { guarded([&] { runBuild(*build); }); });
 

@@ -71,6 +71,12 @@ const std::vector<std::pair<const char*, viz::GutColouring>> kGutColourings{
     {"Plain", viz::GutColouring::Plain},
     {"Pressure [Pa]", viz::GutColouring::Pressure},
     {"Displacement [mm]", viz::GutColouring::Displacement}};
+const std::vector<std::pair<const char*, viz::SkinDisplay>> kSkinDisplays{
+    {"Translucent", viz::SkinDisplay::Translucent},
+    {"Opaque", viz::SkinDisplay::Opaque},
+    {"Hidden", viz::SkinDisplay::Hidden}};
+const std::vector<std::pair<const char*, viz::SkinColouring>> kSkinColourings{
+    {"Plain", viz::SkinColouring::Plain}, {"Displacement [mm]", viz::SkinColouring::Displacement}};
 const std::vector<std::pair<const char*, sim::pattern::SwitchMode>> kAffectModes{
     {"at end of cycle", sim::pattern::SwitchMode::EndOfCycle},
     {"immediately", sim::pattern::SwitchMode::Immediate}};
@@ -378,10 +384,20 @@ void MainWindow::buildDocks() {
     m_gutColour->addItem(label, static_cast<int>(colouring));
   colourForm->addRow("Muscles", m_muscleColour);
   colourForm->addRow("Gut", m_gutColour);
+  m_skinColour = new QComboBox(colouring);
+  for (const auto& [label, colouring] : kSkinColourings)
+    m_skinColour->addItem(label, static_cast<int>(colouring));
+  colourForm->addRow("Skin", m_skinColour);
   displayLayout->addWidget(colouring);
 
   auto* structures = new QGroupBox("Structures", display);
   auto* structLayout = new QVBoxLayout(structures);
+  auto* skinRow = new QHBoxLayout();
+  skinRow->addWidget(new QLabel("Skin", structures));
+  m_skinDisplay = new QComboBox(structures);
+  for (const auto& [label, display] : kSkinDisplays) m_skinDisplay->addItem(label, static_cast<int>(display));
+  skinRow->addWidget(m_skinDisplay, 1);
+  structLayout->addLayout(skinRow);
   for (const auto& [name, flag] : kStructures) {
     auto* check = new QCheckBox(name, structures);
     structLayout->addWidget(check);
@@ -422,12 +438,16 @@ void MainWindow::buildDocks() {
     viz::DisplayOptions o = m_scene->options();
     o.muscleColouring = static_cast<viz::MuscleColouring>(m_muscleColour->currentData().toInt());
     o.gutColouring = static_cast<viz::GutColouring>(m_gutColour->currentData().toInt());
+    o.skin = static_cast<viz::SkinDisplay>(m_skinDisplay->currentData().toInt());
+    o.skinColouring = static_cast<viz::SkinColouring>(m_skinColour->currentData().toInt());
     for (const auto& [check, flag] : m_structureChecks) o.*flag = check->isChecked();
     for (std::size_t g = 0; g < m_groupChecks.size(); ++g) o.showGroup[g] = m_groupChecks[g]->isChecked();
     setDisplayOptions(o);
   };
   connect(m_muscleColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
   connect(m_gutColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
+  connect(m_skinDisplay, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
+  connect(m_skinColour, qOverload<int>(&QComboBox::currentIndexChanged), this, readOptions);
   for (const auto& [check, flag] : m_structureChecks) connect(check, &QCheckBox::toggled, this, readOptions);
   for (QCheckBox* c : m_groupChecks) connect(c, &QCheckBox::toggled, this, readOptions);
 
@@ -461,12 +481,16 @@ void MainWindow::syncDisplayWidgets() {
     std::vector<QSignalBlocker> b;
     b.emplace_back(m_muscleColour);
     b.emplace_back(m_gutColour);
+    b.emplace_back(m_skinDisplay);
+    b.emplace_back(m_skinColour);
     for (const auto& [check, flag] : m_structureChecks) b.emplace_back(check);
     for (QCheckBox* c : m_groupChecks) b.emplace_back(c);
     return b;
   }();
   m_muscleColour->setCurrentIndex(m_muscleColour->findData(static_cast<int>(o.muscleColouring)));
   m_gutColour->setCurrentIndex(m_gutColour->findData(static_cast<int>(o.gutColouring)));
+  m_skinDisplay->setCurrentIndex(m_skinDisplay->findData(static_cast<int>(o.skin)));
+  m_skinColour->setCurrentIndex(m_skinColour->findData(static_cast<int>(o.skinColouring)));
   for (const auto& [check, flag] : m_structureChecks) check->setChecked(o.*flag);
   for (std::size_t g = 0; g < m_groupChecks.size(); ++g) m_groupChecks[g]->setChecked(o.showGroup[g]);
 }

@@ -154,6 +154,8 @@ class MainWindow : public QMainWindow {
   QComboBox* m_affectMode = nullptr;
   QComboBox* m_muscleColour = nullptr;
   QComboBox* m_gutColour = nullptr;
+  QComboBox* m_skinDisplay = nullptr;  // the skin: translucent, opaque or hidden
+  QComboBox* m_skinColour = nullptr;   // the skin: plain or displacement
   std::vector<std::pair<QCheckBox*, bool viz::DisplayOptions::*>> m_structureChecks;  // each with its option
   std::vector<QCheckBox*> m_groupChecks;
   std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique

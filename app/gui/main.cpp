@@ -86,11 +86,13 @@ int main(int argc, char** argv) {
       "camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME", "oblique");
   const QCommandLineOption labels("labels",
                                   "Show the anatomical labels and the lung cavity (teaching view).");
+  const QCommandLineOption skin("skin", "The skin: translucent (default), opaque or hidden.", "MODE",
+                                "translucent");
   const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X",
                                  "1");
   const QCommandLineOption measure(
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
-  parser.addOptions({model, style, affect, posture, camera, labels, speed, screenshot, after, measure});
+  parser.addOptions({model, style, affect, posture, camera, labels, skin, speed, screenshot, after, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -137,6 +139,17 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  const std::map<QString, pneuma::viz::SkinDisplay> skinModes{
+      {"translucent", pneuma::viz::SkinDisplay::Translucent},
+      {"opaque", pneuma::viz::SkinDisplay::Opaque},
+      {"hidden", pneuma::viz::SkinDisplay::Hidden}};
+  const auto skinMode = skinModes.find(parser.value(skin));
+  if (skinMode == skinModes.end()) {
+    std::fprintf(stderr, "pneuma: --skin: unknown mode '%s' (valid: translucent, opaque, hidden)\n",
+                 qPrintable(parser.value(skin)));
+    return 2;
+  }
+
   pneuma::app::MainWindow window;
   window.setSpeed(speedValue);
   window.show();
@@ -152,10 +165,13 @@ int main(int argc, char** argv) {
     if (!window.pushAffect(parser.value(affect), true).isEmpty() && isScripted) return 2;
   }
   window.scene().setCamera(preset->second);
-  if (parser.isSet(labels)) {
+  {
     pneuma::viz::DisplayOptions options = window.scene().options();
-    options.showLabels = true;
-    options.showCavity = true;
+    options.skin = skinMode->second;
+    if (parser.isSet(labels)) {
+      options.showLabels = true;
+      options.showCavity = true;
+    }
     window.setDisplayOptions(options);
   }
 

@@ -36,6 +36,7 @@
 #include <limits>
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/PosedGeometry.h"
 
 namespace pneuma::viz {
 
@@ -68,6 +69,15 @@ vtkSmartPointer<vtkLookupTable> makeForceTable() {
 // colour scale of the gut: deep blue to cyan to white
 vtkSmartPointer<vtkLookupTable> makeGutTable() {
   auto table = makeRampTable({{0.0, 0.17, 0.25, 0.62}, {0.6, 0.25, 0.72, 0.85}, {1.0, 0.88, 0.97, 1.0}});
+  table->Build();
+  return table;
+}
+
+// colour scale of the skin's displacement: a heat map, skin tone (still) through orange to deep red, over the
+// fixed range [0, kSkinDisplacementTop] mm
+vtkSmartPointer<vtkLookupTable> makeSkinTable() {
+  auto table = makeRampTable({{0.0, 0.93, 0.80, 0.70}, {0.4, 0.98, 0.60, 0.25}, {1.0, 0.70, 0.05, 0.08}});
+  table->SetTableRange(0.0, kSkinDisplacementTop);
   table->Build();
   return table;
 }
@@ -189,6 +199,8 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkLookupTable> gutTable = makeGutTable();
   vtkSmartPointer<vtkScalarBarActor> forceBar = makeScalarBar(forceTable, "Contractive\nforce [N]", 0.55);
   vtkSmartPointer<vtkScalarBarActor> gutBar = makeScalarBar(gutTable, "Gut", 0.07);
+  vtkSmartPointer<vtkLookupTable> skinTable = makeSkinTable();
+  vtkSmartPointer<vtkScalarBarActor> skinBar = makeScalarBar(skinTable, "Skin\ndisplacement\n[mm]", 0.31);
   DisplayOptions options;
 
   sim::Model model;
@@ -204,7 +216,7 @@ struct ModelScene::Impl {
     vtkSmartPointer<vtkActor> actor;
   };
   std::array<Group, kGroups> groups;
-  Eigen::Matrix3Xd endA, endB;  // [m] element end positions (3 x #E)
+  sim::PosedGeometry posed;  // the model posed for the last update() (the one posing function)
 
   std::vector<vtkSmartPointer<vtkActor>> bodies;
   std::vector<vtkSmartPointer<vtkMatrix4x4>> bodyPose;
@@ -215,13 +227,18 @@ struct ModelScene::Impl {
 
   vtkSmartPointer<vtkPolyData> cavity;
   vtkSmartPointer<vtkActor> cavityActor;
-  Eigen::Matrix3Xd cavityPoints;  // [m]
 
   std::array<vtkSmartPointer<vtkPolyData>, 2> lungs;  // right, left
   std::array<vtkSmartPointer<vtkActor>, 2> lungActors;
 
   vtkSmartPointer<vtkPolyData> landmarks;
   vtkSmartPointer<vtkActor> landmarkActor;
+
+  // the skin, coloured plain or by its displacement from the rest pose
+  vtkSmartPointer<vtkPolyData> skin;
+  vtkSmartPointer<vtkFloatArray> skinScalar;  // [mm] displacement from the rest pose
+  vtkSmartPointer<vtkActor> skinActor;
+  Eigen::Matrix3Xd skinRest;  // [m] skin vertices at the rest pose (3 x #V)
 
   // teaching labels: landmarks, group centres, and a few named bones
   struct Label {
@@ -240,7 +257,7 @@ struct ModelScene::Impl {
     bodies.clear();
     bodyPose.clear();
     labels.clear();
-    gutActor = cavityActor = landmarkActor = highlightActor = nullptr;
+    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = nullptr;
     lungs = {};
     lungActors = {};
     highlight = Pick{};
@@ -255,7 +272,8 @@ struct ModelScene::Impl {
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
                        static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
-                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
+                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor),
+                       static_cast<vtkProp*>(skinActor)})
       if (p) props.push_back(p);
     return props;
   }
@@ -390,6 +408,31 @@ struct ModelScene::Impl {
       lungActors[i]->PickableOff();
     }
 
+    // the skin: smooth-shaded, drawn last among the surfaces so the translucent body wraps the rest
+    if (model.skin.vertexCount() > 0) {
+      skin = surface(model.skin.vertexCount(), model.skin.triangles);
+      skinScalar = vtkSmartPointer<vtkFloatArray>::New();
+      skinScalar->SetNumberOfValues(model.skin.vertexCount());
+      skinScalar->Fill(0.0f);
+      skin->GetPointData()->SetScalars(skinScalar);
+      vtkNew<vtkPolyDataNormals> skinNormals;
+      skinNormals->SetInputData(skin);
+      skinNormals->SplittingOff();
+      skinNormals->ConsistencyOff();
+      vtkNew<vtkPolyDataMapper> skinMapper;
+      skinMapper->SetInputConnection(skinNormals->GetOutputPort());
+      skinMapper->SetLookupTable(skinTable);
+      skinMapper->UseLookupTableScalarRangeOn();
+      skinActor = vtkSmartPointer<vtkActor>::New();
+      skinActor->SetMapper(skinMapper);
+      skinActor->GetProperty()->SetSpecular(0.15);
+      skinActor->GetProperty()->SetSpecularPower(12.0);
+      skinActor->PickableOff();
+      sim::PosedGeometry rest;
+      sim::poseGeometry(model, sim::makeInitialState(model), rest);
+      skinRest = rest.skin;
+    }
+
     landmarks = vtkSmartPointer<vtkPolyData>::New();
     vtkNew<vtkPoints> lmPoints;
     lmPoints->SetNumberOfPoints(static_cast<vtkIdType>(model.landmarks.name.size()));
@@ -478,6 +521,16 @@ struct ModelScene::Impl {
     for (const auto& a : lungActors)
       if (a) a->SetVisibility(options.showLungs);
     if (landmarkActor) landmarkActor->SetVisibility(options.showLandmarks);
+    const bool isSkinShown = skinActor && options.skin != SkinDisplay::Hidden;
+    const bool isSkinColoured = options.skinColouring == SkinColouring::Displacement;
+    if (skinActor) {
+      skinActor->SetVisibility(isSkinShown);
+      skinActor->GetProperty()->SetOpacity(options.skin == SkinDisplay::Translucent ? kSkinTranslucency
+                                                                                    : 1.0);
+      skinActor->GetProperty()->SetColor(0.93, 0.76, 0.64);
+      skinActor->GetMapper()->SetScalarVisibility(isSkinColoured);
+    }
+    skinBar->SetVisibility(isSkinShown && isSkinColoured);
     for (const Label& l : labels) {
       const bool relevant = l.group >= 0      ? options.showGroup[static_cast<std::size_t>(l.group)]
                             : l.landmark >= 0 ? options.showLandmarks
@@ -495,8 +548,10 @@ ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
   r->SetBackground2(0.36, 0.39, 0.47);
   r->AddViewProp(m_impl->forceBar);
   r->AddViewProp(m_impl->gutBar);
+  r->AddViewProp(m_impl->skinBar);
   m_impl->forceBar->VisibilityOff();
   m_impl->gutBar->VisibilityOff();
+  m_impl->skinBar->VisibilityOff();
 }
 
 ModelScene::~ModelScene() = default;
@@ -543,21 +598,18 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
   Impl& s = *m_impl;
   const sim::Model& model = s.model;
 
+  sim::poseGeometry(model, state, s.posed);
+
   // bones: rigid transforms body -> world
   for (std::size_t b = 0; b < s.bodies.size(); ++b) {
-    const Eigen::Matrix3d R = state.bodyOrientation[b].toRotationMatrix();
-    const Eigen::Vector3d x = state.bodyPosition.col(static_cast<Eigen::Index>(b));
+    const Eigen::Matrix4d T = s.posed.body[b].matrix();
     vtkMatrix4x4* m = s.bodyPose[b];
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) m->SetElement(i, j, R(i, j));
-      m->SetElement(i, 3, x(i));
-    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 4; ++j) m->SetElement(i, j, T(i, j));
     m->Modified();
   }
 
   // muscle elements: end positions and contractive force magnitude (NaN = slack = grey)
-  sim::anchorPositions(model.elements.endA, state, s.endA);
-  sim::anchorPositions(model.elements.endB, state, s.endB);
   const bool hasForces = metrics.elementForce.size() == model.elements.size();
   double maxForce = 0.0;
   for (Impl::Group& g : s.groups) {
@@ -566,8 +618,8 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     for (std::size_t k = 0; k < g.element.size(); ++k) {
       const int e = g.element[k];
       const auto id = static_cast<vtkIdType>(2 * k);
-      points->SetPoint(id, s.endA(0, e), s.endA(1, e), s.endA(2, e));
-      points->SetPoint(id + 1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
+      points->SetPoint(id, s.posed.elementA(0, e), s.posed.elementA(1, e), s.posed.elementA(2, e));
+      points->SetPoint(id + 1, s.posed.elementB(0, e), s.posed.elementB(1, e), s.posed.elementB(2, e));
       const double tension = hasForces ? std::max(0.0, -metrics.elementForce(e)) : 0.0;
       const bool isSlack = !(tension > 0.0) || (static_cast<std::size_t>(e) < metrics.isSlack.size() &&
                                                 metrics.isSlack[static_cast<std::size_t>(e)]);
@@ -585,7 +637,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
 
   // gut surface and its colour
   if (s.gut) {
-    Impl::setPoints(s.gut, state.nodePosition);
+    Impl::setPoints(s.gut, s.posed.gut);
     double maxDisp = 0.0;
     for (int n = 0; n < model.nodes.size(); ++n) {
       const double d = (state.nodePosition.col(n) - model.nodes.rest.col(n)).norm();
@@ -609,19 +661,21 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
 
   // cavity and landmarks
   if (s.cavity) {
-    sim::anchorPositions(model.cavity.vertices, state, s.cavityPoints);
-    Impl::setPoints(s.cavity, s.cavityPoints);
-    const std::array<const sim::LungSurface*, 2> lungSurfaces{&model.lungs.right, &model.lungs.left};
-    Eigen::Matrix3Xd x;
-    for (std::size_t i = 0; i < 2; ++i) {
-      if (!s.lungs[i]) continue;
-      sim::lungPositions(*lungSurfaces[i], s.cavityPoints, x);
-      Impl::setPoints(s.lungs[i], x);
-    }
+    Impl::setPoints(s.cavity, s.posed.cavity);
+    if (s.lungs[0]) Impl::setPoints(s.lungs[0], s.posed.lungRight);
+    if (s.lungs[1]) Impl::setPoints(s.lungs[1], s.posed.lungLeft);
   }
-  Eigen::Matrix3Xd lm;
-  sim::anchorPositions(model.landmarks.points, state, lm);
+  const Eigen::Matrix3Xd& lm = s.posed.landmarks;
   if (s.landmarks) Impl::setPoints(s.landmarks, lm);
+
+  // skin and its displacement from the rest pose [mm]
+  if (s.skin) {
+    Impl::setPoints(s.skin, s.posed.skin);
+    for (Eigen::Index v = 0; v < s.posed.skin.cols(); ++v)
+      s.skinScalar->SetValue(v,
+                             static_cast<float>(1000.0 * (s.posed.skin.col(v) - s.skinRest.col(v)).norm()));
+    s.skinScalar->Modified();
+  }
 
   // labels follow their structures
   for (const Impl::Label& l : s.labels) {
@@ -634,7 +688,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
       // a group is labelled at its element furthest to the subject's right, clear of the midline
       at = Eigen::Vector3d::Constant(-1e9);
       for (int e : s.groups[static_cast<std::size_t>(l.group)].element) {
-        const Eigen::Vector3d mid = 0.5 * (s.endA.col(e) + s.endB.col(e));
+        const Eigen::Vector3d mid = 0.5 * (s.posed.elementA.col(e) + s.posed.elementB.col(e));
         if (mid.x() > at.x()) at = mid;
       }
     }
@@ -647,8 +701,10 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
   // selection highlight
   if (s.highlight.kind == Pick::Kind::Element) {
     const int e = s.highlight.index;
-    s.highlightLine->GetPoints()->SetPoint(0, s.endA(0, e), s.endA(1, e), s.endA(2, e));
-    s.highlightLine->GetPoints()->SetPoint(1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
+    s.highlightLine->GetPoints()->SetPoint(0, s.posed.elementA(0, e), s.posed.elementA(1, e),
+                                           s.posed.elementA(2, e));
+    s.highlightLine->GetPoints()->SetPoint(1, s.posed.elementB(0, e), s.posed.elementB(1, e),
+                                           s.posed.elementB(2, e));
     s.highlightLine->GetPoints()->Modified();
   }
 }
@@ -718,8 +774,10 @@ void ModelScene::setHighlight(const Pick& pick) {
     s.bodies[static_cast<std::size_t>(pick.index)]->GetProperty()->SetColor(0.3, 0.95, 0.95);
   if (pick.kind == Pick::Kind::Element) {
     const int e = pick.index;
-    s.highlightLine->GetPoints()->SetPoint(0, s.endA(0, e), s.endA(1, e), s.endA(2, e));
-    s.highlightLine->GetPoints()->SetPoint(1, s.endB(0, e), s.endB(1, e), s.endB(2, e));
+    s.highlightLine->GetPoints()->SetPoint(0, s.posed.elementA(0, e), s.posed.elementA(1, e),
+                                           s.posed.elementA(2, e));
+    s.highlightLine->GetPoints()->SetPoint(1, s.posed.elementB(0, e), s.posed.elementB(1, e),
+                                           s.posed.elementB(2, e));
     s.highlightLine->GetPoints()->Modified();
   }
 }

@@ -26,6 +26,15 @@ namespace pneuma::viz {
 enum class MuscleColouring { Force, Group };
 /// How the gut surface is coloured.
 enum class GutColouring { Plain, Pressure, Displacement };
+/// How the skin is shown.
+enum class SkinDisplay { Hidden, Translucent, Opaque };
+/// How the skin is coloured: plain skin tone, or its displacement from the rest pose (the relaxed
+/// end-expiration the model is built at) in mm on the fixed scale [0, kSkinDisplacementTop] (a breathing heat
+/// map: calm breathing moves the chest and belly 1-4 mm, a deep breath 5-15 mm).
+enum class SkinColouring { Plain, Displacement };
+constexpr double kSkinDisplacementTop = 10.0;  ///< [mm] top of the skin displacement colour scale
+constexpr double kSkinTranslucency = 0.3;      ///< [-] opacity of the translucent skin
+
 /// Camera presets, looking at the whole model.
 enum class CameraPreset { Anterior, Lateral, Superior, Oblique };
 
@@ -49,6 +58,10 @@ struct DisplayOptions {
   bool showLungs = true;  ///< the right and left lungs, translucent (Model::lungs)
   bool showLandmarks = true;
   bool showLabels = false;
+  /// the skin (Model::skin): translucent by default, so that a lecturer sees the body's outline and the rib
+  /// cage, muscles and gut breathing inside it
+  SkinDisplay skin = SkinDisplay::Translucent;
+  SkinColouring skinColouring = SkinColouring::Plain;
   std::array<bool, sim::kElementGroupCount> showGroup{true, true, true, true, true, true};
   double forceRange = 0.0;  ///< [N] top of the force colour scale; 0 = adapt to the largest force seen
 };

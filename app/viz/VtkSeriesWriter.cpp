@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/PosedGeometry.h"
 #include "viz/AtomicFile.h"
 #include "viz/ModelScene.h"
 
@@ -30,8 +31,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity", "lungs"};
-constexpr int kPartCount = 5;
+constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity", "lungs", "skin"};
+constexpr int kPartCount = 6;
 
 vtkSmartPointer<vtkDoubleArray> scalarArray(const char* name, int components, vtkIdType tuples) {
   auto a = vtkSmartPointer<vtkDoubleArray>::New();
@@ -76,6 +77,8 @@ struct VtkSeriesWriter::Impl {
   vtkSmartPointer<vtkCellArray> bonePolys, boneVerts;
   vtkSmartPointer<vtkIntArray> boneBodyId;  // per cell: vertices first, then polygons (VTK's cell order)
   std::vector<double> frameTimes;           // [s]
+  sim::PosedGeometry posed;                 // the frame being written (the one posing function)
+  Eigen::Matrix3Xd skinRest;                // [m] skin vertices at the rest pose (3 x #V)
 
   Impl(const sim::Model& m, const std::string& modelDir, std::string dir, std::string base)
       : model(m), outDir(std::move(dir)), baseName(std::move(base)) {
@@ -125,6 +128,8 @@ struct VtkSeriesWriter::Impl {
     for (int b : polyBody) boneBodyId->InsertNextValue(b);
     boneLocal.resize(3, static_cast<Eigen::Index>(local.size()));
     for (std::size_t i = 0; i < local.size(); ++i) boneLocal.col(static_cast<Eigen::Index>(i)) = local[i];
+    sim::poseGeometry(model, sim::makeInitialState(model), posed);
+    skinRest = posed.skin;
   }
 
   std::string partPath(int part, int frame) const {
@@ -146,13 +151,11 @@ struct VtkSeriesWriter::Impl {
     writeFileAtomically(path, writer->GetOutputString());
   }
 
-  vtkSmartPointer<vtkPolyData> bones(const sim::State& state) const {
+  vtkSmartPointer<vtkPolyData> bones() const {
     Eigen::Matrix3Xd x(3, boneLocal.cols());
-    for (Eigen::Index i = 0; i < boneLocal.cols(); ++i) {
-      const std::size_t b = static_cast<std::size_t>(bonePointBody[static_cast<std::size_t>(i)]);
-      x.col(i) =
-          state.bodyOrientation[b] * boneLocal.col(i) + state.bodyPosition.col(static_cast<Eigen::Index>(b));
-    }
+    for (Eigen::Index i = 0; i < boneLocal.cols(); ++i)
+      x.col(i) = posed.body[static_cast<std::size_t>(bonePointBody[static_cast<std::size_t>(i)])] *
+                 Eigen::Vector3d(boneLocal.col(i));
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     setPoints(pd, x);
     pd->SetVerts(boneVerts);
@@ -161,11 +164,10 @@ struct VtkSeriesWriter::Impl {
     return pd;
   }
 
-  vtkSmartPointer<vtkPolyData> muscles(const sim::State& state, const sim::Metrics& metrics) const {
+  vtkSmartPointer<vtkPolyData> muscles(const sim::Metrics& metrics) const {
     const sim::Elements& el = model.elements;
-    Eigen::Matrix3Xd a, b;
-    sim::anchorPositions(el.endA, state, a);
-    sim::anchorPositions(el.endB, state, b);
+    const Eigen::Matrix3Xd& a = posed.elementA;
+    const Eigen::Matrix3Xd& b = posed.elementB;
     Eigen::Matrix3Xd x(3, 2 * el.size());
     vtkNew<vtkCellArray> lines;
     auto force = scalarArray("force_N", 1, el.size());
@@ -201,13 +203,13 @@ struct VtkSeriesWriter::Impl {
     return pd;
   }
 
-  vtkSmartPointer<vtkPolyData> gut(const sim::State& state, const sim::Metrics& metrics) const {
+  vtkSmartPointer<vtkPolyData> gut(const sim::Metrics& metrics) const {
     auto pd = vtkSmartPointer<vtkPolyData>::New();
-    setPoints(pd, state.nodePosition);
+    setPoints(pd, posed.gut);
     pd->SetPolys(triangles(model.gut.triangles));
-    auto disp = scalarArray("displacement_m", 3, state.nodePosition.cols());
-    for (Eigen::Index i = 0; i < state.nodePosition.cols(); ++i) {
-      const Eigen::Vector3d d = state.nodePosition.col(i) - model.nodes.rest.col(i);
+    auto disp = scalarArray("displacement_m", 3, posed.gut.cols());
+    for (Eigen::Index i = 0; i < posed.gut.cols(); ++i) {
+      const Eigen::Vector3d d = posed.gut.col(i) - model.nodes.rest.col(i);
       disp->SetTuple3(i, d.x(), d.y(), d.z());
     }
     pd->GetPointData()->AddArray(disp);
@@ -216,11 +218,9 @@ struct VtkSeriesWriter::Impl {
     return pd;
   }
 
-  vtkSmartPointer<vtkPolyData> cavity(const sim::State& state, const sim::Metrics& metrics) const {
-    Eigen::Matrix3Xd x;
-    sim::anchorPositions(model.cavity.vertices, state, x);
+  vtkSmartPointer<vtkPolyData> cavity(const sim::Metrics& metrics) const {
     auto pd = vtkSmartPointer<vtkPolyData>::New();
-    setPoints(pd, x);
+    setPoints(pd, posed.cavity);
     pd->SetPolys(triangles(model.cavity.triangles));
     fieldValue(pd, "thoracic_cavity_volume_m3", metrics.thoracicCavityVolume);
     fieldValue(pd, "lung_volume_m3", metrics.lungVolume);
@@ -229,13 +229,11 @@ struct VtkSeriesWriter::Impl {
 
   // both lungs in one polydata, the right lung's vertices and triangles first; cell data side: 0 right, 1
   // left
-  vtkSmartPointer<vtkPolyData> lungs(const sim::State& state, const sim::Metrics& metrics) const {
+  vtkSmartPointer<vtkPolyData> lungs(const sim::Metrics& metrics) const {
     const sim::LungSurface& right = model.lungs.right;
     const sim::LungSurface& left = model.lungs.left;
-    Eigen::Matrix3Xd cavity, xr, xl;
-    sim::anchorPositions(model.cavity.vertices, state, cavity);
-    sim::lungPositions(right, cavity, xr);
-    sim::lungPositions(left, cavity, xl);
+    const Eigen::Matrix3Xd& xr = posed.lungRight;
+    const Eigen::Matrix3Xd& xl = posed.lungLeft;
     Eigen::Matrix3Xd x(3, xr.cols() + xl.cols());
     x << xr, xl;
     Eigen::Matrix3Xi t(3, right.triangles.cols() + left.triangles.cols());
@@ -252,6 +250,20 @@ struct VtkSeriesWriter::Impl {
     fieldValue(pd, "lung_volume_m3", metrics.lungVolume);
     return pd;
   }
+
+  // the skin (empty for a model without one); point data displacement_m from the rest pose
+  vtkSmartPointer<vtkPolyData> skin() const {
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, posed.skin);
+    pd->SetPolys(triangles(model.skin.triangles));
+    auto disp = scalarArray("displacement_m", 3, posed.skin.cols());
+    for (Eigen::Index i = 0; i < posed.skin.cols(); ++i) {
+      const Eigen::Vector3d d = posed.skin.col(i) - skinRest.col(i);
+      disp->SetTuple3(i, d.x(), d.y(), d.z());
+    }
+    pd->GetPointData()->AddArray(disp);
+    return pd;
+  }
 };
 
 VtkSeriesWriter::VtkSeriesWriter(const sim::Model& model, const std::string& modelDir,
@@ -262,11 +274,13 @@ VtkSeriesWriter::~VtkSeriesWriter() = default;
 
 void VtkSeriesWriter::writeFrame(const sim::State& state, const sim::Metrics& metrics) {
   const int frame = static_cast<int>(m_impl->frameTimes.size());
-  m_impl->write(m_impl->bones(state), m_impl->partPath(0, frame));
-  m_impl->write(m_impl->muscles(state, metrics), m_impl->partPath(1, frame));
-  m_impl->write(m_impl->gut(state, metrics), m_impl->partPath(2, frame));
-  m_impl->write(m_impl->cavity(state, metrics), m_impl->partPath(3, frame));
-  m_impl->write(m_impl->lungs(state, metrics), m_impl->partPath(4, frame));
+  sim::poseGeometry(m_impl->model, state, m_impl->posed);
+  m_impl->write(m_impl->bones(), m_impl->partPath(0, frame));
+  m_impl->write(m_impl->muscles(metrics), m_impl->partPath(1, frame));
+  m_impl->write(m_impl->gut(metrics), m_impl->partPath(2, frame));
+  m_impl->write(m_impl->cavity(metrics), m_impl->partPath(3, frame));
+  m_impl->write(m_impl->lungs(metrics), m_impl->partPath(4, frame));
+  m_impl->write(m_impl->skin(), m_impl->partPath(5, frame));
   m_impl->frameTimes.push_back(state.time);
 }
 

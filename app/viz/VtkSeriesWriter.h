@@ -1,15 +1,17 @@
 #pragma once
 /// @file VtkSeriesWriter.h
 /// Export of a running simulation as a ParaView time series: one .pvd collection that lists, per frame,
-/// five .vtp parts (VTK XML polydata, SI units):
+/// six .vtp parts (VTK XML polydata, SI units), all posed by sim::poseGeometry():
 ///   part 0 bones    body meshes posed in world [m]; cell data body_id
 ///   part 1 muscles  one line per element [m]; cell data force_N (signed, <= 0 is tension), tension_N,
 ///                   group (ElementGroup index), is_slack
 ///   part 2 gut      the gut surface [m]; point data displacement_m (3), field data pressure_Pa
 ///   part 3 cavity   the lung-cavity surface [m]; field data thoracic_cavity_volume_m3, lung_volume_m3
 ///   part 4 lungs    the right and the left lung surfaces [m] (empty for a model without them); cell data
-///   side
-///                   (0 right, 1 left), field data right_lung_volume_m3, left_lung_volume_m3, lung_volume_m3
+///                   side (0 right, 1 left), field data right_lung_volume_m3, left_lung_volume_m3,
+///                   lung_volume_m3
+///   part 5 skin     the body surface [m] (empty for a model without one); point data displacement_m (3) from
+///                   the rest pose
 /// Every file is written to a temporary name and renamed; the .pvd is written by finish().
 
 #include <memory>
@@ -32,7 +34,7 @@ class VtkSeriesWriter {
   VtkSeriesWriter(const VtkSeriesWriter&) = delete;
   VtkSeriesWriter& operator=(const VtkSeriesWriter&) = delete;
 
-  /// Writes the four parts of one frame at `state.time`.
+  /// Writes the six parts of one frame at `state.time`.
   void writeFrame(const sim::State& state, const sim::Metrics& metrics);
   /// Writes the .pvd collection of all frames written so far; returns its file name ("<baseName>.pvd").
   std::string finish();

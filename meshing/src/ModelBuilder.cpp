@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -10,6 +11,7 @@
 #include "LungCavity.h"
 #include "MuscleNetwork.h"
 #include "Skeleton.h"
+#include "Skin.h"
 #include "pneuma/meshing/MeshTools.h"
 #include "pneuma/meshing/Tetrahedralizer.h"
 #include "pneuma/sim/Error.h"
@@ -153,7 +155,7 @@ void buildLandmarks(const AnatomyParams& a, const Skeleton& sk, const GutSurface
 
 }  // namespace
 
-BuiltModel buildModel(const AnatomyParams& a) {
+BuiltModel buildModel(const AnatomyParams& a, const std::string& skinFile) {
   BuiltModel out;
   out.model.name = a.name;
   out.model.anatomy = a.source.substr(a.source.find_last_of('/') + 1);
@@ -171,6 +173,14 @@ BuiltModel buildModel(const AnatomyParams& a) {
   out.model.cavity.recoilPressure = a.gains.lungRecoil;
   out.model.cavity.compliance = a.gains.lungCompliance;
   buildLandmarks(a, sk, gut, out.model);
+  if (!skinFile.empty()) {
+    if (skinFile == kDefaultSkinFile && !std::filesystem::exists(skinFile))
+      throw sim::Error(
+          skinFile +
+          ": the default skin mesh is missing; install it with 'apt-get install assimp-testmodels' "
+          "(Debian) or give another with --skin FILE");
+    buildSkin(a, skinFile, out);
+  }
 
   sim::validateModel(out.model);
   out.report.summary = summarizeModel(out.model);

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pneuma/meshing/TriangleMesh.h"
+#include "pneuma/sim/State.h"
 
 namespace pneuma::meshing {
 
@@ -47,6 +48,14 @@ ModelSummary summarizeModel(const sim::Model& m) {
   for (sim::ElementGroup g : m.elements.group) ++s.elements[static_cast<std::size_t>(g)];
   s.gutVolume = enclosedVolume(m.nodes.rest, m.gut.triangles);
   s.cavityVolume = enclosedVolume(restPoints(m.cavity.vertices, m), m.cavity.triangles);
+  s.skinVertices = m.skin.vertexCount();
+  s.skinTriangles = static_cast<int>(m.skin.triangles.cols());
+  s.skinTetrahedra = m.skin.tetrahedra;
+  if (s.skinVertices > 0) {
+    Eigen::Matrix3Xd x;
+    sim::skinPositions(m.skin, restPoints(m.skin.anchors, m), x);
+    s.skinVolume = enclosedVolume(x, m.skin.triangles);
+  }
   return s;
 }
 
@@ -66,6 +75,10 @@ std::string summaryJson(const ModelSummary& s) {
   j["cavity_volume_ml"] = std::round(s.cavityVolume * kMlPerM3 * 10.0) / 10.0;
   j["gut_wall_mass_kg"] = std::round(s.gutWallMass * 1e4) / 1e4;
   j["bone_mass_kg"] = std::round(s.boneMass * 1e4) / 1e4;
+  j["skin"] = {{"vertices", s.skinVertices},
+               {"triangles", s.skinTriangles},
+               {"tetrahedra", s.skinTetrahedra},
+               {"volume_ml", std::round(s.skinVolume * kMlPerM3 * 10.0) / 10.0}};
   return j.dump(2);
 }
 
@@ -86,6 +99,13 @@ std::string summaryText(const ModelSummary& s) {
   o.precision(3);
   o << "gut wall mass:   " << s.gutWallMass << " kg\n"
     << "bone mass:       " << s.boneMass << " kg\n";
+  if (s.skinVertices > 0) {
+    o.precision(1);
+    o << "skin:            " << s.skinVertices << " vertices, " << s.skinTriangles << " triangles, "
+      << s.skinTetrahedra << " soft-tissue tetrahedra, " << s.skinVolume * kMlPerM3 << " mL\n";
+  } else {
+    o << "skin:            none\n";
+  }
   return o.str();
 }
 

@@ -4,6 +4,7 @@
 #include <tetgen.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -17,9 +18,9 @@ namespace {
 // own clean-up (SIGSEGV, no exception to catch) on nearly flat surfaces, e.g. an abdomen 1e-12 mm wide.
 constexpr double kMinTetgenQuality = 0.01;
 
-}  // namespace
-
-TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
+// TetGen on the piecewise-linear complex of `surface` with the `interior` points added as vertices
+TetMesh run(const TriangleMesh& surface, const Eigen::Matrix3Xd& interior, const char* options,
+            const std::string& part) {
   for (int f = 0; f < surface.triangleCount(); ++f) {
     const double q = triangleQuality(surface.vertices.col(surface.triangles(0, f)),
                                      surface.vertices.col(surface.triangles(1, f)),
@@ -34,10 +35,12 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
   // the surface as a piecewise-linear complex of triangular facets (tetgenio frees these arrays)
   tetgenio in;
   in.firstnumber = 0;
-  in.numberofpoints = surface.vertexCount();
+  const int nSurface = surface.vertexCount();
+  in.numberofpoints = nSurface + static_cast<int>(interior.cols());
   in.pointlist = new REAL[static_cast<std::size_t>(3 * in.numberofpoints)];
   for (int i = 0; i < in.numberofpoints; ++i) {
-    for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = surface.vertices(k, i);
+    for (int k = 0; k < 3; ++k)
+      in.pointlist[3 * i + k] = i < nSurface ? surface.vertices(k, i) : interior(k, i - nSurface);
   }
   in.numberoffacets = surface.triangleCount();
   in.facetlist = new tetgenio::facet[static_cast<std::size_t>(in.numberoffacets)];
@@ -53,9 +56,9 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
   }
 
   tetgenio out;
-  char switches[] = "pq1.5YQ";
+  std::string switches = options;
   try {
-    ::tetrahedralize(switches, &in, &out);
+    ::tetrahedralize(switches.data(), &in, &out);
   } catch (int code) {
     throw sim::Error(part + ": TetGen failed to tetrahedralise the surface (error " + std::to_string(code) +
                      ")");
@@ -78,7 +81,24 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
   }
   t.boundaryTriangles = out.numberoftrifaces;
   if (out.numberoftetrahedra == 0) throw sim::Error(part + ": TetGen produced no tetrahedra");
+  // the input points keep their indices (TetGen numbers its output points from the input's)
+  for (int i = 0; i < std::min(in.numberofpoints, out.numberofpoints); ++i) {
+    for (int k = 0; k < 3; ++k)
+      if (out.pointlist[3 * i + k] != in.pointlist[3 * i + k])
+        throw sim::Error(part + ": TetGen renumbered the input points");
+  }
   return t;
+}
+
+}  // namespace
+
+TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part) {
+  return run(surface, Eigen::Matrix3Xd(3, 0), "pq1.5YQ", part);
+}
+
+TetMesh tetrahedralizeAround(const TriangleMesh& surface, const Eigen::Matrix3Xd& interior,
+                             const std::string& part) {
+  return run(surface, interior, "pYQ", part);
 }
 
 }  // namespace pneuma::meshing

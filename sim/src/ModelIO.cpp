@@ -89,6 +89,39 @@ json writeAnchor(const AnchorSet& a, int i) {
 
 json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
+// skin: {"tetrahedra": n, "anchors": [anchor, ...], "vertices": [{"anchors": [i, ...], "weights": [w, ...],
+// "offset": [x, y, z]}, ...], "triangles": [[a, b, c], ...]}
+void readSkin(const Reader& r, Skin& out) {
+  r.allowKeys({"tetrahedra", "anchors", "vertices", "triangles"});
+  out.tetrahedra = r.at("tetrahedra").integer();
+  const Reader anchors = r.at("anchors");
+  for (std::size_t i = 0; i < anchors.size(); ++i) readAnchor(anchors[i], out.anchors);
+  const Reader verts = r.at("vertices");
+  const auto n = static_cast<Eigen::Index>(verts.size());
+  out.anchor.setConstant(kSkinVertexSlots, n, -1);
+  out.weights.setZero(kSkinVertexSlots, n);
+  out.offset.resize(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Reader v = verts[static_cast<std::size_t>(i)];
+    v.allowKeys({"anchors", "weights", "offset"});
+    const Reader idx = v.at("anchors");
+    const Reader w = v.at("weights");
+    if (idx.size() < 1 || idx.size() > kSkinVertexSlots)
+      idx.fail("must list 1 to " + std::to_string(kSkinVertexSlots) + " anchor indices");
+    if (w.size() != idx.size())
+      w.fail("must have as many entries as anchors (" + std::to_string(idx.size()) + ")");
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      out.anchor(static_cast<Eigen::Index>(k), i) = idx[k].integer();
+      out.weights(static_cast<Eigen::Index>(k), i) = w[k].number();
+    }
+    out.offset.col(i) = v.at("offset").vec3();
+  }
+  const Reader tris = r.at("triangles");
+  out.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    out.triangles.col(static_cast<Eigen::Index>(i)) = tris[i].index3();
+}
+
 // lung surface: {"vertices": [{"cavity_vertices": [i, ...], "weights": [w, ...]}, ...], "triangles": [[a, b,
 // c], ...]}
 void readLungSurface(const Reader& r, LungSurface& out) {
@@ -442,6 +475,38 @@ void validateModel(const Model& m) {
     }
   }
 
+  // skin: optional; bound to anchors, each vertex a convex combination of them plus an offset
+  const Skin& skin = m.skin;
+  const int nV = skin.vertexCount();
+  if (skin.weights.cols() != nV || skin.offset.cols() != nV) invalid("skin", "inconsistent array sizes");
+  if (skin.tetrahedra < 0) invalid("skin.tetrahedra", "must be >= 0, got " + std::to_string(skin.tetrahedra));
+  if (nV > 0) {
+    validateAnchors(skin.anchors, "skin.anchors", nB, nN);
+    for (int i = 0; i < nV; ++i) {
+      const std::string f = "skin.vertices[" + std::to_string(i) + "]";
+      double sum = 0.0;
+      int used = 0;
+      for (int k = 0; k < kSkinVertexSlots; ++k) {
+        const int a = skin.anchor(k, i);
+        if (a < 0) continue;
+        if (a >= skin.anchors.size())
+          invalid(f + ".anchors", "index " + std::to_string(a) + " out of range [0, " +
+                                      std::to_string(skin.anchors.size()) + ")");
+        const double w = skin.weights(k, i);
+        if (!std::isfinite(w) || w < 0.0) invalid(f + ".weights", "must be finite and >= 0, got " + num(w));
+        sum += w;
+        ++used;
+      }
+      if (used == 0) invalid(f + ".anchors", "must list at least one anchor");
+      if (std::abs(sum - 1.0) > 1e-6) invalid(f + ".weights", "must sum to 1, got " + num(sum));
+      requireFinite(skin.offset.col(i), f + ".offset");
+    }
+    validateTriangles(skin.triangles, "skin.triangles", nV);
+    validateClosedSurface(skin.triangles, "skin.triangles");
+  } else if (skin.triangles.cols() > 0) {
+    invalid("skin.triangles", "given without vertices");
+  }
+
   // landmarks
   if (static_cast<int>(m.landmarks.name.size()) != m.landmarks.points.size())
     invalid("landmarks", "inconsistent array sizes");
@@ -460,7 +525,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
   const Reader root = doc.root();
   root.allowKeys({"format", "version", "name", "anatomy", "units", "frame", "gravity", "bodies", "joints",
-                  "nodes", "gut", "elements", "cavity", "lungs", "landmarks"});
+                  "nodes", "gut", "elements", "cavity", "lungs", "landmarks", "skin"});
 
   // header
   if (root.at("format").string() != kFormatName)
@@ -603,6 +668,9 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     readAnchor(landmarks[i], m.landmarks.points, true);
   }
 
+  // skin: optional; a model written before the skin loads without one (docs/model-format.md)
+  if (root.has("skin")) readSkin(root.at("skin"), m.skin);
+
   // semantic checks; their messages name the model field
   try {
     validateModel(m);
@@ -715,6 +783,27 @@ std::string serializeModel(const Model& m) {
     landmarks.push_back(std::move(l));
   }
   doc["landmarks"] = std::move(landmarks);
+
+  if (m.skin.vertexCount() > 0) {
+    const Skin& skin = m.skin;
+    json anchors = json::array();
+    for (int i = 0; i < skin.anchors.size(); ++i) anchors.push_back(writeAnchor(skin.anchors, i));
+    json verts = json::array();
+    for (int i = 0; i < skin.vertexCount(); ++i) {
+      json idx = json::array(), w = json::array();
+      for (int k = 0; k < kSkinVertexSlots; ++k) {
+        if (skin.anchor(k, i) < 0) continue;
+        idx.push_back(skin.anchor(k, i));
+        w.push_back(skin.weights(k, i));
+      }
+      verts.push_back(
+          {{"anchors", std::move(idx)}, {"weights", std::move(w)}, {"offset", vec(skin.offset.col(i))}});
+    }
+    doc["skin"] = {{"tetrahedra", skin.tetrahedra},
+                   {"anchors", std::move(anchors)},
+                   {"vertices", std::move(verts)},
+                   {"triangles", triangles(skin.triangles)}};
+  }
 
   return doc.dump(1) + "\n";
 }

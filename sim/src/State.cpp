@@ -28,4 +28,11 @@ void lungPositions(const LungSurface& lung, const Eigen::Matrix3Xd& cavity, Eige
         out.col(i) += lung.weights(k, i) * cavity.col(lung.cavityVertex(k, i));
 }
 
+void skinPositions(const Skin& skin, const Eigen::Matrix3Xd& anchors, Eigen::Matrix3Xd& out) {
+  out = skin.offset;
+  for (int i = 0; i < skin.vertexCount(); ++i)
+    for (int k = 0; k < kSkinVertexSlots; ++k)
+      if (skin.anchor(k, i) >= 0) out.col(i) += skin.weights(k, i) * anchors.col(skin.anchor(k, i));
+}
+
 }  // namespace pneuma::sim

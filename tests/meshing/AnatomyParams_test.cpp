@@ -28,7 +28,7 @@ std::string errorOf(F corrupt) {
   corrupt(j);
   try {
     const AnatomyParams a = parseAnatomy(j.dump(), read(kDir + "muscle_gains.json"), "male.json");
-    buildModel(a);
+    buildModel(a, "");  // no skin: the anatomy's errors come before it
   } catch (const sim::Error& e) {
     return e.what();
   }

@@ -10,8 +10,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "SurfaceCrossings.h"
 #include "pneuma/meshing/MeshTools.h"
-#include "pneuma/sim/Elements.h"
+#include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/State.h"
@@ -285,24 +286,22 @@ TEST(ModelBuilder, BuildIsDeterministicAndDirectoryIsReplacedWhole) {
   const AnatomyParams a = loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/female.json");
   const BuiltModel one = buildModel(a);
   const BuiltModel two = buildModel(a);
-  // bodies, joints, nodes, gut, elements and landmarks are bit-identical; the cavity's triangulation
-  // comes from CGAL corefinement, whose tie-breaking follows heap addresses inside one process (separate
-  // processes, as at build time, give identical bytes), so it and the lungs carved from it are compared by
-  // their volumes
+  // bodies, joints, nodes, gut, elements, landmarks and the skin are bit-identical; the cavity's and the
+  // lungs' triangulations come from CGAL corefinement, whose tie-breaking follows heap addresses inside one
+  // process (separate processes, as at build time, give identical bytes), so they are compared by their
+  // volumes
   EXPECT_NEAR(two.report.summary.cavityVolume, one.report.summary.cavityVolume,
               1e-9 * one.report.summary.cavityVolume);
-  const auto lungVolumes = [](const sim::Model& m) {
-    Eigen::Matrix3Xd cavity, right, left;
-    sim::anchorPositions(m.cavity.vertices, sim::makeInitialState(m), cavity);
-    sim::lungPositions(m.lungs.right, cavity, right);
-    sim::lungPositions(m.lungs.left, cavity, left);
-    return Eigen::Vector2d(sim::enclosedVolume(right, m.lungs.right.triangles),
-                           sim::enclosedVolume(left, m.lungs.left.triangles));
-  };
-  const Eigen::Vector2d v1 = lungVolumes(one.model), v2 = lungVolumes(two.model);
-  EXPECT_GT(v1.minCoeff(), 1e-3);  // [m^3] a litre at least
-  EXPECT_LT((v2 - v1).cwiseAbs().maxCoeff(), 1e-6 * v1.maxCoeff());
   sim::Model a1 = one.model, a2 = two.model;
+  for (const auto& [lung1, lung2] :
+       {std::pair{&a1.lungs.right, &a2.lungs.right}, {&a1.lungs.left, &a2.lungs.left}}) {
+    Eigen::Matrix3Xd c, x1, x2;
+    c = restPoints(a1.cavity.vertices, a1);
+    sim::lungPositions(*lung1, c, x1);
+    c = restPoints(a2.cavity.vertices, a2);
+    sim::lungPositions(*lung2, c, x2);
+    EXPECT_NEAR(enclosedVolume(x2, lung2->triangles), enclosedVolume(x1, lung1->triangles), 1e-9);
+  }
   a2.cavity = a1.cavity;
   a2.lungs = a1.lungs;
   EXPECT_TRUE(sim::serializeModel(a1) == sim::serializeModel(a2)) << "two builds differ";
@@ -368,6 +367,62 @@ TEST_P(BuiltPresets, CorruptedModelJsonIsRejected) {
     EXPECT_NE(std::string(e.what()).find("elements[3].rest_length: must be > 0"), std::string::npos)
         << e.what();
   }
+}
+
+// true when `p` lies inside the closed outward mesh (v, f): a ray from p crosses it an odd number of times
+bool isInside(const Eigen::Vector3d& p, const Eigen::Matrix3Xd& v, const Eigen::Matrix3Xi& f) {
+  const Eigen::Vector3d d = Eigen::Vector3d(0.5773, 0.5774, 0.5775).normalized();  // off every axis
+  int hits = 0;
+  for (Eigen::Index i = 0; i < f.cols(); ++i) {
+    // Moller-Trumbore
+    const Eigen::Vector3d a = v.col(f(0, i)), e1 = v.col(f(1, i)) - a, e2 = v.col(f(2, i)) - a;
+    const Eigen::Vector3d h = d.cross(e2);
+    const double det = e1.dot(h);
+    if (std::abs(det) < 1e-18) continue;
+    const Eigen::Vector3d s = p - a;
+    const double u = s.dot(h) / det;
+    if (u < 0.0 || u > 1.0) continue;
+    const Eigen::Vector3d q = s.cross(e1);
+    const double w = d.dot(q) / det;
+    if (w < 0.0 || u + w > 1.0) continue;
+    if (e2.dot(q) / det > 0.0) ++hits;
+  }
+  return hits % 2 == 1;
+}
+
+// the skin: a closed body surface free of self-crossings, no vertex inside or within 5 mm of a bone,
+// registered to the landmarks within 20 mm, and bound through a TetGen mesh of the soft tissue
+TEST_P(BuiltPresets, SkinIsAClosedBodySurfaceOutsideEveryBone) {
+  const sim::Model& m = model();
+  ASSERT_GT(m.skin.vertexCount(), 5000);
+  EXPECT_GT(m.skin.tetrahedra, m.skin.vertexCount());
+  Eigen::Matrix3Xd x;
+  sim::skinPositions(m.skin, restPoints(m.skin.anchors, m), x);
+  EXPECT_EQ(pneuma::test::countSelfCrossings(x, m.skin.triangles), 0);
+  // a body without its lower legs and feet: 40-100 L
+  const double volume = enclosedVolume(x, m.skin.triangles);
+  EXPECT_GT(volume, 0.040);
+  EXPECT_LT(volume, 0.100);
+
+  int inside = 0;
+  for (int b = 0; b < m.bodies.size(); ++b) {
+    const TriangleMesh& mesh = built().bodyMeshes[static_cast<std::size_t>(b)];
+    const Eigen::Matrix3Xd bone = mesh.vertices.colwise() + m.bodies.com.col(b);
+    const Eigen::Vector3d lo = bone.rowwise().minCoeff(), hi = bone.rowwise().maxCoeff();
+    for (int i = 0; i < x.cols(); ++i) {
+      const Eigen::Vector3d p = x.col(i);
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+      if (isInside(p, bone, mesh.triangles)) {
+        ++inside;
+        ADD_FAILURE() << "skin vertex " << i << " inside " << m.bodies.name[static_cast<std::size_t>(b)];
+        if (inside > 5) return;
+      }
+    }
+  }
+  EXPECT_GE(built().report.skinBoneClearance, 0.005);
+  EXPECT_LT(built().report.skinLandmarkResidual, 0.020);
+  RecordProperty("skin_bone_clearance_mm", std::to_string(built().report.skinBoneClearance * 1e3));
+  RecordProperty("skin_landmark_residual_mm", std::to_string(built().report.skinLandmarkResidual * 1e3));
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, BuiltPresets, ::testing::Values("male", "female"));

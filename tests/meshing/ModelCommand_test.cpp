@@ -1,12 +1,15 @@
 // `pneuma-cli model build` and `model info`, run as a child process (tests/app/cli/CliRunner.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "CliRunner.h"
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/ModelIO.h"
+#include "pneuma/sim/State.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -86,6 +89,62 @@ TEST(ModelCommand, BuildRefusesAFolderThatIsNotAModel) {
       << r.err;
   EXPECT_EQ(test::slurp((out / "notes.txt").string()), "keep me");
   fs::remove_all(out);
+}
+
+// --skin: a body of the user's in another format and unit: the default model's skin as an OBJ in centimetres,
+// in the file axes the reader expects (Y up, facing +Z), registered to the female preset
+TEST(ModelCommand, BuildWithAnObjSkinRegistersIt) {
+  const sim::Model m = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
+  ASSERT_GT(m.skin.vertexCount(), 0);
+  Eigen::Matrix3Xd x;
+  sim::skinPositions(m.skin, restPoints(m.skin.anchors, m), x);
+  const fs::path dir = scratch("objskin");
+  fs::create_directories(dir);
+  {
+    std::ofstream obj(dir / "body.obj");
+    for (Eigen::Index i = 0; i < x.cols(); ++i)
+      obj << "v " << -100.0 * x(0, i) << " " << 100.0 * x(2, i) << " " << 100.0 * x(1, i) << "\n";
+    for (Eigen::Index f = 0; f < m.skin.triangles.cols(); ++f)
+      obj << "f " << m.skin.triangles(0, f) + 1 << " " << m.skin.triangles(1, f) + 1 << " "
+          << m.skin.triangles(2, f) + 1 << "\n";
+  }
+  const fs::path out = dir / "model";
+  const test::CliResult r = runCli({"model", "build", "--anatomy", kAnatomy + "female.json", "--skin",
+                                    (dir / "body.obj").string(), "--out", out.string(), "--no-preview"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const ModelSummary s = summarizeModel(sim::loadModel(out.string()));
+  EXPECT_GT(s.skinVertices, 5000);
+  EXPECT_GT(s.skinTetrahedra, s.skinVertices);
+  // model info counts the skin
+  const test::CliResult info = runCli({"model", "info", out.string(), "--json"});
+  ASSERT_EQ(info.exitCode, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out).at("skin").at("vertices").get<int>(), s.skinVertices);
+  fs::remove_all(dir);
+}
+
+// a skin file assimp cannot read, or one that is not closed: one line naming the file, nothing written
+TEST(ModelCommand, CorruptOrOpenSkinFailsInOneLineAndWritesNothing) {
+  const fs::path dir = scratch("badskin");
+  fs::create_directories(dir);
+  {
+    std::ofstream(dir / "corrupt.ply")
+        << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n";
+  }
+  // a tetrahedron with one face missing
+  { std::ofstream(dir / "open.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n"; }
+  for (const auto& [file, problem] :
+       {std::pair<std::string, std::string>{"corrupt.ply", "assimp cannot read it"},
+        {"open.obj", "is not closed (3 edges without"}}) {
+    const fs::path out = dir / "model";
+    const test::CliResult r =
+        runCli({"model", "build", "--skin", (dir / file).string(), "--out", out.string(), "--no-preview"});
+    EXPECT_EQ(r.exitCode, 2) << file;
+    EXPECT_NE(r.err.find("pneuma-cli: error: " + (dir / file).string() + ": "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << file;
+  }
+  fs::remove_all(dir);
 }
 
 TEST(ModelCommand, InfoOnAMissingModelIsBadInput) {

@@ -16,6 +16,7 @@
 #include "DefaultModel.h"
 #include "SurfaceCrossings.h"
 #include "pneuma/sim/BreathStyleController.h"
+#include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/pattern/PatternController.h"
 
@@ -25,17 +26,10 @@ namespace {
 namespace fs = std::filesystem;
 using test::defaultModel;
 
-// the posed surfaces of one frame
-struct Posed {
-  Eigen::Matrix3Xd cavity, right, left, gut;
-};
-
-Posed pose(const Model& m, const State& s) {
-  Posed p;
-  anchorPositions(m.cavity.vertices, s, p.cavity);
-  lungPositions(m.lungs.right, p.cavity, p.right);
-  lungPositions(m.lungs.left, p.cavity, p.left);
-  p.gut = s.nodePosition;
+// the posed surfaces of one frame (the one posing function)
+PosedGeometry pose(const Model& m, const State& s) {
+  PosedGeometry p;
+  poseGeometry(m, s, p);
   return p;
 }
 
@@ -43,18 +37,18 @@ Posed pose(const Model& m, const State& s) {
 std::map<std::string, int> crossings(const Model& m, const State& s) {
   using pneuma::test::countCrossings;
   using pneuma::test::countSelfCrossings;
-  const Posed p = pose(m, s);
+  const PosedGeometry p = pose(m, s);
   const Eigen::Matrix3Xi &tc = m.cavity.triangles, &tr = m.lungs.right.triangles,
                          &tl = m.lungs.left.triangles, &tg = m.gut.triangles;
   return {{"cavity", countSelfCrossings(p.cavity, tc)},
           {"gut", countSelfCrossings(p.gut, tg)},
-          {"right", countSelfCrossings(p.right, tr)},
-          {"left", countSelfCrossings(p.left, tl)},
-          {"right-left", countCrossings(p.right, tr, p.left, tl)},
-          {"right-gut", countCrossings(p.right, tr, p.gut, tg)},
-          {"left-gut", countCrossings(p.left, tl, p.gut, tg)},
-          {"right-cavity", countCrossings(p.right, tr, p.cavity, tc)},
-          {"left-cavity", countCrossings(p.left, tl, p.cavity, tc)}};
+          {"right", countSelfCrossings(p.lungRight, tr)},
+          {"left", countSelfCrossings(p.lungLeft, tl)},
+          {"right-left", countCrossings(p.lungRight, tr, p.lungLeft, tl)},
+          {"right-gut", countCrossings(p.lungRight, tr, p.gut, tg)},
+          {"left-gut", countCrossings(p.lungLeft, tl, p.gut, tg)},
+          {"right-cavity", countCrossings(p.lungRight, tr, p.cavity, tc)},
+          {"left-cavity", countCrossings(p.lungLeft, tl, p.cavity, tc)}};
 }
 
 std::string describe(const std::map<std::string, int>& c) {
@@ -111,9 +105,9 @@ void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> cont
   for (const auto& [phase, state] :
        {std::pair<const char*, const State*>{"end-expiration", &lo}, {"end-inspiration", &hi}}) {
     const std::map<std::string, int> c = crossings(*model, *state);
-    const Posed p = pose(*model, *state);
+    const PosedGeometry p = pose(*model, *state);
     const int medial =
-        medialCrossings(model->lungs.right, p.right) + medialCrossings(model->lungs.left, p.left);
+        medialCrossings(model->lungs.right, p.lungRight) + medialCrossings(model->lungs.left, p.lungLeft);
     EXPECT_EQ(c.at("right-left"), 0) << name << " at " << phase;
     EXPECT_EQ(medial, 0) << name << " at " << phase << ": mediastinal faces cross";
     int total = 0;

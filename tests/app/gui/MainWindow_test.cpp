@@ -129,6 +129,7 @@ TEST_F(DefaultModelWindow, LungsAreDrawnAndTheirCheckBoxHidesThem) {
   viz::DisplayOptions o = window.scene().options();
   EXPECT_TRUE(o.showLungs);
   o.showBones = o.showGut = o.showLandmarks = false;
+  o.skin = viz::SkinDisplay::Hidden;
   o.showGroup.fill(false);
   window.setDisplayOptions(o);
   const QImage with = window.grabView();
@@ -151,6 +152,41 @@ TEST_F(DefaultModelWindow, LungsAreDrawnAndTheirCheckBoxHidesThem) {
           std::abs(a.red() - b.red()) + std::abs(a.green() - b.green()) + std::abs(a.blue() - b.blue()) > 30;
     }
   EXPECT_GT(covered, with.width() * with.height() / 50);
+}
+
+// pixels that differ by more than 30 (sum over RGB) between two grabs of the view
+int differing(const QImage& a, const QImage& b) {
+  int n = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) {
+      const QColor p = a.pixelColor(x, y), q = b.pixelColor(x, y);
+      n += std::abs(p.red() - q.red()) + std::abs(p.green() - q.green()) + std::abs(p.blue() - q.blue()) > 30;
+    }
+  return n;
+}
+
+// the skin: translucent by default, its combo box makes it opaque (a body covering a good part of the view)
+// or hides it; translucent, the rib cage and muscles inside show through (the grab differs from the opaque
+// one)
+TEST_F(DefaultModelWindow, SkinShowsTheBodyAndTheRibCageThroughIt) {
+  EXPECT_EQ(window.scene().options().skin, viz::SkinDisplay::Translucent);
+  QComboBox* combo = nullptr;
+  for (QComboBox* c : window.findChildren<QComboBox*>())
+    if (c->findText("Opaque") >= 0) combo = c;
+  ASSERT_NE(combo, nullptr);
+  const QImage translucent = window.grabView();
+  combo->setCurrentIndex(combo->findText("Opaque"));
+  QApplication::processEvents();
+  EXPECT_EQ(window.scene().options().skin, viz::SkinDisplay::Opaque);
+  const QImage opaque = window.grabView();
+  combo->setCurrentIndex(combo->findText("Hidden"));
+  QApplication::processEvents();
+  EXPECT_EQ(window.scene().options().skin, viz::SkinDisplay::Hidden);
+  const QImage hidden = window.grabView();
+  ASSERT_EQ(opaque.size(), hidden.size());
+  const int area = opaque.width() * opaque.height();
+  EXPECT_GT(differing(opaque, hidden), area / 10) << "the opaque body covers the view's middle";
+  EXPECT_GT(differing(translucent, opaque), area / 50) << "the inside shows through the translucent skin";
 }
 
 TEST(MainWindow, ExportedPlotFilesHoldThePlottedData) {
@@ -443,8 +479,8 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
   ASSERT_TRUE(pvd.open(QIODevice::ReadOnly));
   const QByteArray text = pvd.readAll();
   EXPECT_TRUE(text.contains("<VTKFile type=\"Collection\""));
-  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 4 parts each)
-  EXPECT_GE(text.count("<DataSet"), 4 * 30);
+  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 6 parts each)
+  EXPECT_GE(text.count("<DataSet"), 6 * 30);
   EXPECT_FALSE(QDir(out.filePath("run")).entryList({"*.vtp"}, QDir::Files).isEmpty());
 
   // an unwritable destination is an error, not a crash

@@ -77,13 +77,17 @@ TEST(VtkSeriesWriter, FramesHoldThePosedGeometry) {
   }
   EXPECT_EQ(writer.finish(), "run.pvd");
 
-  // the collection lists the four parts of each frame at its time
+  // the collection lists the six parts of each frame at its time
   std::ifstream pvdFile(dir / "run.pvd");
   std::stringstream pvd;
   pvd << pvdFile.rdbuf();
   EXPECT_NE(pvd.str().find("timestep=\"0.5\" group=\"\" part=\"2\" name=\"gut\" file=\"run/gut_000001.vtp\""),
             std::string::npos)
       << pvd.str();
+
+  // the skin, the sixth part: written for every frame, empty for a model without a skin
+  EXPECT_NE(pvd.str().find("part=\"5\" name=\"skin\" file=\"run/skin_000001.vtp\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "run" / "skin_000001.vtp"));
 
   const sim::State& s = states[1];
   const double tol = 1e-12;  // [m] written as doubles

@@ -21,6 +21,10 @@ struct ModelSummary {
   double cavityVolume = 0.0;                            ///< [m^3] enclosed by the lung-cavity surface at rest
   double gutWallMass = 0.0;  ///< [kg] mass of the moving abdominal-wall nodes (region Wall)
   double boneMass = 0.0;     ///< [kg] mass of all bodies
+  int skinVertices = 0;      ///< vertices of the skin (0: the model has none)
+  int skinTriangles = 0;     ///< triangles of the skin
+  int skinTetrahedra = 0;    ///< TetGen tetrahedra of the soft tissue the skin is bound through
+  double skinVolume = 0.0;   ///< [m^3] enclosed by the skin at rest
 };
 
 /// World rest positions of the points of `set` (3 x #P) [m]: body points at com + local (body axes are

@@ -22,4 +22,12 @@ struct TetMesh {
 ///         degenerate (quality < 0.01: TetGen 1.5 would crash on it).
 TetMesh tetrahedralize(const TriangleMesh& surface, const std::string& part);
 
+/// Tetrahedralisation of the volume bounded by a closed outward `surface` with the `interior` points (3 x #P)
+/// [m] as further vertices, with TetGen (switches "pYQ": piecewise-linear complex, boundary kept unsplit, no
+/// quality refinement). TetMesh::vertices holds the surface vertices, then the interior points in their
+/// order (a point outside the surface is in no tetrahedron), then any Steiner points.
+/// @throws sim::Error naming `part` as tetrahedralize().
+TetMesh tetrahedralizeAround(const TriangleMesh& surface, const Eigen::Matrix3Xd& interior,
+                             const std::string& part);
+
 }  // namespace pneuma::meshing

@@ -203,6 +203,31 @@ struct Lungs {
       0.0;  ///< [m^3] V_med, the part of the cavity's rest volume the lungs do not fill, >= 0
 };
 
+constexpr int kSkinVertexSlots = 4;  ///< anchors one skin vertex may combine (Skin)
+
+/// The body surface (skin), bound to the bones and the gut through the soft tissue between them (built by
+/// meshing/src/Skin.cpp, docs/model-format.md "skin"). Each vertex is a fixed affine combination of anchor
+/// points, so posing it is pure data:
+///   x_v = c_v + sum_k w_vk a_{i_vk},   sum_k w_vk = 1,
+/// with a the posed anchors (anchorPositions() of `anchors`: bone-frame points and gut-node points) and c_v a
+/// constant offset [m]. A vertex that follows one bone rigidly has a single anchor, a point of that bone at
+/// the vertex itself (c_v = 0). A vertex of the soft tissue over moving parts blends the displacements of the
+/// anchors nearest it through the tissue (c_v = rest position minus the anchors' weighted rest positions).
+/// The weights come from a TetGen tetrahedralisation of the volume inside the skin (`tetrahedra` counts it).
+/// An empty Skin (no vertices) is a model without a skin.
+struct Skin {
+  AnchorSet anchors;  ///< points the skin is bound to: bone-frame points and gut nodes (#A points)
+  Eigen::Matrix<int, kSkinVertexSlots, Eigen::Dynamic>
+      anchor;  ///< indices into `anchors`, -1 marks an unused slot (4 x #V)
+  Eigen::Matrix<double, kSkinVertexSlots, Eigen::Dynamic>
+      weights;                 ///< [-] w_vk >= 0, summing to 1; 0 in unused slots (4 x #V)
+  Eigen::Matrix3Xd offset;     ///< [m] c_v (3 x #V)
+  Eigen::Matrix3Xi triangles;  ///< vertex indices, outward normals (3 x #T)
+  int tetrahedra = 0;          ///< [-] TetGen tetrahedra of the soft tissue the weights were computed on
+
+  int vertexCount() const { return static_cast<int>(anchor.cols()); }
+};
+
 /// Named points for measurement, bound like cavity vertices.
 /// Required names: "xiphoid", "umbilicus", "diaphragm_apex", "rib8_lateral_left", "rib8_lateral_right".
 struct Landmarks {
@@ -226,6 +251,7 @@ struct Model {
   Cavity cavity;
   Lungs lungs;
   Landmarks landmarks;
+  Skin skin;  ///< may be empty (models written before the skin)
 };
 
 }  // namespace pneuma::sim

@@ -49,4 +49,8 @@ void anchorPositions(const AnchorSet& anchors, const State& state, Eigen::Matrix
 /// vertices `cavity` (3 x #C, anchorPositions() of Cavity::vertices), written into `out` (3 x #V, resized).
 void lungPositions(const LungSurface& lung, const Eigen::Matrix3Xd& cavity, Eigen::Matrix3Xd& out);
 
+/// World positions [m] of the skin vertices (Skin: x_v = c_v + sum_k w_vk a_{i_vk}) from the posed skin
+/// anchors `anchors` (3 x #A, anchorPositions() of Skin::anchors), written into `out` (3 x #V, resized).
+void skinPositions(const Skin& skin, const Eigen::Matrix3Xd& anchors, Eigen::Matrix3Xd& out);
+
 }  // namespace pneuma::sim

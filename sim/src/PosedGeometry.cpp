@@ -1,0 +1,31 @@
+#include "pneuma/sim/PosedGeometry.h"
+
+namespace pneuma::sim {
+
+void poseGeometry(const Model& model, const State& state, PosedGeometry& out) {
+  // bones: rigid transforms body -> world
+  const int nb = model.bodies.size();
+  out.body.resize(static_cast<std::size_t>(nb));
+  for (int b = 0; b < nb; ++b) {
+    Eigen::Isometry3d& T = out.body[static_cast<std::size_t>(b)];
+    T.setIdentity();
+    T.linear() = state.bodyOrientation[static_cast<std::size_t>(b)].toRotationMatrix();
+    T.translation() = state.bodyPosition.col(b);
+  }
+
+  // anchored points
+  anchorPositions(model.elements.endA, state, out.elementA);
+  anchorPositions(model.elements.endB, state, out.elementB);
+  out.gut = state.nodePosition;
+  anchorPositions(model.cavity.vertices, state, out.cavity);
+  lungPositions(model.lungs.right, out.cavity, out.lungRight);
+  lungPositions(model.lungs.left, out.cavity, out.lungLeft);
+  anchorPositions(model.landmarks.points, state, out.landmarks);
+
+  // skin: through its anchors
+  Eigen::Matrix3Xd anchors;
+  anchorPositions(model.skin.anchors, state, anchors);
+  skinPositions(model.skin, anchors, out.skin);
+}
+
+}  // namespace pneuma::sim
