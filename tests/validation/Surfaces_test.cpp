@@ -73,12 +73,17 @@ int medialCrossings(const LungSurface& l, const Eigen::Matrix3Xd& x) {
   return n;
 }
 
-// The cavity's walls cross at the costal margin once the model has settled (issue 13): the diaphragm's dome,
-// bound to the gut, moves outward through the rib-bound wall at ribs 7-8 on both sides (z about 230 mm), its
-// nodes up to 25-80 mm beyond the wall's plane, and the gut crosses itself in 0-17 places. The lungs inherit
-// it: their costal and diaphragmatic faces lie on those walls (every lung self-crossing there is between two
-// wall faces). It is the mechanics' (nothing keeps the gut inside the rib cage), not the meshing's. Until it
-// is fixed, those pairs are reported and the test is skipped naming them; set this to true to enforce them.
+// The surfaces still cross once the model has settled (issue 13), though not because the gut passes through
+// the rib cage: a one-sided rib contact tried on the default model hardly acted and changed no count. The
+// crossings are the diaphragm folding on itself. Measured (calm, 2 s of settling): (1) the posterior dome
+// beside the spine, its lowest nodes there (z about 165 mm) rising about 20 mm and moving 15 mm back within
+// the first 0.4 s of settling, over the dome ring above them (z about 194 mm): 6-8 gut self-crossings and
+// 10-18 in the cavity's diaphragm faces bound to those nodes (holding the crural rim nodes fixed removes the
+// gut's at end-expiration, not the cavity's); (2) the anterior dome beside the xiphoid, its nodes rising
+// 5-10 mm above the sternum's lowest cavity vertex, so that the seam faces between sternum and dome cross the
+// dome's faces (9-10); (3) a few seam faces at ribs 5-6 and rib 8 (1-3). The lungs inherit them: their
+// costal and diaphragmatic faces lie on those walls. Until the dome's posterior rim and its xiphoid edge are
+// held, those pairs are reported and the test is skipped naming them; set this to true to enforce them.
 constexpr bool kEnforceWallCrossings = false;
 
 // runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
@@ -120,10 +125,10 @@ void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> cont
   }
 }
 
-// the known crossings at the costal margin, reported as a skip until kEnforceWallCrossings
+// the known crossings where the dome folds, reported as a skip until kEnforceWallCrossings
 void reportWallCrossings(const std::ostringstream& wall) {
   if (!wall.str().empty())
-    GTEST_SKIP() << "surfaces cross at the costal margin (kEnforceWallCrossings):" << wall.str();
+    GTEST_SKIP() << "surfaces cross where the dome folds (kEnforceWallCrossings):" << wall.str();
 }
 
 TEST(Surfaces, DefaultModelAtRestHasNoCrossings) {
