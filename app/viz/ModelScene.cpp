@@ -286,6 +286,29 @@ struct ModelScene::Impl {
     return actor;
   }
 
+  // a smooth-shaded surface of `data` coloured through `table` by one float scalar per point (`scalar`, zero
+  // at first); `isOriented` keeps the triangles' own orientation for the normals
+  static vtkSmartPointer<vtkActor> scalarSurfaceActor(vtkPolyData* data,
+                                                      vtkSmartPointer<vtkFloatArray>& scalar,
+                                                      vtkLookupTable* table, bool isOriented) {
+    scalar = vtkSmartPointer<vtkFloatArray>::New();
+    scalar->SetNumberOfValues(data->GetNumberOfPoints());
+    scalar->Fill(0.0f);
+    data->GetPointData()->SetScalars(scalar);
+    vtkNew<vtkPolyDataNormals> normals;
+    normals->SetInputData(data);
+    normals->SplittingOff();
+    if (isOriented) normals->ConsistencyOff();
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputConnection(normals->GetOutputPort());
+    mapper->SetLookupTable(table);
+    mapper->UseLookupTableScalarRangeOn();
+    auto actor = vtkSmartPointer<vtkActor>::New();
+    actor->SetMapper(mapper);
+    actor->PickableOff();
+    return actor;
+  }
+
   static vtkSmartPointer<vtkPolyData> surface(int nPoints, const Eigen::Matrix3Xi& triangles) {
     auto data = vtkSmartPointer<vtkPolyData>::New();
     vtkNew<vtkPoints> points;
@@ -376,20 +399,7 @@ struct ModelScene::Impl {
 
     // gut, cavity, landmarks
     gut = surface(model.nodes.size(), model.gut.triangles);
-    gutScalar = vtkSmartPointer<vtkFloatArray>::New();
-    gutScalar->SetNumberOfValues(model.nodes.size());
-    gutScalar->Fill(0.0f);
-    gut->GetPointData()->SetScalars(gutScalar);
-    vtkNew<vtkPolyDataNormals> gutNormals;
-    gutNormals->SetInputData(gut);
-    gutNormals->SplittingOff();
-    vtkNew<vtkPolyDataMapper> gutMapper;
-    gutMapper->SetInputConnection(gutNormals->GetOutputPort());
-    gutMapper->SetLookupTable(gutTable);
-    gutMapper->UseLookupTableScalarRangeOn();
-    gutActor = vtkSmartPointer<vtkActor>::New();
-    gutActor->SetMapper(gutMapper);
-    gutActor->PickableOff();
+    gutActor = scalarSurfaceActor(gut, gutScalar, gutTable, false);
 
     cavity = surface(model.cavity.vertices.size(), model.cavity.triangles);
     cavityActor = actorFor(cavity);
@@ -411,23 +421,9 @@ struct ModelScene::Impl {
     // the skin: smooth-shaded, drawn last among the surfaces so the translucent body wraps the rest
     if (model.skin.vertexCount() > 0) {
       skin = surface(model.skin.vertexCount(), model.skin.triangles);
-      skinScalar = vtkSmartPointer<vtkFloatArray>::New();
-      skinScalar->SetNumberOfValues(model.skin.vertexCount());
-      skinScalar->Fill(0.0f);
-      skin->GetPointData()->SetScalars(skinScalar);
-      vtkNew<vtkPolyDataNormals> skinNormals;
-      skinNormals->SetInputData(skin);
-      skinNormals->SplittingOff();
-      skinNormals->ConsistencyOff();
-      vtkNew<vtkPolyDataMapper> skinMapper;
-      skinMapper->SetInputConnection(skinNormals->GetOutputPort());
-      skinMapper->SetLookupTable(skinTable);
-      skinMapper->UseLookupTableScalarRangeOn();
-      skinActor = vtkSmartPointer<vtkActor>::New();
-      skinActor->SetMapper(skinMapper);
+      skinActor = scalarSurfaceActor(skin, skinScalar, skinTable, true);
       skinActor->GetProperty()->SetSpecular(0.15);
       skinActor->GetProperty()->SetSpecularPower(12.0);
-      skinActor->PickableOff();
       sim::PosedGeometry rest;
       sim::poseGeometry(model, sim::makeInitialState(model), rest);
       skinRest = rest.skin;
