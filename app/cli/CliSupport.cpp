@@ -158,7 +158,7 @@ void writeMotion(const sim::Motion& m, nlohmann::json& j) {
   j["umbilicus_anterior_min_mm"] = jsonNumber(m.umbilicusAnteriorMin * kMm);
   j["rib_cage_tidal_ml"] = jsonNumber(m.ribCageTidal * kMl);
   j["abdomen_tidal_ml"] = jsonNumber(m.abdomenTidal * kMl);
-  j["rib_cage_fraction"] = jsonNumber(m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal));
+  j["rib_cage_fraction"] = jsonNumber(m.ribCageShare());
   j["rc_ab_phase_deg"] = jsonNumber(m.phaseAngle * 180.0 / M_PI);
   j["flow_sign_changes_per_breath"] = jsonNumber(m.flowSignChanges);
   j["max_flow_jump_pct"] = jsonNumber(m.maxFlowJump * 100.0);

@@ -89,7 +89,6 @@ QString breathingText(const sim::Summary* b) {
     return std::isfinite(v) ? QString("%1 %2").arg(v * scale, 0, 'f', decimals).arg(unit) : QString("n/a");
   };
   const sim::Motion& m = b->motion;
-  const double ribCageShare = m.ribCageTidal / b->tidalVolume;
   return QStringList{QString("Tidal volume %1 at %2")
                          .arg(value(b->tidalVolume, 1e6, 0, "mL"), value(b->breathsPerMinute, 1.0, 1, "b/m")),
                      "Dome descent " + value(m.domeDescent, 1e3, 1, "mm"),
@@ -97,7 +96,7 @@ QString breathingText(const sim::Summary* b) {
                      "Sternum forward " + value(m.sternumAnterior, 1e3, 1, "mm") + ", up " +
                          value(m.sternumCranial, 1e3, 1, "mm"),
                      "Belly forward " + value(m.umbilicusAnterior, 1e3, 1, "mm"),
-                     "Rib cage share " + value(ribCageShare, 100.0, 0, "%"),
+                     "Rib cage share " + value(m.ribCageShare(), 100.0, 0, "%"),
                      "Rib cage-abdomen phase " + value(m.phaseAngle, 180.0 / M_PI, 0, "\u00b0")}
       .join('\n');
 }

@@ -217,7 +217,7 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
         "physiology.calm.rib_cage_share", "rib-cage share of the tidal volume, calm, upright", "55 - 85 %",
         "seated at rest the abdomen gives about a quarter (J Appl Physiol 1968, 24:159); rib cage dominant "
         "upright (Sharp et al. 1975, J Appl Physiol 39:608)",
-        "%", kPct * m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal), 55.0, 85.0));
+        "%", kPct * m.ribCageShare(), 55.0, 85.0));
     out.push_back(check("physiology.calm.phase", "rib-cage / abdomen phase angle, calm", "< 30 deg",
                         "12-23 deg in healthy young adults (Chen et al. 2015)", "deg",
                         m.phaseAngle * 180.0 / M_PI, 0.0, 30.0));
@@ -321,10 +321,7 @@ double settleDrift(const StyleRun& r, double window) {
 }
 
 std::vector<Check> postureChecks(const StyleRun& upright, const StyleRun& supine) {
-  const auto share = [](const StyleRun& r) {
-    const Motion& m = r.summary.motion;
-    return m.ribCageTidal / (m.ribCageTidal + m.abdomenTidal);
-  };
+  const auto share = [](const StyleRun& r) { return r.summary.motion.ribCageShare(); };
   const std::string name = upright.style.name;
   const double eev = upright.summary.endExpiratoryVolume;
   const double bound = 0.02 * supine.summary.tidalVolume;  // [m^3] settling drift

@@ -87,6 +87,10 @@ struct Motion {
   double phaseAngle = kNaN;
   double flowSignChanges = kNaN;  ///< [-] sign changes of the flow dV/dt (central differences) per cycle
   double maxFlowJump = kNaN;      ///< [-] largest frame-to-frame change of dV/dt over the largest |dV/dt|
+
+  /// [-] the rib cage's share of the tidal volume, ribCageTidal / (ribCageTidal + abdomenTidal) (Konno & Mead
+  /// 1967); NaN when the breath does not define it. The one rule for summary.json, validate and the app.
+  double ribCageShare() const { return ribCageTidal / (ribCageTidal + abdomenTidal); }
 };
 
 /// Figures over a run, measured after the settling phase.
