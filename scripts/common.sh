@@ -16,6 +16,8 @@ PNEUMA_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
   help2man clang-format
+  slurm-wlm munge
+  pybind11-dev python3-dev python3-numpy python3-matplotlib
 )
 
 pneuma_log() { printf '[pneuma] %s\n' "$*" >&2; }

@@ -15,6 +15,8 @@ void addSimulateCommand(CLI::App& app);
 void addValidateCommand(CLI::App& app);
 /// `bench`: real-time factor per breath style and step time per element count.
 void addBenchCommand(CLI::App& app);
+/// `sweep FILE`: run a sweep file's variants in parallel (or write a Slurm job array); write their table.
+void addSweepCommand(CLI::App& app);
 /// `scenario check FILE`: validate a scenario file; `scenario show FILE`: print it with all defaults.
 void addScenarioCommand(CLI::App& app);
 

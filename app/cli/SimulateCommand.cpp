@@ -10,6 +10,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "CliSupport.h"
 #include "Commands.h"
@@ -43,10 +44,26 @@ struct SimulateArgs {
   std::uint64_t seed = 0;
   std::string integrator;
   std::string posture;
-  double dt = 0.0;      // [s]
-  double settle = 0.0;  // [s]
+  double dt = 0.0;                // [s]
+  double settle = 0.0;            // [s]
+  std::vector<std::string> sets;  // --set KEY=VALUE, scenario overrides
   std::function<bool(const char*)> isGiven;
 };
+
+/// Applies each --set KEY=VALUE by the scenario file's overrides rule (sim::applyOverride()).
+void applySets(const std::vector<std::string>& sets, sim::SimulationOptions& options) {
+  for (const std::string& kv : sets) {
+    const std::size_t eq = kv.find('=');
+    if (eq == std::string::npos)
+      fail(kExitBadInput,
+           "--set: expected KEY=VALUE, got '" + kv.substr(0, 60) + "' (keys: " + sim::overrideKeys() + ")");
+    try {
+      sim::applyOverride(options, kv.substr(0, eq), kv.substr(eq + 1));
+    } catch (const sim::Error& e) {
+      fail(kExitBadInput, e.what());
+    }
+  }
+}
 
 /// The scenario to run: the --scenario file (if any) with the command-line settings applied on top.
 sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
@@ -64,6 +81,7 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   if (!a.affect.empty()) s.controller = sim::ControllerKind::Affect, s.controllerName = a.affect;
   if (!a.pattern.empty()) s.controller = sim::ControllerKind::Pattern, s.controllerName = a.pattern;
   if (s.name.empty()) s.name = s.controllerName.empty() ? "run" : fs::path(s.controllerName).stem().string();
+  applySets(a.sets, s.options);
 
   if (a.isGiven("--duration")) {
     checkOption(sim::kDurationRange, "--duration", a.duration);
@@ -320,6 +338,10 @@ void addSimulateCommand(CLI::App& app) {
       "Time step [s] (default: the integrator's, 1/60 s for implicit-euler-joints; 10 ms for affect and "
       "pattern runs)");
   cmd->add_option("--settle", args->settle, "Settling time before the controller starts [s] (default 2)");
+  cmd->add_option("--set", args->sets,
+                  "Override KEY=VALUE, as in a scenario's \"overrides\" (repeatable; e.g. dt_s=0.005, "
+                  "posture=supine, active_gain_scale.diaphragm=1.2; docs/cli.md)")
+      ->allow_extra_args(false);
   args->isGiven = [cmd](const char* flag) { return cmd->count(flag) > 0; };
   cmd->callback([args] { runSimulate(*args); });
 }

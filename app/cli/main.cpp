@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("pneuma-cli ") + PNEUMA_VERSION,
                        "Print the version and exit");
   pneuma::app::addSimulateCommand(app);
+  pneuma::app::addSweepCommand(app);
   pneuma::app::addScenarioCommand(app);
   pneuma::app::addValidateCommand(app);
   pneuma::app::addBenchCommand(app);

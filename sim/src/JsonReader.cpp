@@ -225,6 +225,13 @@ void JsonReader::fail(const std::string& why) const {
   throw Error(*m_source + ": " + (m_path.empty() ? std::string("(root)") : m_path) + ": " + why);
 }
 
+void JsonReader::checkHeader(const char* format, int version) const {
+  if (at("format").string() != format) at("format").fail(std::string("must be \"") + format + "\"");
+  const JsonReader v = at("version");
+  if (v.integerIn(0, std::numeric_limits<int>::max()) != version)
+    v.fail("unsupported version " + v.excerpt() + " (this build reads " + std::to_string(version) + ")");
+}
+
 void JsonReader::failBelow(const std::string& fieldAndReason) const {
   throw Error(*m_source + ": " + (m_path.empty() ? "" : m_path + ".") + fieldAndReason);
 }

@@ -70,9 +70,12 @@ void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
     c.at(controllerKindName(s.controller)).fail("must not be empty");
 }
 
+constexpr std::initializer_list<const char*> kOverrideKeys = {
+    "integrator",           "dt_s",           "settle_time_s", "gravity",           "posture",
+    "joint_friction_scale", "gut_drag_scale", "kappa_pa",      "active_gain_scale", "passive_gain_scale"};
+
 void parseOverrides(const Field& o, SimulationOptions& opt) {
-  o.allowKeys({"integrator", "dt_s", "settle_time_s", "gravity", "posture", "joint_friction_scale",
-               "gut_drag_scale", "kappa_pa", "active_gain_scale", "passive_gain_scale"});
+  o.allowKeys(kOverrideKeys);
   if (o.has("integrator")) {
     const std::string name = o.at("integrator").string();
     if (!integratorFromName(name, opt.step.integrator))
@@ -130,13 +133,7 @@ Scenario parseScenario(const std::string& jsonText, const std::string& sourceNam
   root.allowKeys({"format", "version", "name", "description", "model", "duration_s", "seed", "controller",
                   "overrides", "outputs"});
 
-  // header
-  if (root.at("format").string() != kFormatName)
-    root.at("format").fail(std::string("must be \"") + kFormatName + "\"");
-  const Field version = root.at("version");
-  if (version.integerIn(0, std::numeric_limits<int>::max()) != kScenarioFormatVersion)
-    version.fail("unsupported version " + version.excerpt() + " (this build reads " +
-                 std::to_string(kScenarioFormatVersion) + ")");
+  root.checkHeader(kFormatName, kScenarioFormatVersion);
 
   Scenario s;
   s.name = root.has("name") ? root.at("name").string() : "";
@@ -159,6 +156,38 @@ Scenario parseScenario(const std::string& jsonText, const std::string& sourceNam
     throw Error(sourceName + ": overrides: " + e.what());
   }
   return s;
+}
+
+std::string overrideKeys() {
+  std::string keys;
+  for (const char* k : kOverrideKeys) {
+    const bool isGroupScale = std::string(k).find("gain_scale") != std::string::npos;
+    keys += std::string(keys.empty() ? "" : ", ") + k + (isGroupScale ? ".<group>" : "");
+  }
+  return keys;
+}
+
+void applyOverride(SimulationOptions& options, const std::string& key, const std::string& value,
+                   const std::string& source) {
+  // the value: JSON text when it is JSON, else a bare string (--set posture=supine)
+  json v = json::parse(value, nullptr, /*allow_exceptions=*/false);
+  if (v.is_discarded()) v = value;
+  // "a.b.c" -> {"a": {"b": {"c": value}}}, read by the scenario file's own overrides parser
+  json nested = std::move(v);
+  std::string rest = key;
+  for (std::size_t dot; (dot = rest.rfind('.')) != std::string::npos; rest.erase(dot))
+    nested = json{{rest.substr(dot + 1), std::move(nested)}};
+  if (rest.empty() || key.back() == '.')
+    throw Error(source + ": '" + excerptOf(key) + "': not an override key");
+  const JsonDocument doc = JsonDocument::parse(json{{rest, std::move(nested)}}.dump(), source);
+  SimulationOptions changed = options;
+  parseOverrides(doc.root(), changed);
+  try {
+    validateSimulationOptions(changed);
+  } catch (const Error& e) {
+    throw Error(source + ": " + key + ": " + e.what());
+  }
+  options = changed;
 }
 
 Scenario loadScenario(const std::string& path) {

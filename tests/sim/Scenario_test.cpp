@@ -175,3 +175,61 @@ TEST(Scenario, BadControllerContentsAreNamedByTheirPath) {
         << e.what();
   }
 }
+
+// `simulate --set` and sweeps go through the overrides' own parser: the same keys, bounds and messages
+TEST(Scenario, OverrideKeyValueGivesTheSameOptionsAsTheFile) {
+  const Scenario file = parseScenario(
+      with(R"("overrides": {"dt_s": 0.005, "posture": "supine", "active_gain_scale": {"diaphragm": 1.2},
+                             "gravity": false})"),
+      "run.json", "");
+  SimulationOptions o;
+  applyOverride(o, "dt_s", "0.005");
+  applyOverride(o, "posture", "supine");  // a bare string
+  applyOverride(o, "active_gain_scale.diaphragm", "1.2");
+  applyOverride(o, "gravity", "false");
+  ASSERT_TRUE(o.dt.has_value());
+  EXPECT_EQ(*o.dt, *file.options.dt);
+  EXPECT_EQ(o.step.posture, file.options.step.posture);
+  EXPECT_EQ(o.step.gravity, file.options.step.gravity);
+  EXPECT_EQ(o.step.activeGainScale, file.options.step.activeGainScale);
+  EXPECT_EQ(o.step.activeGainScale[static_cast<std::size_t>(ElementGroup::Diaphragm)], 1.2);
+  // one group's scale leaves the others alone
+  EXPECT_EQ(o.step.activeGainScale[static_cast<std::size_t>(ElementGroup::Rectus)], 1.0);
+}
+
+TEST(Scenario, BadOverrideKeyOrValueIsOneLineNamingTheKeyAndChangesNothing) {
+  auto message = [](const std::string& key, const std::string& value) {
+    SimulationOptions o;
+    const SimulationOptions before = o;
+    try {
+      applyOverride(o, key, value);
+    } catch (const Error& e) {
+      EXPECT_EQ(o.dt, before.dt);
+      EXPECT_EQ(o.step.activeGainScale, before.step.activeGainScale);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // the file's message for the same value, with "--set" for the file name
+  std::string fileMessage;
+  try {
+    parseScenario(with(R"("overrides": {"dt_s": -1})"), "run.json", "");
+  } catch (const Error& e) {
+    fileMessage = e.what();
+  }
+  EXPECT_EQ(fileMessage, "run.json: overrides.dt_s: must be in [1e-06, 0.05] s, got -1");
+  EXPECT_EQ(message("dt_s", "-1"), "--set: dt_s: must be in [1e-06, 0.05] s, got -1");
+  EXPECT_EQ(message("dt", "0.01"), "--set: dt: unknown field (did you mean dt_s?)");
+  EXPECT_NE(
+      message("active_gain_scale.diaphram", "1").find("active_gain_scale.diaphram: unknown muscle group"),
+      std::string::npos);
+  EXPECT_EQ(message("active_gain_scale.diaphragm", "-0.5"),
+            "--set: active_gain_scale.diaphragm: must be >= 0, got -0.5");
+  EXPECT_NE(message("posture", "sideways").find("--set: posture: unknown posture 'sideways'"),
+            std::string::npos);
+  EXPECT_NE(message("settle_time_s", "1e9").find("--set: settle_time_s: must be in [0, 600] s"),
+            std::string::npos);
+  EXPECT_NE(message("gravity", "maybe").find("--set: gravity:"), std::string::npos);
+  EXPECT_NE(message("", "1").find("not an override key"), std::string::npos);
+  EXPECT_NE(message("dt_s.", "1").find("not an override key"), std::string::npos);
+}

@@ -138,13 +138,7 @@ Pattern parseAt(const std::string& jsonText, const std::string& sourceName, cons
   const Node root = doc.root();
   root.allowKeys({"format", "version", "name", "description", "layers", "affect", "timeline"});
 
-  // header
-  const Node format = root.at("format");
-  if (format.string() != kFormatName) format.fail(std::string("must be \"") + kFormatName + "\"");
-  const Node version = root.at("version");
-  if (version.integerIn(0, std::numeric_limits<int>::max()) != kPatternFormatVersion)
-    version.fail("unsupported version " + version.excerpt() + " (this build reads " +
-                 std::to_string(kPatternFormatVersion) + ")");
+  root.checkHeader(kFormatName, kPatternFormatVersion);
   Pattern p;
   p.name = root.at("name").string();
   p.description = root.stringOr("description", "");

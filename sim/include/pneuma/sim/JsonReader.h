@@ -117,6 +117,10 @@ class JsonReader {
   /// string() of member `key`, or `fallback` when absent.
   std::string stringOr(const std::string& key, const std::string& fallback) const;
 
+  /// Checks a versioned file's header: member "format" equal to `format` and "version" equal to `version`;
+  /// fails with 'must be "<format>"' or "unsupported version V (this build reads N)".
+  void checkHeader(const char* format, int version) const;
+
   /// The value as JSON text (for values passed on to another parser, e.g. an inline pattern).
   std::string dump(int indent = -1) const;
   /// At most `maxChars` characters of the value as JSON text, "..." marking a cut; cheap on huge values.

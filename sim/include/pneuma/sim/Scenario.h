@@ -64,6 +64,19 @@ struct Scenario {
 Scenario parseScenario(const std::string& jsonText, const std::string& sourceName,
                        const std::string& baseDir);
 
+/// The keys of the scenario file's "overrides" object, as `simulate --set` and sweeps name them: "dt_s",
+/// "posture", ..., and "active_gain_scale.<group>" / "passive_gain_scale.<group>" for one muscle group.
+std::string overrideKeys();
+
+/// Applies one override KEY=VALUE to `options` by the rule of the scenario file's "overrides" object (the
+/// same keys, bounds and messages: parseScenario() and this share one parser). `key` is an overrides key,
+/// a dot descending into an object ("active_gain_scale.diaphragm"); `value` is JSON text (1.2, true,
+/// "supine") or, when it is not JSON, a bare string (supine). Nothing is changed when it throws.
+/// @throws Error "<source>: <key>: <reason>", e.g. "--set: dt_s: must be in [1e-06, 0.05] s, got -1" or
+///         "--set: dt: unknown field (did you mean dt_s?)".
+void applyOverride(SimulationOptions& options, const std::string& key, const std::string& value,
+                   const std::string& source = "--set");
+
 /// Reads and parses a scenario file. @throws Error as parseScenario(), or when the file cannot be read.
 Scenario loadScenario(const std::string& path);
 
