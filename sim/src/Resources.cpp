@@ -1,5 +1,7 @@
 #include "pneuma/sim/Resources.h"
 
+#include <dlfcn.h>
+
 #include <cstdlib>
 #include <filesystem>
 
@@ -18,9 +20,16 @@ std::string environment(const char* name) {
 }  // namespace
 
 std::string installDataDir() {
+  // the binary that holds this code: a shared object (the Python module, build/python or PREFIX/...), else
+  // the running executable
   std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  const fs::path bin = ec ? fs::current_path(ec) : exe.parent_path();
+  fs::path binary;
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&installDataDir), &info) != 0 && info.dli_fname != nullptr &&
+      fs::path(info.dli_fname).extension() == ".so")
+    binary = fs::absolute(info.dli_fname, ec);
+  if (binary.empty()) binary = fs::read_symlink("/proc/self/exe", ec);
+  const fs::path bin = binary.empty() ? fs::current_path(ec) : binary.parent_path();
   // PNEUMA_DATA_FROM_BIN: the data folder relative to the binaries' folder, from the install layout
   // (CMakeLists.txt: "../share/pneuma")
   return (bin / PNEUMA_DATA_FROM_BIN).lexically_normal().string();

@@ -8,7 +8,9 @@
 ///  - installed: PREFIX/bin/pneuma-cli finds PREFIX/share/pneuma (the default model in models/default);
 ///  - build tree: build/bin/pneuma-cli finds build/share/pneuma, whose entries link to the source tree's
 ///    resources/ (so edits there are seen without a rebuild) and whose models/default the build writes.
-/// The location follows the running executable (/proc/self/exe), so an installed tree can be moved.
+/// The location follows the running executable (/proc/self/exe), so an installed tree can be moved. Code
+/// loaded as a shared object (the Python module, build/python/pneuma*.so) counts from the object's own folder
+/// instead.
 
 #include <string>
 
@@ -21,8 +23,9 @@ std::string resourceDir();
 /// installDataDir()/models/default.
 std::string defaultModelDir();
 
-/// <directory of the running executable>/../share/pneuma, normalised (the current directory stands in for the
-/// executable's when /proc/self/exe cannot be read). The one place that knows the data folder's position.
+/// <directory of the running executable, or of the shared object holding pneuma::sim>/../share/pneuma,
+/// normalised (the current directory stands in for the executable's when /proc/self/exe cannot be read). The
+/// one place that knows the data folder's position.
 std::string installDataDir();
 
 }  // namespace pneuma::sim
