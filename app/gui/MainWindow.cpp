@@ -458,6 +458,9 @@ void MainWindow::buildDocks() {
     showPosture();
   });
 
+  connect(m_params, &ParameterPanel::magnificationEdited, this,
+          [this](double factor) { setMagnification(factor); });
+
   auto* tabs = new QTabWidget(this);
   auto* displayScroll = new QScrollArea(this);
   displayScroll->setWidget(display);
@@ -496,8 +499,9 @@ void MainWindow::syncDisplayWidgets() {
 
 void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
   m_scene->setOptions(options);
+  m_params->setMagnification(options.magnification);
   syncDisplayWidgets();
-  if (m_shown) m_scene->update(m_shown->state, m_shown->metrics);
+  if (m_shown) m_scene->update(m_shown->state, m_shown->metrics, m_shown->endExpiration.get());
   m_view->renderWindow()->Render();
 }
 
@@ -651,6 +655,18 @@ QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
   return {};
 }
 
+QString MainWindow::setMagnification(double factor) {
+  const std::string error = viz::magnificationError(factor);
+  if (!error.empty()) {
+    report("Motion magnification refused", QString::fromStdString(error));
+    return QString::fromStdString(error);
+  }
+  viz::DisplayOptions o = m_scene->options();
+  o.magnification = factor;
+  setDisplayOptions(o);
+  return {};
+}
+
 void MainWindow::play() { m_playAction->setChecked(true); }
 
 void MainWindow::setSpeed(double speed) {
@@ -735,7 +751,7 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   const Snapshot& s = *m_shown;
   QElapsedTimer clock;
   clock.start();
-  if (s.model == m_document.model()) m_scene->update(s.state, s.metrics);
+  if (s.model == m_document.model()) m_scene->update(s.state, s.metrics, s.endExpiration.get());
   m_view->renderWindow()->Render();
   m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
   m_sinceRender.restart();

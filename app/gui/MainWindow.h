@@ -58,6 +58,10 @@ class MainWindow : public QMainWindow {
   /// @return empty, or the error (an unknown name lists the valid ones).
   QString setPosture(const QString& name);
 
+  /// Sets the view's motion magnification (display only, viz::DisplayOptions::magnification).
+  /// @return empty, or the error (outside [viz::kMinMagnification, viz::kMaxMagnification]).
+  QString setMagnification(double factor);
+
   void play();
   void pause();
   /// Runs as fast as possible until simulated time `time` [s], then pauses and shows that instant.

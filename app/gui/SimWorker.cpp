@@ -2,6 +2,7 @@
 
 #include <QTimer>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 
@@ -16,6 +17,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kWallBudget = 0.030;  // [s] longest stepping batch between two sync points
 constexpr int kTickMs = 8;             // [ms] worker tick
+// [-] rise of the lung volume above its running minimum, as a fraction of it, that confirms an
+// end-expiration (0.5 %: 29 mL of a 5.8 L chest, well under a calm breath's 500 mL, well over the rib
+// cage's few-hertz wobble)
+constexpr double kEndExpirationRise = 0.005;
 
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -121,6 +126,7 @@ void SimWorker::sync() {
     ++m_generation;
     m_breathing = nullptr;
     m_breathingAt = -1.0;
+    clearEndExpirations();
   }
   // a new posture turns gravity: the run starts over from the rest pose and settles in it
   const bool isNewPosture = p.settings && p.settings->options.step.posture != m_settings.options.step.posture;
@@ -137,6 +143,7 @@ void SimWorker::sync() {
     ++m_generation;
     m_breathing = nullptr;
     m_breathingAt = -1.0;
+    clearEndExpirations();
   }
   if (p.speed) m_speed = *p.speed;
   if (p.runUntil) {
@@ -185,6 +192,40 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   s.groupMeanTension = m.groupMeanTension;
   s.elementForce.assign(m.elementForce.data(), m.elementForce.data() + m.elementForce.size());
   m_samples.push_back(std::move(s));
+  findEndExpiration(simulation);
+}
+
+void SimWorker::clearEndExpirations() {
+  m_endExpirations.clear();
+  m_isSeekingMinimum = true;
+  m_extremeVolume = std::numeric_limits<double>::quiet_NaN();
+}
+
+void SimWorker::findEndExpiration(const sim::Simulation& simulation) {
+  const double v = simulation.latestMetrics().lungVolume;
+  if (simulation.state().time < simulation.options().settleTime || !std::isfinite(v)) return;
+  const double rise = kEndExpirationRise * v;
+  if (m_isSeekingMinimum) {
+    if (!(v >= m_extremeVolume)) {
+      m_extremeVolume = v;
+      m_atMinimum = simulation.state();
+    } else if (v > m_extremeVolume + rise) {
+      // the minimum is past: that breath's end-expiration; forget those older than the recording
+      m_endExpirations.push_back(std::make_shared<const sim::State>(m_atMinimum));
+      const sim::Recorder& rec = simulation.recorder();
+      const double oldest = rec.empty() ? 0.0 : rec.frame(0).time;
+      while (m_endExpirations.size() > 1 && m_endExpirations[1]->time <= oldest)
+        m_endExpirations.erase(m_endExpirations.begin());
+      m_isSeekingMinimum = false;
+      m_extremeVolume = v;
+    }
+  } else if (v > m_extremeVolume) {
+    m_extremeVolume = v;
+  } else if (v < m_extremeVolume - rise) {
+    m_isSeekingMinimum = true;
+    m_extremeVolume = v;
+    m_atMinimum = simulation.state();
+  }
 }
 
 void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mode) {
@@ -300,6 +341,9 @@ void SimWorker::publish(bool isScrubbed) {
   } else {
     snap->state = m_sim->state();
   }
+  // the end-expiration the shown instant's breath started from
+  for (const auto& e : m_endExpirations)
+    if (e->time <= snap->state.time) snap->endExpiration = e;
 
   std::lock_guard lock(m_outboxMutex);
   if (m_outbox.snapshot && m_outbox.snapshot->generation != m_generation) m_outbox.samples.clear();

@@ -59,6 +59,10 @@ struct Snapshot {
   /// tidal volume, rate and the motion in anatomical axes), refreshed once per simulated second; null before
   /// the first full breath.
   std::shared_ptr<const sim::Summary> breathing;
+  /// The end-expiratory state the shown instant's breath started from (the last volume minimum at or before
+  /// it, after settling): the view magnifies the motion from it (viz::DisplayOptions::magnification). Null
+  /// before the first end-expiration.
+  std::shared_ptr<const sim::State> endExpiration;
 };
 
 /// [s] span of the run that Snapshot::breathing measures: two breaths at 10 b/m.
@@ -146,6 +150,11 @@ class SimWorker : public QObject {
   /// gut pressure, as measured then: sim::Recorder::restore()).
   void restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const;
   void publish(bool isScrubbed);
+  /// Forgets the end-expirations found (reset, new model, new posture).
+  void clearEndExpirations();
+  /// Follows the lung volume of each output frame and keeps the state at each end-expiration: a volume
+  /// minimum confirmed once the volume has risen kEndExpirationRise of itself above it.
+  void findEndExpiration(const sim::Simulation& simulation);
 
   std::shared_ptr<const sim::Model> m_model;
   std::unique_ptr<sim::Simulation> m_sim;
@@ -168,6 +177,11 @@ class SimWorker : public QObject {
   double m_breathingAt = -1.0;                      // [s] simulated time it was measured at
   std::chrono::steady_clock::time_point m_lastTick;
   std::vector<PlotSample> m_samples;  // collected since the last publish
+  // end-expirations: the confirmed ones within the recording (oldest first), and the search for the next
+  std::vector<std::shared_ptr<const sim::State>> m_endExpirations;
+  bool m_isSeekingMinimum = true;
+  double m_extremeVolume = std::numeric_limits<double>::quiet_NaN();  // [m^3] running minimum or maximum
+  sim::State m_atMinimum;                                             // the state at the running minimum
 
   std::mutex m_outboxMutex;
   Frame m_outbox;

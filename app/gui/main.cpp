@@ -1,5 +1,5 @@
-// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--model DIR]`
-// starts, simulates for the given time, saves a grab of the whole window and exits.
+// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--magnify N] [--model
+// DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -88,11 +88,19 @@ int main(int argc, char** argv) {
                                   "Show the anatomical labels and the lung cavity (teaching view).");
   const QCommandLineOption skin("skin", "The skin: translucent (default), opaque or hidden.", "MODE",
                                 "translucent");
+  const QCommandLineOption magnify(
+      "magnify",
+      QString("Motion magnification of the view, display only (%1 to %2, default %3).")
+          .arg(pneuma::viz::kMinMagnification)
+          .arg(pneuma::viz::kMaxMagnification)
+          .arg(pneuma::viz::kDefaultMagnification),
+      "N", QString::number(pneuma::viz::kDefaultMagnification));
   const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X",
                                  "1");
   const QCommandLineOption measure(
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
-  parser.addOptions({model, style, affect, posture, camera, labels, skin, speed, screenshot, after, measure});
+  parser.addOptions(
+      {model, style, affect, posture, camera, labels, skin, magnify, speed, screenshot, after, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -123,6 +131,15 @@ int main(int argc, char** argv) {
   if (parser.isSet(measure) && (!isNumber || !(measureSeconds > 0.0))) {
     std::fprintf(stderr, "pneuma: --measure: expected seconds > 0, got '%s'\n",
                  qPrintable(parser.value(measure)));
+    return 2;
+  }
+
+  const double magnification = parser.value(magnify).toDouble(&isNumber);
+  const std::string magnifyError =
+      isNumber ? pneuma::viz::magnificationError(magnification)
+               : "motion magnification: '" + parser.value(magnify).toStdString() + "' is not a number";
+  if (!magnifyError.empty()) {
+    std::fprintf(stderr, "pneuma: --magnify: %s\n", magnifyError.c_str());
     return 2;
   }
 
@@ -168,6 +185,7 @@ int main(int argc, char** argv) {
   {
     pneuma::viz::DisplayOptions options = window.scene().options();
     options.skin = skinMode->second;
+    options.magnification = magnification;
     if (parser.isSet(labels)) {
       options.showLabels = true;
       options.showCavity = true;

@@ -25,6 +25,7 @@
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkSphereSource.h>
+#include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkXMLPolyDataReader.h>
 
@@ -34,6 +35,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <limits>
+#include <sstream>
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
@@ -152,6 +154,14 @@ vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::st
   return normals->GetOutput();
 }
 
+std::string magnificationError(double factor) {
+  if (factor >= kMinMagnification && factor <= kMaxMagnification) return {};
+  std::ostringstream out;
+  out << "motion magnification: " << factor << " is outside [" << kMinMagnification << ", "
+      << kMaxMagnification << "]";
+  return out.str();
+}
+
 const char* groupLabel(sim::ElementGroup g) {
   switch (g) {
     case sim::ElementGroup::IntercostalExternal:
@@ -201,6 +211,8 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkScalarBarActor> gutBar = makeScalarBar(gutTable, "Gut", 0.07);
   vtkSmartPointer<vtkLookupTable> skinTable = makeSkinTable();
   vtkSmartPointer<vtkScalarBarActor> skinBar = makeScalarBar(skinTable, "Skin\ndisplacement\n[mm]", 0.31);
+  // "motion x5" at the top left of the view while the motion is magnified
+  vtkSmartPointer<vtkTextActor> motionText = vtkSmartPointer<vtkTextActor>::New();
   DisplayOptions options;
 
   sim::Model model;
@@ -485,6 +497,13 @@ struct ModelScene::Impl {
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
   }
 
+  std::string motionCaption() const {
+    if (options.magnification == 1.0) return {};
+    std::ostringstream out;
+    out << "motion \u00d7" << options.magnification;
+    return out.str();
+  }
+
   void applyOptions() {
     const bool byForce = options.muscleColouring == MuscleColouring::Force;
     bool anyMuscleShown = false;
@@ -527,6 +546,8 @@ struct ModelScene::Impl {
       skinActor->GetMapper()->SetScalarVisibility(isSkinColoured);
     }
     skinBar->SetVisibility(isSkinShown && isSkinColoured);
+    motionText->SetInput(motionCaption().c_str());
+    motionText->SetVisibility(options.magnification != 1.0);
     for (const Label& l : labels) {
       const bool relevant = l.group >= 0      ? options.showGroup[static_cast<std::size_t>(l.group)]
                             : l.landmark >= 0 ? options.showLandmarks
@@ -548,6 +569,19 @@ ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
   m_impl->forceBar->VisibilityOff();
   m_impl->gutBar->VisibilityOff();
   m_impl->skinBar->VisibilityOff();
+  vtkTextActor* motion = m_impl->motionText;
+  motion->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  motion->SetPosition(0.015, 0.94);
+  vtkTextProperty* text = motion->GetTextProperty();
+  text->SetFontSize(18);
+  text->BoldOn();
+  text->ShadowOff();
+  text->SetColor(1.0, 0.86, 0.35);
+  text->SetBackgroundColor(0.08, 0.09, 0.12);
+  text->SetBackgroundOpacity(0.7);
+  motion->PickableOff();
+  r->AddViewProp(motion);
+  m_impl->applyOptions();
 }
 
 ModelScene::~ModelScene() = default;
@@ -590,11 +624,16 @@ void ModelScene::setModel(const sim::Model& model, const std::string& modelDir) 
   setCamera(CameraPreset::Oblique);
 }
 
-void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
+void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
+                        const sim::State* endExpiration) {
   Impl& s = *m_impl;
   const sim::Model& model = s.model;
 
-  sim::poseGeometry(model, state, s.posed);
+  // display only: the motion from the end-expiratory pose magnified, posed by the one posing function
+  if (endExpiration && s.options.magnification != 1.0)
+    sim::poseGeometry(model, sim::magnifyMotion(*endExpiration, state, s.options.magnification), s.posed);
+  else
+    sim::poseGeometry(model, state, s.posed);
 
   // bones: rigid transforms body -> world
   for (std::size_t b = 0; b < s.bodies.size(); ++b) {
@@ -679,7 +718,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     if (l.landmark >= 0) {
       at = lm.col(l.landmark);
     } else if (l.body >= 0) {
-      at = state.bodyPosition.col(l.body);
+      at = s.posed.body[static_cast<std::size_t>(l.body)].translation();
     } else {
       // a group is labelled at its element furthest to the subject's right, clear of the midline
       at = Eigen::Vector3d::Constant(-1e9);
@@ -704,6 +743,10 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     s.highlightLine->GetPoints()->Modified();
   }
 }
+
+const sim::PosedGeometry& ModelScene::posed() const { return m_impl->posed; }
+
+std::string ModelScene::motionCaption() const { return m_impl->motionCaption(); }
 
 void ModelScene::setOptions(const DisplayOptions& options) {
   m_impl->options = options;

@@ -14,6 +14,7 @@
 
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
+#include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/State.h"
 
 class vtkPolyData;
@@ -34,6 +35,17 @@ enum class SkinDisplay { Hidden, Translucent, Opaque };
 enum class SkinColouring { Plain, Displacement };
 constexpr double kSkinDisplacementTop = 10.0;  ///< [mm] top of the skin displacement colour scale
 constexpr double kSkinTranslucency = 0.3;      ///< [-] opacity of the translucent skin
+
+/// Motion magnification (display only): the view draws every displacement from the end-expiratory pose
+/// (bones, muscles, gut, lungs, skin) this many times larger (sim::magnifyMotion()), so that calm breathing,
+/// a few millimetres at the chest wall, is visible; the view says so ("motion x5"). Plots, read-outs and
+/// exported numbers are never magnified.
+constexpr double kMinMagnification = 1.0;      ///< [-]
+constexpr double kMaxMagnification = 20.0;     ///< [-]
+constexpr double kDefaultMagnification = 5.0;  ///< [-] makes a calm breath visible across a lecture hall
+/// Empty when `factor` is a valid magnification, else the one-line reason ("motion magnification: 25 is
+/// outside [1, 20]").
+std::string magnificationError(double factor);
 
 /// Camera presets, looking at the whole model.
 enum class CameraPreset { Anterior, Lateral, Superior, Oblique };
@@ -64,6 +76,8 @@ struct DisplayOptions {
   SkinColouring skinColouring = SkinColouring::Plain;
   std::array<bool, sim::kElementGroupCount> showGroup{true, true, true, true, true, true};
   double forceRange = 0.0;  ///< [N] top of the force colour scale; 0 = adapt to the largest force seen
+  double magnification = kDefaultMagnification;  ///< [-] motion magnification, in [kMinMagnification,
+                                                 ///< kMaxMagnification]
 };
 
 /// What a pick in the view hit.
@@ -93,8 +107,16 @@ class ModelScene {
   void setModel(const sim::Model& model, const std::string& modelDir);
 
   /// Moves everything to `state` and colours it from `metrics` (elementForce [N], gutPressure [Pa]).
-  /// `state` and `metrics` must belong to the model given to setModel().
-  void update(const sim::State& state, const sim::Metrics& metrics);
+  /// `state` and `metrics` must belong to the model given to setModel(). With `endExpiration` (the
+  /// end-expiratory state of the breath, Snapshot::endExpiration) the motion from it is drawn magnified
+  /// DisplayOptions::magnification times; without it the state is drawn as it is.
+  void update(const sim::State& state, const sim::Metrics& metrics,
+              const sim::State* endExpiration = nullptr);
+
+  /// The geometry as drawn by the last update() (magnified) [m].
+  const sim::PosedGeometry& posed() const;
+  /// The caption the view shows for the magnification ("motion \u00d75"; empty at 1x).
+  std::string motionCaption() const;
 
   /// Applies display options (visibility, colouring, translucency).
   void setOptions(const DisplayOptions& options);

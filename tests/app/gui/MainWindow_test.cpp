@@ -8,6 +8,7 @@
 #include <vtkCoordinate.h>
 #include <vtkPropCollection.h>
 #include <vtkRenderer.h>
+#include <vtkTextActor.h>
 
 #include <QAction>
 #include <QCheckBox>
@@ -28,6 +29,7 @@
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/PosedGeometry.h"
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -322,6 +324,94 @@ TEST_F(DefaultModelWindow, BreathingReadOutShowsTheCalmBreathsMotion) {
     if (a->text() == "Reset") a->trigger();
   ASSERT_TRUE(window.runUntil(1.0)) << window.lastError().toStdString();
   EXPECT_EQ(window.breathingReadout(), "Measured after the first full breath.");
+}
+
+namespace {
+
+// the caption text actors the view shows (the "motion x5" of the magnification among them)
+std::vector<std::string> shownTexts(vtkRenderer* renderer) {
+  std::vector<std::string> texts;
+  vtkPropCollection* props = renderer->GetViewProps();
+  props->InitTraversal();
+  while (vtkProp* prop = props->GetNextProp())
+    if (auto* text = vtkTextActor::SafeDownCast(prop); text && text->GetVisibility() && text->GetInput())
+      texts.emplace_back(text->GetInput());
+  return texts;
+}
+
+}  // namespace
+
+// motion magnification moves what is drawn by the stated factor: at the end of a calm inhale the landmarks'
+// projected screen displacement from the end-expiratory pose is five times larger at 5x than at 1x, the view
+// says "motion x5", and the plotted volume is the real one; a factor outside [1, 20] is refused
+TEST_F(DefaultModelWindow, MagnificationMovesTheDrawnLandmarksByTheFactor) {
+  ASSERT_TRUE(window.runUntil(12.0)) << window.lastError().toStdString();
+  // the end of the last inhale: the largest plotted volume after t = 8.5 s (calm: 15 b/m after 2 s settling)
+  const app::PlotView* plot = window.plots()->volumePlot();
+  const std::vector<double>& t = plot->time();
+  const std::vector<double>& v = plot->series()[0].y;
+  std::size_t peak = 0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] > 8.5 && (peak == 0 || v[k] > v[peak])) peak = k;
+  ASSERT_TRUE(window.scrubTo(t[peak]));
+  const app::Snapshot* shown = window.shown();
+  ASSERT_NE(shown->endExpiration, nullptr) << "an end-expiration found before " << t[peak] << " s";
+  EXPECT_LT(shown->endExpiration->time, t[peak]);
+  EXPECT_GT(shown->endExpiration->time, t[peak] - 4.0) << "the breath's own end-expiration";
+
+  // the landmarks of the end-expiratory pose and as drawn, projected to the screen [px]
+  vtkRenderer* renderer = window.scene().renderer();
+  window.scene().setCamera(viz::CameraPreset::Anterior);
+  window.grabView();
+  sim::PosedGeometry endExpiration;
+  sim::poseGeometry(*window.model(), *shown->endExpiration, endExpiration);
+  auto screen = [&](const Eigen::Vector3d& x) {
+    vtkNew<vtkCoordinate> c;
+    c->SetCoordinateSystemToWorld();
+    c->SetValue(x.x(), x.y(), x.z());
+    const double* d = c->GetComputedDoubleDisplayValue(renderer);
+    return Eigen::Vector2d(d[0], d[1]);
+  };
+  auto drawnDisplacement = [&](double factor) {
+    EXPECT_EQ(window.setMagnification(factor), QString());
+    window.grabView();
+    std::vector<Eigen::Vector2d> d;
+    const Eigen::Matrix3Xd& drawn = window.scene().posed().landmarks;
+    for (Eigen::Index l = 0; l < drawn.cols(); ++l)
+      d.push_back(screen(drawn.col(l)) - screen(endExpiration.landmarks.col(l)));
+    return d;
+  };
+  const std::vector<Eigen::Vector2d> real = drawnDisplacement(1.0);
+  EXPECT_TRUE(shownTexts(renderer).empty() ||
+              std::none_of(shownTexts(renderer).begin(), shownTexts(renderer).end(),
+                           [](const std::string& s) { return s.rfind("motion", 0) == 0; }))
+      << "no caption at 1x";
+  const std::vector<Eigen::Vector2d> magnified = drawnDisplacement(5.0);
+  const std::vector<std::string> texts = shownTexts(renderer);
+  EXPECT_NE(std::find(texts.begin(), texts.end(), "motion \u00d75"), texts.end());
+  // the landmark that moves most on screen (the umbilicus or the xiphoid in an anterior view)
+  std::size_t most = 0;
+  for (std::size_t l = 0; l < real.size(); ++l)
+    if (real[l].norm() > real[most].norm()) most = l;
+  ASSERT_GT(real[most].norm(), 1.0) << "a calm inhale moves a landmark at least a pixel";
+  EXPECT_NEAR(magnified[most].norm() / real[most].norm(), 5.0, 0.25);
+  EXPECT_GT(magnified[most].normalized().dot(real[most].normalized()), 0.99) << "the same direction";
+  // the numbers stay real: the snapshot's volume is the plotted one
+  EXPECT_NEAR(1e6 * shown->metrics.lungVolume, v[peak], 1e-6);
+
+  // out of range: refused with the reason, the factor kept
+  const QString error = window.setMagnification(25.0);
+  EXPECT_TRUE(error.contains("motion magnification: 25 is outside [1, 20]")) << error.toStdString();
+  EXPECT_EQ(window.scene().options().magnification, 5.0);
+  QLineEdit* field = window.parameters()->magnificationField();
+  field->setText("0.5");
+  emit field->editingFinished();
+  EXPECT_TRUE(window.parameters()->refusal().contains("0.5 is outside [1, 20]"))
+      << window.parameters()->refusal().toStdString();
+  EXPECT_EQ(window.scene().options().magnification, 5.0);
+  field->setText("10");
+  emit field->editingFinished();
+  EXPECT_EQ(window.scene().options().magnification, 10.0);
 }
 
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {
