@@ -66,10 +66,12 @@ const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructur
     {"Landmarks", &viz::DisplayOptions::showLandmarks},
     {"Anatomical labels", &viz::DisplayOptions::showLabels}};
 const std::vector<std::pair<const char*, viz::MuscleColouring>> kMuscleColourings{
-    {"Contractive force [N]", viz::MuscleColouring::Force}, {"Muscle group", viz::MuscleColouring::Group}};
+    {"Tension [N]", viz::MuscleColouring::Force},
+    {"Activation \u03b1 [0-1]", viz::MuscleColouring::Activation},
+    {"Muscle group", viz::MuscleColouring::Group}};
 const std::vector<std::pair<const char*, viz::GutColouring>> kGutColourings{
     {"Plain", viz::GutColouring::Plain},
-    {"Pressure [Pa]", viz::GutColouring::Pressure},
+    {"Pressure [cmH2O]", viz::GutColouring::Pressure},
     {"Displacement [mm]", viz::GutColouring::Displacement}};
 const std::vector<std::pair<const char*, viz::SkinDisplay>> kSkinDisplays{
     {"Translucent", viz::SkinDisplay::Translucent},
@@ -387,6 +389,13 @@ void MainWindow::buildDocks() {
   for (const auto& [label, colouring] : kSkinColourings)
     m_skinColour->addItem(label, static_cast<int>(colouring));
   colourForm->addRow("Skin", m_skinColour);
+  auto* autoRange = new QCheckBox("Auto-range (95th percentile)", colouring);
+  autoRange->setToolTip(
+      "Off: every scale has its fixed range (tension 0-20 N, activation 0-1, gut 0-20 mm, skin 0-10 mm, gut "
+      "pressure \u00b15 cmH2O), the same on every frame and run. On: each scale is topped at the 95th "
+      "percentile of its values so far, rounded up, never shrinking.");
+  colourForm->addRow(autoRange);
+  m_structureChecks.emplace_back(autoRange, &viz::DisplayOptions::isAutoRange);
   displayLayout->addWidget(colouring);
 
   auto* structures = new QGroupBox("Structures", display);

@@ -6,8 +6,11 @@
 #include <gtest/gtest.h>
 #include <vtkCaptionActor2D.h>
 #include <vtkCoordinate.h>
+#include <vtkDoubleArray.h>
 #include <vtkPropCollection.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkScalarsToColors.h>
 #include <vtkTextActor.h>
 
 #include <QAction>
@@ -412,6 +415,78 @@ TEST_F(DefaultModelWindow, MagnificationMovesTheDrawnLandmarksByTheFactor) {
   field->setText("10");
   emit field->editingFinished();
   EXPECT_EQ(window.scene().options().magnification, 10.0);
+}
+
+namespace {
+
+// what each shown colour legend says: its title, range and labels as drawn
+std::vector<std::string> shownLegends(vtkRenderer* renderer) {
+  std::vector<std::string> legends;
+  vtkPropCollection* props = renderer->GetViewProps();
+  props->InitTraversal();
+  while (vtkProp* prop = props->GetNextProp()) {
+    auto* bar = vtkScalarBarActor::SafeDownCast(prop);
+    if (!bar || !bar->GetVisibility()) continue;
+    std::string text = std::string(bar->GetTitle()) + " |";
+    EXPECT_TRUE(bar->GetUseCustomLabels()) << bar->GetTitle();
+    vtkDoubleArray* labels = bar->GetCustomLabels();
+    for (vtkIdType i = 0; labels && i < labels->GetNumberOfTuples(); ++i) {
+      char label[64];
+      std::snprintf(label, sizeof label, bar->GetLabelFormat(), labels->GetValue(i));
+      // round numbers: no exponent, no trailing zero after a decimal point
+      EXPECT_TRUE(QRegularExpression("^-?[0-9]+(\\.[0-9]*[1-9])?$").match(label).hasMatch())
+          << bar->GetTitle() << ": label '" << label << "'";
+      text += std::string(" ") + label;
+    }
+    const double* range = bar->GetLookupTable()->GetRange();
+    text += " [" + std::to_string(range[0]) + ", " + std::to_string(range[1]) + "]";
+    legends.push_back(text);
+  }
+  return legends;
+}
+
+}  // namespace
+
+// the colour legends of a recorded run stay fixed across its frames (tension 0-20 N, gut and skin
+// displacement 0-20 and 0-10 mm from end-expiration), with round labels; the auto range (95th percentile)
+// fits the run and never shrinks while it is replayed
+TEST_F(DefaultModelWindow, ColourLegendsOfARecordedRunStayFixedAcrossFrames) {
+  viz::DisplayOptions o = window.scene().options();
+  o.skinColouring = viz::SkinColouring::Displacement;
+  window.setDisplayOptions(o);
+  ASSERT_TRUE(window.runUntil(10.0)) << window.lastError().toStdString();
+  vtkRenderer* renderer = window.scene().renderer();
+  std::vector<std::string> first;
+  for (double t : {2.5, 4.0, 5.2, 6.9, 8.3, 9.9}) {
+    ASSERT_TRUE(window.scrubTo(t));
+    window.grabView();
+    const std::vector<std::string> legends = shownLegends(renderer);
+    ASSERT_EQ(legends.size(), 3u) << "tension, gut and skin";
+    if (first.empty()) first = legends;
+    EXPECT_EQ(legends, first) << "at t = " << t << " s";
+  }
+  EXPECT_EQ(first[0], "Tension per\nelement [N] | 0 5 10 15 20 [0.000000, 20.000000]");
+  EXPECT_EQ(first[1], "Gut\ndisplacement\n[mm] | 0 5 10 15 20 [0.000000, 20.000000]");
+  EXPECT_EQ(first[2], "Skin\ndisplacement\n[mm] | 0 2 4 6 8 10 [0.000000, 10.000000]");
+
+  // auto range: fitted to the values shown, never shrinking as the replay goes on
+  o.isAutoRange = true;
+  window.setDisplayOptions(o);
+  double top = 0.0;
+  for (double t : {3.0, 5.0, 7.0, 9.0}) {
+    ASSERT_TRUE(window.scrubTo(t));
+    const std::vector<std::string> legends = shownLegends(renderer);
+    vtkPropCollection* props = renderer->GetViewProps();
+    props->InitTraversal();
+    while (vtkProp* prop = props->GetNextProp())
+      if (auto* bar = vtkScalarBarActor::SafeDownCast(prop);
+          bar && bar->GetVisibility() && std::string(bar->GetTitle()).rfind("Gut", 0) == 0) {
+        EXPECT_GE(bar->GetLookupTable()->GetRange()[1], top) << "at t = " << t << " s";
+        top = bar->GetLookupTable()->GetRange()[1];
+      }
+  }
+  EXPECT_GE(top, 1.0);
+  EXPECT_LT(top, 100.0) << "the gut moves a few millimetres from end-expiration, not the settling sag";
 }
 
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {
