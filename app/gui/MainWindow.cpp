@@ -550,6 +550,7 @@ QString MainWindow::openModel(const QString& dir) {
     return message;
   }
   m_document.adopt(opened);
+  m_drive = nullptr;  // a new model starts with the breath style
   const std::shared_ptr<const sim::Model>& model = opened.model;
   m_selected = {};
   m_plots->clearTraces();
@@ -600,6 +601,14 @@ QString MainWindow::openScenario(const QString& path) {
     m_settings = previous;
     return error;
   }
+  m_drive = scenario.drive;
+  if (m_drive) {
+    m_worker->requestScenario(m_drive);
+    if (m_drive->controller == sim::ControllerKind::Affect) {
+      const QSignalBlocker blockAffect(m_affectCombo);
+      m_affectCombo->setCurrentText(QString::fromStdString(m_drive->controllerName));
+    }
+  }
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
   showMessage(QString("Scenario '%1' loaded").arg(scenario.name), 5000);
@@ -608,7 +617,7 @@ QString MainWindow::openScenario(const QString& path) {
 
 QString MainWindow::saveScenario(const QString& path) {
   try {
-    m_document.saveScenario(path, m_settings);
+    m_document.saveScenario(path, m_settings, m_drive.get());
   } catch (const std::exception& e) {
     const QString message = QString("Cannot save scenario '%1': %2").arg(path, e.what());
     report("Scenario not saved", message);
@@ -625,6 +634,7 @@ QString MainWindow::setBreathStyle(const QString& name) {
     report("Unknown breath style", e.what());
     return e.what();
   }
+  m_drive = nullptr;
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(name);
   m_params->setSettings(m_settings, m_document.model());
@@ -658,6 +668,12 @@ QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
   if (!m_worker) return "no model is open";
   m_worker->requestAffect(name.toStdString(), isImmediate ? sim::pattern::SwitchMode::Immediate
                                                           : sim::pattern::SwitchMode::EndOfCycle);
+  // saved with the scenario: the affect pushed last
+  auto drive = std::make_shared<sim::Scenario>();
+  drive->name = name.toStdString();
+  drive->controller = sim::ControllerKind::Affect;
+  drive->controllerName = name.toStdString();
+  m_drive = std::move(drive);
   showMessage(
       QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"),
       5000);
@@ -766,6 +782,7 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   m_sinceRender.restart();
   ++m_framesRendered;
 
+  m_plots->setBreaths(s.endExpirationTimes);
   m_plots->setCursor(s.isScrubbed ? s.metrics.time : std::numeric_limits<double>::quiet_NaN());
   m_statusTime->setText(
       QString("  t = %1 s%2  ").arg(s.state.time, 0, 'f', 2).arg(s.isScrubbed ? " (recorded)" : ""));

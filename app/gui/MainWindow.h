@@ -147,6 +147,9 @@ class MainWindow : public QMainWindow {
   QThread m_thread;
   SimWorker* m_worker = nullptr;
   std::shared_ptr<const Snapshot> m_shown;
+  // what drives the run besides the breath style: a pushed affect or an opened affect or pattern scenario
+  // (saved with the scenario); null while a breath style plays
+  std::shared_ptr<const sim::Scenario> m_drive;
   long long m_generation = -1;
   viz::Pick m_selected;
 

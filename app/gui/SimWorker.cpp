@@ -84,6 +84,11 @@ void SimWorker::requestAffect(const std::string& name, sim::pattern::SwitchMode 
   m_pending.affect = std::make_pair(name, mode);
 }
 
+void SimWorker::requestScenario(std::shared_ptr<const sim::Scenario> scenario) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.scenario = std::move(scenario);
+}
+
 void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir,
                                  const std::string& baseName) {
   std::lock_guard lock(m_pendingMutex);
@@ -154,6 +159,7 @@ void SimWorker::sync() {
     m_isRunning = *p.isRunning;
     m_debt = 0.0;
   }
+  if (p.scenario) playScenario(*p.scenario);
   if (p.affect) pushAffect(p.affect->first, p.affect->second);
   if (p.exportRun) exportRun(*p.exportRun);
   if (p.doStep) {
@@ -186,6 +192,12 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   s.rightLungVolume = m.rightLungVolume;
   s.leftLungVolume = m.leftLungVolume;
   s.gutVolumeError = m.gutVolumeError;
+  if (m.time > m_previousTime) s.flow = (m.lungVolume - m_previousVolume) / (m.time - m_previousTime);
+  m_previousTime = m.time;
+  m_previousVolume = m.lungVolume;
+  s.gutPressure = m.gutPressure;
+  if (m_model->cavity.compliance > 0.0)
+    s.transdiaphragmaticPressure = m.gutPressure - simulation.stepWork().outputs.pleuralPressure;
   s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
                              : std::numeric_limits<double>::quiet_NaN();
   s.activations = m.activations;
@@ -197,6 +209,7 @@ void SimWorker::collect(const sim::Simulation& simulation) {
 
 void SimWorker::clearEndExpirations() {
   m_endExpirations.clear();
+  m_previousTime = std::numeric_limits<double>::quiet_NaN();
   m_isSeekingMinimum = true;
   m_extremeVolume = std::numeric_limits<double>::quiet_NaN();
 }
@@ -240,6 +253,15 @@ void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mod
   m_pattern = controller.get();
   m_sim->setController(std::move(controller));
   emit status(QString("Playing affect '%1'").arg(QString::fromStdString(name)));
+}
+
+void SimWorker::playScenario(const sim::Scenario& scenario) {
+  emit status(QString("Calibrating the muscle drive for '%1' (a few simulated seconds)\u2026")
+                  .arg(QString::fromStdString(scenario.name)));
+  auto controller = sim::makeController(scenario, m_model, sim::resourceDir());
+  m_pattern = dynamic_cast<sim::pattern::PatternController*>(controller.get());
+  m_sim->setController(std::move(controller));
+  emit status(QString("Playing scenario '%1'").arg(QString::fromStdString(scenario.name)));
 }
 
 void SimWorker::restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const {
@@ -342,8 +364,10 @@ void SimWorker::publish(bool isScrubbed) {
     snap->state = m_sim->state();
   }
   // the end-expiration the shown instant's breath started from
-  for (const auto& e : m_endExpirations)
+  for (const auto& e : m_endExpirations) {
     if (e->time <= snap->state.time) snap->endExpiration = e;
+    snap->endExpirationTimes.push_back(e->time);
+  }
 
   std::lock_guard lock(m_outboxMutex);
   if (m_outbox.snapshot && m_outbox.snapshot->generation != m_generation) m_outbox.samples.clear();

@@ -15,6 +15,7 @@
 
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/pattern/PatternController.h"
@@ -37,6 +38,13 @@ struct PlotSample {
   double rightLungVolume = 0.0;  ///< [m^3] NaN for a model without lung surfaces
   double leftLungVolume = 0.0;   ///< [m^3] NaN for a model without lung surfaces
   double gutVolumeError = 0.0;   ///< [-] signed (V - V0) / V0
+  /// [m^3/s] lung flow dV/dt, the backward difference over the output frame (inspiration > 0); NaN at a
+  /// run's first frame
+  double flow = std::numeric_limits<double>::quiet_NaN();
+  double gutPressure = 0.0;  ///< [Pa] abdominal (gut) pressure P of Eq. 4
+  /// [Pa] transdiaphragmatic pressure Pdi = Pab - Ppl (gut pressure minus the cavity's pleural pressure,
+  /// Model.h Cavity); NaN for a model without a pleural pressure (cavity.compliance 0)
+  double transdiaphragmaticPressure = std::numeric_limits<double>::quiet_NaN();
   double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung
                                                                    ///< volume; NaN without one
   sim::Activations activations{};                                  ///< r and alpha per group
@@ -63,6 +71,8 @@ struct Snapshot {
   /// it, after settling): the view magnifies the motion from it (viz::DisplayOptions::magnification). Null
   /// before the first end-expiration.
   std::shared_ptr<const sim::State> endExpiration;
+  /// [s] the times of the end-expirations found within the recording, oldest first: the breaths' bounds
+  std::vector<double> endExpirationTimes;
 };
 
 /// [s] span of the run that Snapshot::breathing measures: two breaths at 10 b/m.
@@ -102,6 +112,9 @@ class SimWorker : public QObject {
   /// calibrates the muscle drive on the model (a few simulated seconds, in the worker thread) and
   /// switches to a pattern controller; a later breath-style edit switches back.
   void requestAffect(const std::string& name, sim::pattern::SwitchMode mode);
+  /// Drives the run with the affect or pattern of `scenario` (sim::makeController(): the muscle drive is
+  /// calibrated first, a few simulated seconds in the worker thread).
+  void requestScenario(std::shared_ptr<const sim::Scenario> scenario);
   /// Writes the recorded frames as a ParaView series `outDir`/`baseName`.pvd (viz::VtkSeriesWriter),
   /// then emits exportDone().
   void requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName);
@@ -137,6 +150,7 @@ class SimWorker : public QObject {
     std::optional<double> scrubTime;
     std::optional<double> runUntil;
     std::optional<std::pair<std::string, sim::pattern::SwitchMode>> affect;
+    std::shared_ptr<const sim::Scenario> scenario;
     std::optional<std::array<std::string, 3>> exportRun;  // model dir, out dir, base name
   };
 
@@ -145,6 +159,7 @@ class SimWorker : public QObject {
   void applySettings(const RunSettings& settings);
   void collect(const sim::Simulation& simulation);
   void pushAffect(const std::string& name, sim::pattern::SwitchMode mode);
+  void playScenario(const sim::Scenario& scenario);
   void exportRun(const std::array<std::string, 3>& request);
   /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces and the
   /// gut pressure, as measured then: sim::Recorder::restore()).
@@ -182,6 +197,9 @@ class SimWorker : public QObject {
   bool m_isSeekingMinimum = true;
   double m_extremeVolume = std::numeric_limits<double>::quiet_NaN();  // [m^3] running minimum or maximum
   sim::State m_atMinimum;                                             // the state at the running minimum
+  double m_previousTime =
+      std::numeric_limits<double>::quiet_NaN();  // [s] the last output frame, for the flow
+  double m_previousVolume = 0.0;                 // [m^3] its lung volume
 
   std::mutex m_outboxMutex;
   Frame m_outbox;

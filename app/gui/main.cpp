@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/LivePlots.h"
 #include "gui/MainWindow.h"
 
 int main(int argc, char** argv) {
@@ -95,12 +96,14 @@ int main(int argc, char** argv) {
           .arg(pneuma::viz::kMaxMagnification)
           .arg(pneuma::viz::kDefaultMagnification),
       "N", QString::number(pneuma::viz::kDefaultMagnification));
+  const QCommandLineOption physiology(
+      "physiology", "Show the Physiology plots (flow, flow-volume loop, pressures) in front.");
   const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X",
                                  "1");
   const QCommandLineOption measure(
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
-  parser.addOptions(
-      {model, style, affect, posture, camera, labels, skin, magnify, speed, screenshot, after, measure});
+  parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
+                     screenshot, after, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -186,6 +189,7 @@ int main(int argc, char** argv) {
     pneuma::viz::DisplayOptions options = window.scene().options();
     options.skin = skinMode->second;
     options.magnification = magnification;
+    window.plots()->showPhysiology(parser.isSet(physiology));
     if (parser.isSet(labels)) {
       options.showLabels = true;
       options.showCavity = true;

@@ -41,6 +41,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "viz/PlotLayout.h"
 
 namespace pneuma::viz {
 
@@ -113,43 +114,19 @@ vtkSmartPointer<vtkScalarBarActor> makeScalarBar(vtkLookupTable* table, const ch
   return bar;
 }
 
-// the legend ticks over [lo, hi]: a step of 1, 2 or 5 x 10^n with 2 to 10 intervals (4 or 5 preferred)
-// whose multiples include both ends; written with kLegendFormat (%g: no trailing zeros, and no exponent for
-// 1e-4 <= |v| < 1e6)
+// legend labels: the plots' ticks (viz::niceTicks, a 1-2-5 step) written with %g (no trailing zeros, and no
+// exponent for 1e-4 <= |v| < 1e6)
 constexpr const char* kLegendFormat = "%g";
-std::vector<double> legendTicks(double lo, double hi) {
-  std::vector<double> best;
-  double bestScore = std::numeric_limits<double>::infinity();
-  const double span = hi - lo;
-  if (!(span > 0.0)) return {lo};
-  const int e0 = static_cast<int>(std::floor(std::log10(span)));
-  for (int e = e0 - 2; e <= e0; ++e)
-    for (double m : {1.0, 2.0, 5.0}) {
-      const double step = m * std::pow(10.0, e);
-      const double n = span / step, first = lo / step;
-      if (std::abs(n - std::round(n)) > 1e-6 || std::abs(first - std::round(first)) > 1e-6) continue;
-      if (n < 2.0 || n > 10.0) continue;
-      const double score = std::abs(n - 4.5);
-      if (score >= bestScore) continue;
-      bestScore = score;
-      best.clear();
-      // each tick rounded to the step's decimals, so that %g shows no float noise (0.30000000000000004)
-      const double unit = std::pow(10.0, std::min(e, 0));
-      for (int i = 0; i <= static_cast<int>(std::round(n)); ++i)
-        best.push_back(std::round((lo + i * step) / unit) * unit);
-    }
-  if (best.empty()) best = {lo, hi};  // ends that no step fits: just both
-  return best;
-}
+constexpr int kLegendTicks = 5;  // [-] intervals aimed at
 
-// one colour scale: its table and its legend over [lo, hi], with legendTicks() as its labels
+// one colour scale: its table and its legend over [lo, hi], labelled as legendLabels() writes them
 void setScale(vtkScalarBarActor* bar, vtkLookupTable* table, double lo, double hi) {
   double range[2];
   table->GetTableRange(range);
   if (range[0] == lo && range[1] == hi && bar->GetUseCustomLabels()) return;
   table->SetTableRange(lo, hi);
   vtkNew<vtkDoubleArray> labels;
-  for (double v : legendTicks(lo, hi)) labels->InsertNextValue(v);
+  for (double v : niceTicks(lo, hi, kLegendTicks).values) labels->InsertNextValue(v);
   bar->SetUseCustomLabels(true);
   bar->SetCustomLabels(labels);
   bar->SetLabelFormat(kLegendFormat);
@@ -215,7 +192,7 @@ double niceCeil(double v) {
 std::vector<std::string> legendLabels(double lo, double hi) {
   std::vector<std::string> labels;
   char text[64];
-  for (double v : legendTicks(lo, hi)) {
+  for (double v : niceTicks(lo, hi, kLegendTicks).values) {
     std::snprintf(text, sizeof text, kLegendFormat, v);
     labels.emplace_back(text);
   }

@@ -44,13 +44,13 @@ constexpr double kTensionTop =
 constexpr double kActivationTop = 1.0;         ///< [-] activation alpha, Eq. 2: [0, 1]
 constexpr double kGutDisplacementTop = 20.0;   ///< [mm] gut: a deep breath's dome descent
 constexpr double kSkinDisplacementTop = 10.0;  ///< [mm] skin: a deep breath's chest-wall motion
-constexpr double kGutPressureTop = 5.0;  ///< [cmH2O] gut pressure, on [-top, top] (calm breathing: 1-3 cmH2O)
+constexpr double kGutPressureTop = 20.0;  ///< [cmH2O] gut pressure, on [-top, top] (calm upright: 5-10 cmH2O)
 /// [-] the percentile of the values whose rounded-up value tops an auto-ranged scale
 constexpr double kAutoRangePercentile = 0.95;
 
-/// The labels of a colour legend over [lo, hi], as the legend shows them: 3 to 11 evenly spaced values a step
-/// of 1, 2 or 5 x 10^n apart that include both ends, written without trailing zeros or exponents ("0", "5",
-/// "10"; "0", "0.2", ..., "1").
+/// The labels of a colour legend over [lo, hi], as the legend shows them: the plots' ticks (viz::niceTicks(),
+/// a step of 1, 2 or 5 x 10^n) written without trailing zeros or exponents ("0", "5", ..., "20"; "0", "0.2",
+/// ..., "1").
 std::vector<std::string> legendLabels(double lo, double hi);
 /// The smallest of 1, 2, 5 x 10^n not below `v` (1 for v <= 0): the top of an auto-ranged scale.
 double niceCeil(double v);

@@ -28,11 +28,14 @@
 
 #include "../cli/CliRunner.h"
 #include "GuiTestSupport.h"
+#include "gui/FlowVolumeLoop.h"
 #include "gui/LivePlots.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Resources.h"
+#include "pneuma/sim/Scenario.h"
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -351,8 +354,8 @@ TEST_F(DefaultModelWindow, MagnificationMovesTheDrawnLandmarksByTheFactor) {
   ASSERT_TRUE(window.runUntil(12.0)) << window.lastError().toStdString();
   // the end of the last inhale: the largest plotted volume after t = 8.5 s (calm: 15 b/m after 2 s settling)
   const app::PlotView* plot = window.plots()->volumePlot();
-  const std::vector<double>& t = plot->time();
-  const std::vector<double>& v = plot->series()[0].y;
+  const std::vector<double> t = plot->time();  // copies: a refresh replaces the plot's data
+  const std::vector<double> v = plot->series()[0].y;
   std::size_t peak = 0;
   for (std::size_t k = 0; k < t.size(); ++k)
     if (t[k] > 8.5 && (peak == 0 || v[k] > v[peak])) peak = k;
@@ -489,12 +492,100 @@ TEST_F(DefaultModelWindow, ColourLegendsOfARecordedRunStayFixedAcrossFrames) {
   EXPECT_LT(top, 100.0) << "the gut moves a few millimetres from end-expiration, not the settling sag";
 }
 
+// the physiology panel: the flow-volume loop closes each calm breath (from one end-expiration to the next the
+// lung volume returns within 5 % of the tidal volume and the flow to near zero), the plotted flow integrates
+// to the plotted volume change, the pressures are in cmH2O, and at a scrubbed instant the notes read that
+// instant
+TEST_F(DefaultModelWindow, FlowVolumeLoopClosesEachBreath) {
+  ASSERT_TRUE(window.runUntil(19.0)) << window.lastError().toStdString();
+  const app::FlowVolumeLoop* loop = window.plots()->loop();
+  int complete = 0;
+  for (const app::FlowVolumeLoop::Loop& l : loop->loops()) {
+    ASSERT_GT(l.time.size(), 10u);
+    const auto [vMin, vMax] = std::minmax_element(l.volume.begin(), l.volume.end());
+    double peakFlow = 0.0, integral = 0.0;  // [L/s], [mL]
+    for (std::size_t k = 0; k < l.flow.size(); ++k) {
+      if (std::isfinite(l.flow[k])) peakFlow = std::max(peakFlow, std::abs(l.flow[k]));
+      if (k > 0) integral += 1e3 * l.flow[k] * (l.time[k] - l.time[k - 1]);
+    }
+    if (!l.isComplete) continue;
+    ++complete;
+    const double tidal = *vMax - *vMin;  // [mL]
+    EXPECT_NEAR(tidal, 530.0, 80.0) << "a calm breath";
+    EXPECT_NEAR(l.volume.front(), 0.0, 1e-9);
+    EXPECT_LT(std::abs(l.volume.back()), 0.05 * tidal)
+        << "the loop closes: breath from " << l.time.front() << " s";
+    EXPECT_LT(std::abs(l.flow.back()), 0.2 * peakFlow) << "ends near zero flow";
+    EXPECT_GT(peakFlow, 0.2) << "calm breathing peaks at a few tenths of a litre per second";
+    EXPECT_NEAR(integral, l.volume.back(), 0.02 * tidal) << "flow [L/s] integrates to the volume [mL]";
+    EXPECT_NEAR(l.time.back() - l.time.front(), 4.0, 0.4) << "15 breaths per minute";
+  }
+  EXPECT_GE(complete, 2);
+  EXPECT_NEAR(window.plots()->breathingRate(), 15.0, 1.0);
+
+  // pressures in cmH2O: the gut's and, the model having a pleural pressure, the transdiaphragmatic one
+  const app::PlotView* pressures = window.plots()->pressurePlot();
+  ASSERT_EQ(pressures->series().size(), 2u);
+  const std::vector<double>& pdi = pressures->series()[1].y;
+  const double pdiLast = pdi.back();
+  EXPECT_GT(pdiLast, 0.0) << "the diaphragm holds the abdomen below the chest";
+  EXPECT_LT(pdiLast, 40.0) << "cmH2O, not Pa";
+
+  // scrubbed: the notes read that instant
+  ASSERT_TRUE(window.scrubTo(15.0));
+  window.plots()->refresh();
+  const double t = window.shown()->metrics.time;
+  const std::string at = QString("at %1 s").arg(t, 0, 'f', 2).toStdString();
+  for (const app::PlotView* plot :
+       {window.plots()->volumePlot(), window.plots()->flowPlot(), window.plots()->pressurePlot()})
+    EXPECT_NE(plot->toPlot().note().find(at), std::string::npos) << plot->toPlot().note();
+  EXPECT_NE(
+      window.plots()->volumePlot()->toPlot().note().find(
+          QString("lungs %1 mL").arg(1e6 * window.shown()->metrics.lungVolume, 0, 'f', 0).toStdString()),
+      std::string::npos)
+      << "the scrubbed volume, not the live one";
+}
+
+// scenarios round-trip whatever drives them: the shipped startle scenario (a pattern with a timeline) opens
+// and plays its target volume; saved, it reopens to the same pattern; after a pushed affect the saved
+// scenario records the affect, not the calm style
+TEST_F(DefaultModelWindow, AffectAndPatternScenariosOpenPlayAndSaveWhatDrivesTheRun) {
+  const QString startle = QString::fromStdString(sim::resourceDir()) + "/scenarios/startle-at-10s.json";
+  ASSERT_EQ(window.openScenario(startle), QString());
+  ASSERT_TRUE(window.runUntil(5.0, 120000)) << window.lastError().toStdString();
+  const app::PlotView* plot = window.plots()->volumePlot();
+  ASSERT_EQ(plot->series().size(), 2u) << "simulated and target volume";
+  const std::vector<double> target = plot->series()[1].y;
+  EXPECT_TRUE(std::any_of(target.begin(), target.end(), [](double v) { return v > 1000.0; }))
+      << "the pattern's target lung volume [mL] is plotted";
+
+  QTemporaryDir dir;
+  const QString saved = dir.filePath("startle.json");
+  ASSERT_EQ(window.saveScenario(saved), QString());
+  const sim::Scenario original = sim::loadScenario(startle.toStdString());
+  const sim::Scenario reread = sim::loadScenario(saved.toStdString());
+  EXPECT_EQ(reread.controller, sim::ControllerKind::Pattern);
+  EXPECT_EQ(reread.patternText, original.patternText);
+  EXPECT_EQ(reread.seed, original.seed);
+  ASSERT_EQ(window.openScenario(saved), QString()) << "the saved scenario reopens";
+
+  ASSERT_EQ(window.setBreathStyle("calm"), QString());
+  ASSERT_EQ(window.pushAffect("panic", true), QString());
+  ASSERT_EQ(window.saveScenario(saved), QString());
+  const sim::Scenario affect = sim::loadScenario(saved.toStdString());
+  EXPECT_EQ(affect.controller, sim::ControllerKind::Affect);
+  EXPECT_EQ(affect.controllerName, "panic");
+  ASSERT_EQ(window.setBreathStyle("deep"), QString());
+  ASSERT_EQ(window.saveScenario(saved), QString());
+  EXPECT_EQ(sim::loadScenario(saved.toStdString()).controllerName, "deep");
+}
+
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(5.0));
   const app::PlotView* plot = w.window.plots()->volumePlot();
   // the live sample nearest to t = 3 s
-  const auto& t = plot->time();
+  const std::vector<double> t = plot->time();  // a copy: the scrub refreshes the plot
   const std::size_t k = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), 3.0) - t.begin());
   ASSERT_LT(k, t.size());
   const double liveVolume = plot->series()[0].y[k];  // [mL]
