@@ -33,8 +33,13 @@ class ExportController : public QObject {
   QString exportPlot(const PlotView* plot, const QString& path);
   /// Writes a PNG of the 3D view.
   QString exportViewImage(const QString& path);
-  /// Renders the recording from `from` to `to` [s] at `fps` [1/s]: an .ogv movie or a PNG sequence.
-  QString exportAnimation(const QString& path, double from, double to, double fps);
+  /// Renders the recording from `from` to `to` [s] at `fps` [1/s]: an .ogv movie or a PNG sequence, with a
+  /// progress dialog (parented to `dialogParent`, may be null) whose Cancel stops it and leaves no file
+  /// (the result is then kCancelled, and nothing is reported as failed).
+  QString exportAnimation(const QString& path, double from, double to, double fps,
+                          class QWidget* dialogParent = nullptr);
+  /// What exportAnimation() returns when its Cancel was pressed.
+  static QString cancelled() { return "cancelled"; }
   /// Has `worker` write its recording as `pvdPath` plus a folder of .vtp frames (body meshes from
   /// `modelDir`); blocks, processing events, until it is written.
   QString exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath);

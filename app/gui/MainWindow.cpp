@@ -18,6 +18,7 @@
 #include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
+#include <QInputDialog>
 #include <QLabel>
 #include <QMenu>
 #include <QMenuBar>
@@ -245,7 +246,15 @@ void MainWindow::buildActions() {
     if (!m_shown) return;
     const QString path = QFileDialog::getSaveFileName(this, "Export animation", "breathing.ogv",
                                                       "Ogg Theora movie (*.ogv);;PNG sequence (*.png)");
-    if (!path.isEmpty()) exportAnimation(path, m_shown->recordedFrom, m_shown->recordedTo, 25.0);
+    if (path.isEmpty()) return;
+    // the time range: the whole recording unless narrowed
+    bool ok = false;
+    const double from = QInputDialog::getDouble(this, "Export animation", "From [s]", m_shown->recordedFrom,
+                                                m_shown->recordedFrom, m_shown->recordedTo, 2, &ok);
+    if (!ok) return;
+    const double to = QInputDialog::getDouble(this, "Export animation", "To [s]", m_shown->recordedTo, from,
+                                              m_shown->recordedTo, 2, &ok);
+    if (ok) exportAnimation(path, from, to, 25.0);
   });
   exportMenu->addAction("Run as ParaView series (.pvd)\u2026", this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, "Export run", "run.pvd", "ParaView data (*.pvd)");
@@ -895,7 +904,7 @@ QString MainWindow::exportViewImage(const QString& path) { return m_export->expo
 
 QString MainWindow::exportAnimation(const QString& path, double from, double to, double fps) {
   if (!m_worker) return m_export->exportAnimation(path, 0.0, 0.0, fps);  // refused: nothing recorded
-  return m_export->exportAnimation(path, from, to, fps);
+  return m_export->exportAnimation(path, from, to, fps, this);
 }
 
 QString MainWindow::exportRun(const QString& pvdPath) {

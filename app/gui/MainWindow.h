@@ -76,6 +76,8 @@ class MainWindow : public QMainWindow {
   QString exportViewImage(const QString& path);
   /// Renders the recorded run from `from` to `to` [s] at `fps` frames per second, as an Ogg Theora
   /// movie (.ogv) or a PNG sequence (any other suffix: <base>_0000.png, ...). @return empty or the error.
+  /// A progress dialog shows the frames written; its Cancel leaves no file (returns
+  /// ExportController::cancelled()).
   QString exportAnimation(const QString& path, double from, double to, double fps);
   /// Writes the recorded run as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it.
   /// Blocks (processing events) until the worker has written it. @return empty or the error.

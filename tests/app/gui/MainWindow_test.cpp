@@ -19,15 +19,18 @@
 #include <QFile>
 #include <QLabel>
 #include <QLineEdit>
+#include <QProgressDialog>
 #include <QRegularExpression>
 #include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
+#include <QTimer>
 #include <cmath>
 #include <set>
 
 #include "../cli/CliRunner.h"
 #include "GuiTestSupport.h"
+#include "gui/ExportController.h"
 #include "gui/FlowVolumeLoop.h"
 #include "gui/LivePlots.h"
 #include "gui/ParameterPanel.h"
@@ -833,6 +836,32 @@ TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
   EXPECT_TRUE(movie.read(4) == "OggS");  // an Ogg container
   EXPECT_GT(movie.size(), 1000);
   EXPECT_TRUE(QDir(out.path()).entryList({"*.tmp-*"}, QDir::Files).isEmpty());
+}
+
+// a movie export shows its progress, and Cancel part-way leaves no file behind (neither the movie nor a
+// temporary), with no error reported
+TEST(MainWindow, CancelledAnimationExportLeavesNoFile) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(1.5));
+  QTemporaryDir out;
+  int shownAt = -1;
+  QTimer clicker;
+  QObject::connect(&clicker, &QTimer::timeout, [&] {
+    for (QProgressDialog* dialog : w.window.findChildren<QProgressDialog*>())
+      if (dialog->isVisible() && dialog->value() >= 3 && shownAt < 0) {
+        shownAt = dialog->value();
+        EXPECT_EQ(dialog->maximum(), 26) << "1 s at 25 fps";
+        dialog->cancel();
+      }
+  });
+  clicker.start(2);
+  const QString error = w.window.exportAnimation(out.filePath("breath.ogv"), 0.4, 1.4, 25.0);
+  clicker.stop();
+  EXPECT_EQ(error, app::ExportController::cancelled());
+  EXPECT_GE(shownAt, 3) << "the progress dialog was shown and counted frames";
+  EXPECT_TRUE(QDir(out.path()).entryList(QDir::Files | QDir::Hidden).isEmpty())
+      << QDir(out.path()).entryList(QDir::Files | QDir::Hidden).join(", ").toStdString();
+  EXPECT_EQ(w.window.lastError(), QString()) << "a cancel is not an error";
 }
 
 TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {
