@@ -55,13 +55,7 @@ void runBake(const BakeArgs& a) {
   InterruptGuard guard;
   const sim::MorphTargets m = morphTargetsFor(model, "");
 
-  // one breath of the breathing target (in 2 s, out 3 s) so that a viewer shows it moving
-  viz::GltfAnimation breath;
-  breath.name = "breathing";
-  breath.time = {0.0, 2.0, 5.0};
-  breath.weights = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.targets.size()), 3);
-  breath.weights(0, 1) = 1.0;
-  writeGltfOrFail("--out", a.out, *model, resolveModelDir(a.model), m, {breath});
+  writeGltfOrFail("--out", a.out, *model, resolveModelDir(a.model), m, {viz::breathingDemo(m)});
 
   std::printf("morph targets of model '%s' (%d skin vertices), scaled to the deep breath's %.0f mL:\n",
               model->name.c_str(), m.vertexCount(), (m.targetVolume - m.baseVolume) * 1e6);
@@ -146,7 +140,7 @@ void addPlayCommand(CLI::App& app) {
   cmd->add_option("--morphs", args->morphs, "Morph targets baked by pneuma-cli bake (default: bake now)");
   cmd->add_option("--duration", args->duration, "Seconds to play (default 60)");
   cmd->add_option("--output-rate", args->outputRate, "Animation frames per second [Hz] (default 30)");
-  cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams (default 0)");
+  addSeedOption(*cmd, args->seed);
   cmd->callback([args] { runPlay(*args); });
 }
 

@@ -1,7 +1,6 @@
 /// @file Morphs.cpp
 #include "Morphs.h"
 
-#include <cmath>
 #include <cstdio>
 
 #include "CliSupport.h"
@@ -66,11 +65,6 @@ void checkGltfOutput(const char* flag, const std::string& path) {
   } catch (const std::exception& e) {
     fail(kExitBadInput, std::string(flag) + ": " + e.what());
   }
-}
-
-sim::BlendError BlendErrorSum::total() const {
-  if (m_frames == 0) return {};
-  return {std::sqrt(m_squares / static_cast<double>(m_frames)), m_max};
 }
 
 }  // namespace pneuma::app

@@ -1,7 +1,7 @@
 #pragma once
 /// @file Morphs.h
 /// What `bake`, `play` and `simulate --gltf` share: the morph targets of a model (baked, or read back from a
-/// baked .glb), the check of a glTF output path, and a run's blend error.
+/// baked .glb), and the checks of a glTF export.
 
 #include <memory>
 #include <string>
@@ -23,22 +23,5 @@ void checkGltfOutput(const char* flag, const std::string& path);
 
 /// Fails with kExitBadInput when `model` has no skin ("<flag>: model '<name>' has no skin ...").
 void checkHasSkin(const char* flag, const sim::Model& model);
-
-/// The blend error over the frames of a run: RMS over every vertex of every frame, maximum over all [m].
-class BlendErrorSum {
- public:
-  void add(const sim::BlendError& frame) {
-    m_squares += frame.rms * frame.rms;
-    m_max = frame.max > m_max ? frame.max : m_max;
-    ++m_frames;
-  }
-  sim::BlendError total() const;
-  long long frames() const { return m_frames; }
-
- private:
-  double m_squares = 0.0;  // [m^2] sum over frames of the frame's mean squared distance
-  double m_max = 0.0;      // [m]
-  long long m_frames = 0;
-};
 
 }  // namespace pneuma::app

@@ -11,6 +11,7 @@
 #include <vtkSmartPointer.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
@@ -135,6 +136,46 @@ void boneMesh(const std::string& path, const std::string& name, Eigen::Matrix3Xf
 }
 
 }  // namespace
+
+GltfAnimationBuilder::GltfAnimationBuilder(const sim::Model& model, const sim::MorphTargets& targets)
+    : m_model(model), m_fit(targets) {}
+
+void GltfAnimationBuilder::add(double time, const sim::State& state) {
+  if (!m_time.empty() && !(time > m_time.back())) return;
+  sim::poseGeometry(m_model, state, m_posed);
+  m_weights.push_back(m_fit.weights(m_posed.skin));
+  const sim::BlendError e = m_fit.error(m_posed.skin);
+  m_squares += e.rms * e.rms;
+  m_max = std::max(m_max, e.max);
+  m_time.push_back(time);
+  m_bodies.push_back(m_posed.body);
+}
+
+GltfAnimation GltfAnimationBuilder::animation(const std::string& name) const {
+  GltfAnimation a;
+  a.name = name;
+  a.time = m_time;
+  a.bodies = m_bodies;
+  a.weights.resize(m_weights.empty() ? 0 : m_weights.front().size(),
+                   static_cast<Eigen::Index>(m_weights.size()));
+  for (std::size_t f = 0; f < m_weights.size(); ++f)
+    a.weights.col(static_cast<Eigen::Index>(f)) = m_weights[f];
+  return a;
+}
+
+sim::BlendError GltfAnimationBuilder::error() const {
+  if (m_time.empty()) return {};
+  return {std::sqrt(m_squares / static_cast<double>(m_time.size())), m_max};
+}
+
+GltfAnimation breathingDemo(const sim::MorphTargets& targets) {
+  GltfAnimation a;
+  a.name = "breathing";
+  a.time = {0.0, 2.0, 5.0};
+  a.weights = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(targets.targets.size()), 3);
+  if (a.weights.rows() > 0) a.weights(0, 1) = 1.0;
+  return a;
+}
 
 void writeGltf(const std::string& path, const sim::Model& model, const std::string& modelDir,
                const sim::MorphTargets& targets, const std::vector<GltfAnimation>& animations) {

@@ -15,6 +15,8 @@
 
 #include "pneuma/sim/Model.h"
 #include "pneuma/sim/MorphTargets.h"
+#include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/State.h"
 
 namespace pneuma::viz {
 
@@ -29,6 +31,34 @@ struct GltfAnimation {
   std::vector<std::vector<Eigen::Isometry3d>> bodies;  ///< body frame -> world per frame, model frame (#F x
                                                        ///< #B); empty: the bones stay at their rest pose
 };
+
+/// Collects the frames of a run as a GltfAnimation: each state's skin (sim::poseGeometry) fitted onto the
+/// morph targets (sim::MorphFit) and its bone poses, with the blend error over all frames.
+class GltfAnimationBuilder {
+ public:
+  /// `model` and `targets` must outlive the builder.
+  GltfAnimationBuilder(const sim::Model& model, const sim::MorphTargets& targets);
+  /// Adds `state` as the frame at `time` [s]; a time not after the previous frame's is skipped.
+  void add(double time, const sim::State& state);
+  /// The frames so far as an animation named `name`.
+  GltfAnimation animation(const std::string& name) const;
+  /// The blend error over the frames so far: RMS over every vertex of every frame, maximum over all [m].
+  sim::BlendError error() const;
+  std::size_t frames() const { return m_time.size(); }
+
+ private:
+  const sim::Model& m_model;
+  sim::MorphFit m_fit;
+  sim::PosedGeometry m_posed;
+  std::vector<double> m_time;                            // [s] (#F)
+  std::vector<Eigen::VectorXd> m_weights;                // [-] (#F x #K)
+  std::vector<std::vector<Eigen::Isometry3d>> m_bodies;  // (#F x #B)
+  double m_squares = 0.0;  // [m^2] sum over frames of the frame's mean squared distance
+  double m_max = 0.0;      // [m]
+};
+
+/// A one-breath demonstration of the breathing target (in 2 s, out 3 s), for a file of baked targets.
+GltfAnimation breathingDemo(const sim::MorphTargets& targets);
 
 /// Writes `path` (.glb): scene "pneuma" with node "skin" (the base skin of `targets`, its morph targets
 /// named in mesh.extras.targetNames) and node "bones" holding one node per body of `model` (its render mesh
