@@ -51,7 +51,6 @@ pneuma_install_packages() {
   fi
 }
 
-# configure once (Ninja, Release), then build incrementally
 # the npm packages of the glTF checks (tests/gltf: gltf-validator, three, playwright-core), pinned by its
 # package-lock.json; installed once, again only when the lock file changes; the browser is Debian's chromium
 pneuma_install_npm() {
@@ -59,10 +58,16 @@ pneuma_install_npm() {
   if [ -f "$dir/node_modules/.package-lock.json" ] && ! [ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]; then
     return 0
   fi
+  # Debian's nodejs comes without npm (NodeSource's has it built in)
+  if ! command -v npm >/dev/null 2>&1; then
+    local PNEUMA_PACKAGES=(npm)
+    pneuma_install_packages || return 1
+  fi
   pneuma_log "installing the npm packages of the glTF checks (tests/gltf)"
   (cd "$dir" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error) || return 1
 }
 
+# configure once (Ninja, Release), then build incrementally
 pneuma_build() {
   if [ ! -f "$PNEUMA_BUILD_DIR/build.ninja" ]; then
     pneuma_log "configuring Release build in $PNEUMA_BUILD_DIR"
