@@ -120,19 +120,37 @@ QString ExportController::exportAnimation(const QString& path, double from, doub
   return {};
 }
 
-QString ExportController::exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath) {
-  if (!worker) return "no model loaded";
-  const QFileInfo info(pvdPath);
+QString ExportController::waitForWorker(SimWorker* worker, const std::function<void()>& request) {
   QEventLoop loop;
   QString error = "the export did not finish";
   auto finished = connect(worker, &SimWorker::exportDone, &loop, [&](const QString& e) {
     error = e;
     loop.quit();
   });
-  worker->requestExportRun(modelDir.toStdString(), info.absolutePath().toStdString(),
-                           info.completeBaseName().toStdString());
+  request();
   loop.exec();
   disconnect(finished);
+  return error;
+}
+
+QString ExportController::exportGltf(SimWorker* worker, const QString& modelDir, const QString& path,
+                                     bool isBakeOnly) {
+  if (!worker) return fail("no model loaded");
+  const QString error = waitForWorker(
+      worker, [&] { worker->requestExportGltf(modelDir.toStdString(), path.toStdString(), isBakeOnly); });
+  const QString what = isBakeOnly ? "the morph targets" : "the run";
+  if (!error.isEmpty()) return fail(QString("Cannot export %1 to '%2': %3").arg(what, path, error));
+  emit done(QString("%1 saved as %2").arg(isBakeOnly ? "Morph targets" : "glTF of the run", path));
+  return {};
+}
+
+QString ExportController::exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath) {
+  if (!worker) return "no model loaded";
+  const QFileInfo info(pvdPath);
+  const QString error = waitForWorker(worker, [&] {
+    worker->requestExportRun(modelDir.toStdString(), info.absolutePath().toStdString(),
+                             info.completeBaseName().toStdString());
+  });
   if (!error.isEmpty()) return fail(QString("Cannot export the run to '%1': %2").arg(pvdPath, error));
   emit done(QString("Run saved as %1").arg(pvdPath));
   return {};

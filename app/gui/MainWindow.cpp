@@ -260,6 +260,16 @@ void MainWindow::buildActions() {
     const QString path = QFileDialog::getSaveFileName(this, "Export run", "run.pvd", "ParaView data (*.pvd)");
     if (!path.isEmpty()) exportRun(path);
   });
+  exportMenu->addAction("Run as glTF 2.0 (.glb)\u2026", this, [this] {
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Export run as glTF", "breathing.glb", "glTF 2.0 binary (*.glb)");
+    if (!path.isEmpty()) exportGltf(path);
+  });
+  exportMenu->addAction("Baked morph targets (.glb)\u2026", this, [this] {
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Bake morph targets", "morphs.glb", "glTF 2.0 binary (*.glb)");
+    if (!path.isEmpty()) bakeMorphTargets(path);
+  });
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
 
@@ -909,6 +919,14 @@ QString MainWindow::exportAnimation(const QString& path, double from, double to,
 
 QString MainWindow::exportRun(const QString& pvdPath) {
   return m_export->exportRun(m_worker, m_document.modelDir(), pvdPath);
+}
+
+QString MainWindow::exportGltf(const QString& path) {
+  return m_export->exportGltf(m_worker, m_document.modelDir(), path, false);
+}
+
+QString MainWindow::bakeMorphTargets(const QString& path) {
+  return m_export->exportGltf(m_worker, m_document.modelDir(), path, true);
 }
 
 QImage MainWindow::grabView() {

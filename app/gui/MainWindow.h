@@ -82,6 +82,10 @@ class MainWindow : public QMainWindow {
   /// Writes the recorded run as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it.
   /// Blocks (processing events) until the worker has written it. @return empty or the error.
   QString exportRun(const QString& pvdPath);
+  /// File > Export > Run as glTF: the recording as a .glb (morph weights and bone poses); "" on success.
+  QString exportGltf(const QString& path);
+  /// File > Export > Baked morph targets: the model's morph targets as a .glb; "" on success.
+  QString bakeMorphTargets(const QString& path);
   /// Pushes an affect preset (de Melo et al. 2010), at the end of the current breath or immediately.
   /// @return empty, or the error (an unknown name lists the valid ones; no model open).
   QString pushAffect(const QString& name, bool isImmediate);

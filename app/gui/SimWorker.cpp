@@ -8,6 +8,8 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Resources.h"
+#include "viz/AtomicFile.h"
+#include "viz/GltfWriter.h"
 #include "viz/VtkSeriesWriter.h"
 
 namespace pneuma::app {
@@ -89,6 +91,11 @@ void SimWorker::requestScenario(std::shared_ptr<const sim::Scenario> scenario) {
   m_pending.scenario = std::move(scenario);
 }
 
+void SimWorker::requestExportGltf(const std::string& modelDir, const std::string& path, bool isBakeOnly) {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.exportGltf = GltfRequest{modelDir, path, isBakeOnly};
+}
+
 void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir,
                                  const std::string& baseName) {
   std::lock_guard lock(m_pendingMutex);
@@ -125,6 +132,7 @@ void SimWorker::sync() {
   if (p.simulation) {
     m_model = std::move(p.model);
     m_sim = std::move(p.simulation);
+    m_morphs.reset();
     m_pattern = nullptr;
     m_rtf = 0.0;
     m_samples.clear();
@@ -162,6 +170,7 @@ void SimWorker::sync() {
   if (p.scenario) playScenario(*p.scenario);
   if (p.affect) pushAffect(p.affect->first, p.affect->second);
   if (p.exportRun) exportRun(*p.exportRun);
+  if (p.exportGltf) exportGltf(*p.exportGltf);
   if (p.doStep) {
     m_isRunning = false;
     m_sim->stepOnce();
@@ -281,6 +290,39 @@ void SimWorker::exportRun(const std::array<std::string, 3>& request) {
       writer.writeFrame(state, metrics);
     }
     writer.finish();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  emit exportDone(error);
+}
+
+void SimWorker::exportGltf(const GltfRequest& request) {
+  QString error;
+  try {
+    const sim::Recorder& rec = m_sim->recorder();
+    if (m_model->skin.vertexCount() == 0)
+      throw std::runtime_error("model '" + m_model->name +
+                               "' has no skin (rebuild it with pneuma-cli model build)");
+    if (!request.isBakeOnly && rec.size() < 2)
+      throw std::runtime_error("nothing recorded yet: run the simulation first");
+    viz::AtomicFileWriter probe(request.path);  // a folder that cannot be written fails before the bake
+    if (!m_morphs) {
+      emit status("Baking morph targets from deep, panting and supine runs (a few seconds)\u2026");
+      m_morphs =
+          std::make_unique<const sim::MorphTargets>(sim::bakeMorphTargets(m_model, sim::resourceDir()));
+    }
+    std::vector<viz::GltfAnimation> animations{viz::breathingDemo(*m_morphs)};
+    if (!request.isBakeOnly) {
+      viz::GltfAnimationBuilder builder(*m_model, *m_morphs);
+      sim::State state;
+      sim::Metrics metrics = m_sim->latestMetrics();
+      for (std::size_t i = 0; i < rec.size(); ++i) {
+        restoreRecorded(i, state, metrics);
+        builder.add(state.time - rec.frame(0).time, state);
+      }
+      animations = {builder.animation("recording")};
+    }
+    viz::writeGltf(request.path, *m_model, request.modelDir, *m_morphs, animations);
   } catch (const std::exception& e) {
     error = e.what();
   }

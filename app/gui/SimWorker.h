@@ -16,6 +16,7 @@
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/MorphTargets.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/pattern/PatternController.h"
@@ -118,6 +119,11 @@ class SimWorker : public QObject {
   /// Writes the recorded frames as a ParaView series `outDir`/`baseName`.pvd (viz::VtkSeriesWriter),
   /// then emits exportDone().
   void requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName);
+  /// Writes the recorded frames as a glTF 2.0 .glb at `path` (viz::writeGltf: skin morph weights fitted per
+  /// frame, bone poses; bone meshes from `modelDir`), or with `isBakeOnly` the morph targets alone with a
+  /// demo breath; then emits exportDone(). The morph targets are baked on the model once
+  /// (sim::bakeMorphTargets, a few seconds in the worker thread) and kept until another model is loaded.
+  void requestExportGltf(const std::string& modelDir, const std::string& path, bool isBakeOnly);
 
   /// The latest snapshot and the plot samples produced since the previous call (each handed out once).
   Frame take();
@@ -139,6 +145,10 @@ class SimWorker : public QObject {
   void status(const QString& message);
 
  private:
+  struct GltfRequest {
+    std::string modelDir, path;
+    bool isBakeOnly = false;
+  };
   struct Pending {
     std::optional<bool> isRunning;
     bool doStep = false;
@@ -152,6 +162,7 @@ class SimWorker : public QObject {
     std::optional<std::pair<std::string, sim::pattern::SwitchMode>> affect;
     std::shared_ptr<const sim::Scenario> scenario;
     std::optional<std::array<std::string, 3>> exportRun;  // model dir, out dir, base name
+    std::optional<GltfRequest> exportGltf;
   };
 
   void tick();
@@ -161,6 +172,7 @@ class SimWorker : public QObject {
   void pushAffect(const std::string& name, sim::pattern::SwitchMode mode);
   void playScenario(const sim::Scenario& scenario);
   void exportRun(const std::array<std::string, 3>& request);
+  void exportGltf(const GltfRequest& request);
   /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces and the
   /// gut pressure, as measured then: sim::Recorder::restore()).
   void restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const;
@@ -174,6 +186,7 @@ class SimWorker : public QObject {
   std::shared_ptr<const sim::Model> m_model;
   std::unique_ptr<sim::Simulation> m_sim;
   sim::pattern::PatternController* m_pattern = nullptr;  // the sim's controller when an affect plays
+  std::unique_ptr<const sim::MorphTargets> m_morphs;     // baked on m_model at the first glTF export
   RunSettings m_settings;
   QTimer* m_timer = nullptr;
 

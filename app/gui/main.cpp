@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
                                       "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
+  const QCommandLineOption exportGltf(
+      "export-gltf", "With --screenshot: export the recording as a glTF 2.0 .glb to FILE before the grab.",
+      "FILE");
   const QCommandLineOption camera(
       "camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME", "oblique");
   const QCommandLineOption labels("labels",
@@ -103,7 +106,7 @@ int main(int argc, char** argv) {
   const QCommandLineOption measure(
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
   parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
-                     screenshot, after, measure});
+                     screenshot, after, exportGltf, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -205,6 +208,7 @@ int main(int argc, char** argv) {
                    qPrintable(window.lastError()));
       return 1;
     }
+    if (parser.isSet(exportGltf) && !window.exportGltf(parser.value(exportGltf)).isEmpty()) return 1;
     QApplication::processEvents();
     const QString file = parser.value(screenshot);
     if (!window.grabWindow().save(file, "PNG")) {

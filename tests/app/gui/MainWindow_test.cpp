@@ -39,6 +39,7 @@
 #include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
+#include "viz/GltfWriter.h"
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -744,6 +745,35 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
 
   // an unwritable destination is an error, not a crash
   EXPECT_NE(w.window.exportRun("/proc/pneuma-no-such-dir/run.pvd"), QString());
+}
+
+// File > Export > Run as glTF and Baked morph targets: the recording's skin fitted onto targets baked from
+// the physics (docs/patterns.md), read back with the skin's vertex count; a bad folder is an error, not a
+// file
+TEST_F(DefaultModelWindow, RunExportsAsGltfWithBakedMorphTargets) {
+  ASSERT_TRUE(window.runUntil(2.5));
+  QTemporaryDir out;
+  ASSERT_EQ(window.exportGltf(out.filePath("run.glb")), QString());
+  const sim::MorphTargets run = viz::readGltfMorphTargets(out.filePath("run.glb").toStdString());
+  ASSERT_EQ(run.targets.size(), 3u);
+  EXPECT_EQ(run.vertexCount(), window.model()->skin.vertexCount());
+  // the breathing target lifts the body: its largest displacement is centimetres, not zero and not metres
+  const double largest = run.targets[0].displacement.colwise().norm().maxCoeff();  // [m]
+  EXPECT_GT(largest, 0.01);
+  EXPECT_LT(largest, 0.1);
+  ASSERT_EQ(window.bakeMorphTargets(out.filePath("morphs.glb")), QString());
+  EXPECT_TRUE(QFile::exists(out.filePath("morphs.glb")));
+  EXPECT_NE(window.exportGltf("/proc/pneuma-no-such-dir/run.glb"), QString());
+  EXPECT_FALSE(QFile::exists("/proc/pneuma-no-such-dir/run.glb"));
+}
+
+TEST(MainWindow, GltfExportOfAModelWithoutSkinIsRefused) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(0.5));
+  QTemporaryDir out;
+  const QString error = w.window.exportGltf(out.filePath("toy.glb"));
+  EXPECT_TRUE(error.contains("has no skin")) << error.toStdString();
+  EXPECT_TRUE(QDir(out.path()).isEmpty());
 }
 
 // the teaching view: no muscle group's caption covers another caption, from any camera preset
