@@ -12,9 +12,9 @@ PNEUMA_PACKAGES=(
   libeigen3-dev nlohmann-json3-dev libcli11-dev
   libcgal-dev libtet1.5-dev libassimp-dev assimp-testmodels
   qtbase5-dev libqt5svg5-dev libqt5opengl5-dev
-  libvtk9-dev libvtk9-qt-dev
+  libvtk9-dev libvtk9-qt-dev libtinygltf-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  xvfb xauth
+  xvfb xauth chromium nodejs
   help2man clang-format
   slurm-wlm munge
   pybind11-dev python3-dev python3-numpy python3-matplotlib
@@ -51,6 +51,22 @@ pneuma_install_packages() {
     pneuma_log "could not install Debian package(s): ${still[*]}"
     return 1
   fi
+}
+
+# the npm packages of the glTF checks (tests/gltf: gltf-validator, three, playwright-core), pinned by its
+# package-lock.json; installed once, again only when the lock file changes; the browser is Debian's chromium
+pneuma_install_npm() {
+  local dir="$PNEUMA_ROOT/tests/gltf"
+  if [ -f "$dir/node_modules/.package-lock.json" ] && ! [ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]; then
+    return 0
+  fi
+  # Debian's nodejs comes without npm (NodeSource's has it built in)
+  if ! command -v npm >/dev/null 2>&1; then
+    local PNEUMA_PACKAGES=(npm)
+    pneuma_install_packages || return 1
+  fi
+  pneuma_log "installing the npm packages of the glTF checks (tests/gltf)"
+  (cd "$dir" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error) || return 1
 }
 
 # configure once (Ninja, Release), then build incrementally

@@ -7,7 +7,8 @@ usage() {
 Usage: scripts/test.sh [--help] [-L LABEL] [-R REGEX]
 
 Installs the missing Debian 12 packages (needs root or sudo), configures and builds Pneuma
-(Release, into build/), then runs every ctest test (labels: unit, validation, gui, bench-smoke).
+(Release, into build/), then runs every ctest test (labels: unit, validation, gui, gltf, bench-smoke).
+The glTF checks' npm packages (tests/gltf/package-lock.json) are installed with npm ci.
 GUI and off-screen rendering tests run inside xvfb-run -a -s "-screen 0 1280x800x24".
 
 Options:
@@ -29,6 +30,7 @@ done
 
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 pneuma_install_packages
+pneuma_install_npm
 pneuma_build
 
 pneuma_log "running tests"

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -116,6 +117,20 @@ std::string choiceHelp(const std::string& what, const std::string& names, const 
 }
 
 }  // namespace
+
+void addSeedOption(CLI::App& cmd, std::uint64_t& seed) {
+  // digits only and in range: CLI11 would read -1 as 2^64 - 1 and saturate 2^64
+  cmd.add_option("--seed", seed, "Seed of the pattern irregularity streams, 0 to 2^64 - 1 (default 0)")
+      ->check(CLI::Validator(
+          [](const std::string& v) {
+            std::uint64_t x = 0;
+            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+            const bool ok = !v.empty() && v[0] != '-' && ec == std::errc() && end == v.data() + v.size();
+            return ok ? std::string()
+                      : "must be an integer in [0, 18446744073709551615], got " + v.substr(0, 60);
+          },
+          "UINT64"));
+}
 
 void addIntegratorOption(CLI::App& cmd, std::string& name) {
   cmd.add_option("--integrator", name,

@@ -3,6 +3,7 @@
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
 /// resources, preparing output directories, number formatting for JSON/CSV.
 
+#include <cstdint>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -36,6 +37,9 @@ std::string resolveModelDir(const std::string& requested);
 
 /// Adds `--model DIR` to `cmd` (resolved later by resolveModelDir()).
 void addModelOption(CLI::App& cmd, std::string& model);
+
+/// Adds `--seed N` to `cmd`: an integer in [0, 2^64 - 1]; a sign or an overflow is a usage error.
+void addSeedOption(CLI::App& cmd, std::uint64_t& seed);
 
 /// Adds `--integrator NAME` to `cmd`; applyIntegrator() reads it.
 void addIntegratorOption(CLI::App& cmd, std::string& name);

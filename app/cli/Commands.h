@@ -20,4 +20,9 @@ void addSweepCommand(CLI::App& app);
 /// `scenario check FILE`: validate a scenario file; `scenario show FILE`: print it with all defaults.
 void addScenarioCommand(CLI::App& app);
 
+/// `bake`: morph targets from physics runs of the skinned model, written as a .glb.
+void addBakeCommand(CLI::App& app);
+/// `play`: an affect or pattern mapped straight to morph weights, no physics, written as a .glb animation.
+void addPlayCommand(CLI::App& app);
+
 }  // namespace pneuma::app

@@ -2,7 +2,6 @@
 /// `pneuma-cli simulate`: one run of a breath style, an affect, a pattern file or a scenario file.
 
 #include <CLI/CLI.hpp>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +13,7 @@
 
 #include "CliSupport.h"
 #include "Commands.h"
+#include "Morphs.h"
 #include "Progress.h"
 #include "RunRecord.h"
 #include "pneuma/sim/Error.h"
@@ -23,6 +23,7 @@
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/pattern/PatternController.h"
 #include "viz/AtomicFile.h"
+#include "viz/GltfWriter.h"
 #include "viz/VtkSeriesWriter.h"
 
 namespace pneuma::app {
@@ -38,6 +39,8 @@ struct SimulateArgs {
   std::string style, affect, scenario, pattern;
   double duration = 0.0;  // [s]
   std::string out;
+  std::string gltf;         // .glb of the run (skin morph weights and bones), "" for none
+  std::string morphs;       // morph targets baked by `pneuma-cli bake`, "" to bake them now
   double outputRate = 0.0;  // [Hz]
   bool vtk = false;
   bool force = false;  // replace an earlier run's results in `out`
@@ -155,6 +158,16 @@ void runSimulate(const SimulateArgs& args) {
                 message.substr(field.size());
     fail(kExitBadInput, message);
   }
+  // the glTF export: a skinned model, a writable path and the morph targets, before anything runs
+  std::unique_ptr<sim::MorphTargets> morphs;
+  std::unique_ptr<viz::GltfAnimationBuilder> gltf;
+  if (!args.gltf.empty() && model) {
+    checkHasSkin("--gltf", *model);
+    checkGltfOutput("--gltf", args.gltf);
+    morphs = std::make_unique<sim::MorphTargets>(morphTargetsFor(model, args.morphs));
+    gltf = std::make_unique<viz::GltfAnimationBuilder>(*model, *morphs);
+  }
+
   const bool hasTarget = scenario.controller != sim::ControllerKind::Style;
   const std::string controllerText =
       simulation ? simulation->controller().describe()
@@ -191,6 +204,9 @@ void runSimulate(const SimulateArgs& args) {
         else
           record.append(s.latestMetrics());
         if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());
+        // the glTF animation starts with the controller; each frame's skin fitted onto the morph targets
+        const double t = s.state().time - scenario.options.settleTime;  // [s]
+        if (gltf && t >= 0.0) gltf->add(t, s.state());
         bar.update(s.state().time);
         return true;
       });
@@ -221,6 +237,11 @@ void runSimulate(const SimulateArgs& args) {
       for (const std::string& f : record.writePlots(args.out, scenario.name)) files.push_back(f);
     });
   if (vtk) attempt([&] { files.push_back(vtk->finish()); });
+  if (gltf && gltf->frames() >= 2)
+    attempt([&] {
+      viz::writeGltf(args.gltf, *model, modelDir, *morphs, {gltf->animation(scenario.name)});
+      files.push_back(args.gltf);
+    });
   if (failure.empty() && !writeErrors.empty()) failure = writeErrors.front();
 
   const sim::Summary sum = simulation ? simulation->summary() : sim::Summary{};
@@ -267,6 +288,10 @@ void runSimulate(const SimulateArgs& args) {
       simulation ? dynamic_cast<const sim::pattern::PatternController*>(&simulation->controller()) : nullptr;
   j["tracking_rms_pct"] =
       pattern != nullptr ? jsonNumber(pattern->tracking().rmsPercentOfPeakToPeak()) : none;
+  const bool blended = gltf && gltf->frames() > 0;
+  const sim::BlendError blend = blended ? gltf->error() : sim::BlendError{};
+  j["morph_blend_rms_mm"] = blended ? jsonNumber(blend.rms * 1e3) : none;
+  j["morph_blend_max_mm"] = blended ? jsonNumber(blend.max * 1e3) : none;
   j["measured_from_s"] = sum.measuredFrom;
   j["frames"] = record.size();
   j["files"] = files;
@@ -286,6 +311,9 @@ void runSimulate(const SimulateArgs& args) {
   if (ran)
     std::printf(", max gut volume error %.3f %%, real-time factor %.2f\n", sum.maxGutVolumeError * 100.0,
                 sum.realTimeFactor);
+  if (blended)
+    std::printf("  morph blend error over the skin: RMS %.2f mm, max %.2f mm (%zu frames)\n", blend.rms * 1e3,
+                blend.max * 1e3, gltf->frames());
   std::printf("  wrote %s%zu files in %s\n", hasSummary ? "summary.json and " : "", files.size(),
               args.out.c_str());
   if (!failure.empty() || !writeErrors.empty()) {
@@ -320,17 +348,13 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_option("--output-rate", args->outputRate,
                   "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
   cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
-  // digits only and in range: CLI11 would read -1 as 2^64 - 1 and saturate 2^64
-  cmd->add_option("--seed", args->seed, "Seed of the pattern irregularity streams, 0 to 2^64 - 1 (default 0)")
-      ->check(CLI::Validator(
-          [](const std::string& v) {
-            std::uint64_t x = 0;
-            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-            const bool ok = !v.empty() && v[0] != '-' && ec == std::errc() && end == v.data() + v.size();
-            return ok ? std::string()
-                      : "must be an integer in [0, 18446744073709551615], got " + v.substr(0, 60);
-          },
-          "UINT64"));
+  auto* gltf = cmd->add_option(
+      "--gltf", args->gltf,
+      "Also write the run as a glTF 2.0 .glb: skin morph weights and bone poses (needs a skin)");
+  cmd->add_option("--morphs", args->morphs,
+                  "Morph targets for --gltf, baked by pneuma-cli bake (default: bake now)")
+      ->needs(gltf);
+  addSeedOption(*cmd, args->seed);
   addIntegratorOption(*cmd, args->integrator);
   addPostureOption(*cmd, args->posture);
   cmd->add_option(

@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
   pneuma::app::addValidateCommand(app);
   pneuma::app::addBenchCommand(app);
   pneuma::app::addModelCommand(app);
+  pneuma::app::addBakeCommand(app);
+  pneuma::app::addPlayCommand(app);
   app.footer("Run 'pneuma-cli SUBCOMMAND --help' for the options of a subcommand. Docs: docs/cli.md");
 
   try {

@@ -26,12 +26,15 @@ DocumentController::OpenedModel DocumentController::readModel(const QString& dir
 DocumentController::OpenedScenario DocumentController::readScenario(const QString& path,
                                                                     const RunSettings& current) {
   const sim::Scenario scenario = sim::loadScenario(path.toStdString());
-  if (scenario.controller != sim::ControllerKind::Style)
-    throw sim::Error(std::string("controller: the app plays breath styles; '") +
-                     sim::controllerKindName(scenario.controller) + "' scenarios run in pneuma-cli");
   OpenedScenario opened;
   opened.name = QString::fromStdString(scenario.name);
-  opened.settings.style = sim::loadBreathStyle(scenario.controllerName);
+  if (scenario.controller == sim::ControllerKind::Style) {
+    opened.settings.style = sim::loadBreathStyle(scenario.controllerName);
+  } else {
+    sim::checkController(scenario, sim::resourceDir());
+    opened.settings.style = current.style;  // shown in the panel; the affect or pattern drives the run
+    opened.drive = std::make_shared<const sim::Scenario>(scenario);
+  }
   opened.settings.options = scenario.options;
   opened.settings.options.recordSeconds = current.options.recordSeconds;
   opened.modelDir = scenario.model == "default" ? defaultModelDir() : QString::fromStdString(scenario.model);
@@ -43,7 +46,8 @@ void DocumentController::adopt(const OpenedModel& opened) {
   m_modelDir = opened.dir;
 }
 
-void DocumentController::saveScenario(const QString& path, const RunSettings& settings) const {
+void DocumentController::saveScenario(const QString& path, const RunSettings& settings,
+                                      const sim::Scenario* drive) const {
   sim::Scenario scenario;
   scenario.name = QFileInfo(path).completeBaseName().toStdString();
   scenario.description = "Saved from the Pneuma desktop app";
@@ -69,6 +73,12 @@ void DocumentController::saveScenario(const QString& path, const RunSettings& se
     const QString stylePath = info.absoluteDir().absoluteFilePath(info.completeBaseName() + ".style.json");
     viz::writeFileAtomically(stylePath.toStdString(), sim::serializeBreathStyle(edited));
     scenario.controllerName = stylePath.toStdString();
+  }
+  if (drive) {
+    scenario.controller = drive->controller;
+    scenario.controllerName = drive->controllerName;
+    scenario.patternText = drive->patternText;
+    scenario.seed = drive->seed;
   }
   sim::saveScenario(scenario, path.toStdString());
 }

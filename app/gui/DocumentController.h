@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "gui/SimWorker.h"
+#include "pneuma/sim/Scenario.h"
 
 namespace pneuma::app {
 
@@ -26,6 +27,9 @@ class DocumentController {
     QString name;
     RunSettings settings;
     QString modelDir;
+    /// the scenario itself when an affect or a pattern drives it (null for a breath style): the worker makes
+    /// its controller (SimWorker::requestScenario())
+    std::shared_ptr<const sim::Scenario> drive;
   };
 
   /// The directory of the default model: sim::defaultModelDir() ($PNEUMA_MODEL_DIR, else
@@ -37,7 +41,8 @@ class DocumentController {
   static OpenedModel readModel(const QString& dir, const RunSettings& settings);
   /// Reads the scenario at `path`: its breath style and options (recordSeconds kept from `current`), its
   /// model.
-  /// @throws std::exception naming the problem; the app plays breath-style scenarios only.
+  /// An affect or pattern scenario is checked (sim::checkController()) and kept in OpenedScenario::drive.
+  /// @throws std::exception naming the problem.
   static OpenedScenario readScenario(const QString& path, const RunSettings& current);
 
   /// The adopted model and its directory (null and empty before the first one).
@@ -46,9 +51,11 @@ class DocumentController {
   /// Makes `opened` the document's model (its simulation is left to the caller).
   void adopt(const OpenedModel& opened);
 
-  /// Writes `settings` and the model as the scenario `path` (60 s, a breath style); an edited style goes
+  /// Writes `settings` and the model as the scenario `path` (60 s): driven by `drive`'s affect or pattern
+  /// when given (a pushed affect, an opened pattern scenario), else by the breath style; an edited style goes
   /// beside it as "<stem>.style.json". @throws std::exception naming the file.
-  void saveScenario(const QString& path, const RunSettings& settings) const;
+  void saveScenario(const QString& path, const RunSettings& settings,
+                    const sim::Scenario* drive = nullptr) const;
 
  private:
   std::shared_ptr<const sim::Model> m_model;

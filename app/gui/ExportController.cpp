@@ -6,6 +6,7 @@
 #include <QImage>
 #include <QPainter>
 #include <QPdfWriter>
+#include <QProgressDialog>
 #include <QSvgRenderer>
 #include <cmath>
 #include <stdexcept>
@@ -81,12 +82,27 @@ QString ExportController::exportViewImage(const QString& path) {
   return {};
 }
 
-QString ExportController::exportAnimation(const QString& path, double from, double to, double fps) {
+QString ExportController::exportAnimation(const QString& path, double from, double to, double fps,
+                                          QWidget* dialogParent) {
   try {
     if (!(to > from) || !(fps > 0.0)) throw std::runtime_error("nothing recorded to export");
     viz::MovieWriter writer(path.toStdString(), fps);
     const int frames = static_cast<int>(std::floor((to - from) * fps + 1e-6)) + 1;
+    QProgressDialog progress(QString("Rendering %1 frames of %2 s to %3 s\u2026")
+                                 .arg(frames)
+                                 .arg(from, 0, 'f', 1)
+                                 .arg(to, 0, 'f', 1),
+                             "Cancel", 0, frames, dialogParent);
+    progress.setWindowTitle("Export animation");
+    progress.setWindowModality(Qt::WindowModal);
+    progress.setMinimumDuration(0);
     for (int k = 0; k < frames; ++k) {
+      progress.setValue(k);
+      // the writer, destroyed unfinished, removes every file it began
+      if (progress.wasCanceled()) {
+        emit done(QString("Animation export cancelled; nothing written"));
+        return cancelled();
+      }
       if (!m_view.scrubTo(from + k / fps)) throw std::runtime_error("the recording did not answer");
       const QImage shot = m_view.grab().convertToFormat(QImage::Format_RGB888);
       // QImage pads its rows to 4 bytes: hand the writer packed rows
@@ -104,19 +120,37 @@ QString ExportController::exportAnimation(const QString& path, double from, doub
   return {};
 }
 
-QString ExportController::exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath) {
-  if (!worker) return "no model loaded";
-  const QFileInfo info(pvdPath);
+QString ExportController::waitForWorker(SimWorker* worker, const std::function<void()>& request) {
   QEventLoop loop;
   QString error = "the export did not finish";
   auto finished = connect(worker, &SimWorker::exportDone, &loop, [&](const QString& e) {
     error = e;
     loop.quit();
   });
-  worker->requestExportRun(modelDir.toStdString(), info.absolutePath().toStdString(),
-                           info.completeBaseName().toStdString());
+  request();
   loop.exec();
   disconnect(finished);
+  return error;
+}
+
+QString ExportController::exportGltf(SimWorker* worker, const QString& modelDir, const QString& path,
+                                     bool isBakeOnly) {
+  if (!worker) return fail("no model loaded");
+  const QString error = waitForWorker(
+      worker, [&] { worker->requestExportGltf(modelDir.toStdString(), path.toStdString(), isBakeOnly); });
+  const QString what = isBakeOnly ? "the morph targets" : "the run";
+  if (!error.isEmpty()) return fail(QString("Cannot export %1 to '%2': %3").arg(what, path, error));
+  emit done(QString("%1 saved as %2").arg(isBakeOnly ? "Morph targets" : "glTF of the run", path));
+  return {};
+}
+
+QString ExportController::exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath) {
+  if (!worker) return "no model loaded";
+  const QFileInfo info(pvdPath);
+  const QString error = waitForWorker(worker, [&] {
+    worker->requestExportRun(modelDir.toStdString(), info.absolutePath().toStdString(),
+                             info.completeBaseName().toStdString());
+  });
   if (!error.isEmpty()) return fail(QString("Cannot export the run to '%1': %2").arg(pvdPath, error));
   emit done(QString("Run saved as %1").arg(pvdPath));
   return {};

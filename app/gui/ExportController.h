@@ -1,7 +1,8 @@
 #pragma once
 /// @file ExportController.h
 /// The app's exports: a plot as PNG, SVG, PDF or CSV; the 3D view as PNG; the recording as an Ogg Theora
-/// movie or a PNG sequence (viz::MovieWriter); the run as a ParaView series (written by the SimWorker). Each
+/// movie or a PNG sequence (viz::MovieWriter); the run as a ParaView series or a glTF 2.0 .glb, and the baked
+/// morph targets as a .glb (written by the SimWorker). Each
 /// returns an empty string on success, else the error, and announces it with failed() or done(); every file
 /// is written through a temporary name, so a failed export leaves nothing.
 
@@ -33,11 +34,19 @@ class ExportController : public QObject {
   QString exportPlot(const PlotView* plot, const QString& path);
   /// Writes a PNG of the 3D view.
   QString exportViewImage(const QString& path);
-  /// Renders the recording from `from` to `to` [s] at `fps` [1/s]: an .ogv movie or a PNG sequence.
-  QString exportAnimation(const QString& path, double from, double to, double fps);
+  /// Renders the recording from `from` to `to` [s] at `fps` [1/s]: an .ogv movie or a PNG sequence, with a
+  /// progress dialog (parented to `dialogParent`, may be null) whose Cancel stops it and leaves no file
+  /// (the result is then kCancelled, and nothing is reported as failed).
+  QString exportAnimation(const QString& path, double from, double to, double fps,
+                          class QWidget* dialogParent = nullptr);
+  /// What exportAnimation() returns when its Cancel was pressed.
+  static QString cancelled() { return "cancelled"; }
   /// Has `worker` write its recording as `pvdPath` plus a folder of .vtp frames (body meshes from
   /// `modelDir`); blocks, processing events, until it is written.
   QString exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath);
+  /// Has `worker` write its recording as a glTF 2.0 .glb (skin morph weights and bone poses), or with
+  /// `isBakeOnly` the model's baked morph targets alone; blocks, processing events, until it is written.
+  QString exportGltf(SimWorker* worker, const QString& modelDir, const QString& path, bool isBakeOnly);
 
  signals:
   /// An export failed: a title and the message (naming the file).
@@ -47,6 +56,8 @@ class ExportController : public QObject {
 
  private:
   QString fail(const QString& message);
+  /// Calls `request` and waits, processing events, for `worker`'s exportDone(); returns its error.
+  QString waitForWorker(SimWorker* worker, const std::function<void()>& request);
   View m_view;
 };
 

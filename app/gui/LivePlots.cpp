@@ -1,12 +1,14 @@
 #include "gui/LivePlots.h"
 
 #include <QSplitter>
+#include <QTabWidget>
 #include <QVBoxLayout>
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <limits>
 
+#include "gui/FlowVolumeLoop.h"
 #include "gui/PlotView.h"
 #include "viz/ModelScene.h"
 
@@ -21,9 +23,11 @@ constexpr std::size_t kSegmentBuckets =
     512;                             // MinMaxSeries buckets per segment: exact up to 512 / 6 s = 85 Hz
 constexpr double kForceRate = 60.0;  // [Hz] most element-force frames kept per simulated second
 
-// the columns of a segment: time, lung volume [m^3], target volume [m^3], gut volume error [-], then r, alpha
-// and mean tension [N] of each muscle group
-enum Column : std::size_t { kTime, kLung, kTarget, kGut, kFirstGroupColumn };
+// the columns of a segment: time, lung volume [m^3], target volume [m^3], gut volume error [-], flow [m^3/s],
+// gut and transdiaphragmatic pressures [Pa], then r, alpha and mean tension [N] of each muscle group
+enum Column : std::size_t { kTime, kLung, kTarget, kGut, kFlow, kGutPressure, kPdi, kFirstGroupColumn };
+constexpr double kPascalPerCmH2O = 98.0665;  // [Pa / cmH2O]
+constexpr int kLoops = 3;                    // complete breaths drawn in the flow-volume loop
 constexpr std::size_t kColumnsPerGroup = 3;
 
 const std::vector<sim::ElementGroup>& muscleGroups() {
@@ -76,10 +80,27 @@ LivePlots::LivePlots(QWidget* parent) : QWidget(parent), m_cursor(kNaN) {
                              {"-2 %", -2.0, QColor(220, 120, 0)}});
   m_plots[3]->setIncludeZero(true);
   for (PlotView* plot : m_plots) splitter->addWidget(plot);
+
+  // the physiology tab: flow, the flow-volume loop, pressures
+  auto* physiology = new QSplitter(Qt::Vertical, this);
+  m_plots.push_back(new PlotView("Flow", "flow [L/s]"));
+  m_plots.push_back(new PlotView("Pressures", "pressure [cmH2O]"));
+  m_plots[4]->setIncludeZero(true);
+  m_plots[5]->setIncludeZero(true);
+  m_loop = new FlowVolumeLoop(physiology);
+  physiology->addWidget(m_plots[4]);
+  physiology->addWidget(m_loop);
+  physiology->addWidget(m_plots[5]);
+
+  m_tabs = new QTabWidget(this);
+  m_tabs->addTab(splitter, "Mechanics");
+  m_tabs->addTab(physiology, "Physiology");
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
-  layout->addWidget(splitter);
+  layout->addWidget(m_tabs);
 }
+
+void LivePlots::showPhysiology(bool isShown) { m_tabs->setCurrentIndex(isShown ? 1 : 0); }
 
 void LivePlots::clear() {
   m_segments.clear();
@@ -113,6 +134,9 @@ void LivePlots::appendSample(const PlotSample& s) {
   c[kLung].append(s.time, s.lungVolume);
   c[kTarget].append(s.time, s.targetVolume);
   c[kGut].append(s.time, s.gutVolumeError);
+  c[kFlow].append(s.time, s.flow);
+  c[kGutPressure].append(s.time, s.gutPressure);
+  c[kPdi].append(s.time, s.transdiaphragmaticPressure);
   std::size_t k = kFirstGroupColumn;
   for (const sim::ElementGroup g : muscleGroups()) {
     const auto i = static_cast<std::size_t>(g);
@@ -134,8 +158,23 @@ void LivePlots::setWindow(double seconds) {
 void LivePlots::setBreathPeriod(double seconds) { m_breathPeriod = seconds; }
 
 void LivePlots::setCursor(double time) {
+  if (time == m_cursor || (std::isnan(time) && std::isnan(m_cursor))) return;
   m_cursor = time;
   for (PlotView* plot : m_plots) plot->setCursor(time);
+  m_loop->setCursor(time);
+  m_isDirty = true;
+}
+
+void LivePlots::setBreaths(std::vector<double> endExpirations) {
+  if (endExpirations == m_breaths) return;
+  m_breaths = std::move(endExpirations);
+  m_isDirty = true;
+}
+
+double LivePlots::breathingRate() const {
+  const std::size_t n = std::min<std::size_t>(m_breaths.size(), kLoops + 1);
+  if (n < 2) return std::numeric_limits<double>::quiet_NaN();
+  return 60.0 * static_cast<double>(n - 1) / (m_breaths.back() - m_breaths[m_breaths.size() - n]);
 }
 
 void LivePlots::addTrace(const Trace& trace) {
@@ -163,16 +202,12 @@ double LivePlots::tidalVolume() const {
   return hi >= lo ? hi - lo : 0.0;
 }
 
-bool LivePlots::refresh() {
-  if (!m_isDirty) return false;
-  m_isDirty = false;
-
-  // the shown window as a table: per bucket its first and last sample time, and each column's minimum and
-  // maximum in the order they occurred (a bucket of one sample gives one row)
-  const double from =
-      m_hasLatest && m_window > 0.0 ? m_latest.time - m_window : -std::numeric_limits<double>::infinity();
-  std::vector<double> time;
-  std::vector<std::vector<double>> columns(m_segments.empty() ? 0 : m_segments.front().columns.size());
+void LivePlots::table(double from, std::vector<double>& time,
+                      std::vector<std::vector<double>>& columns) const {
+  // per bucket its first and last sample time, and each column's minimum and maximum in the order they
+  // occurred (a bucket of one sample gives one row)
+  time.clear();
+  columns.assign(m_segments.empty() ? 0 : m_segments.front().columns.size(), {});
   for (const Segment& seg : m_segments) {
     const auto& tb = seg.columns[kTime].buckets();
     for (std::size_t k = 0; k < tb.size(); ++k) {
@@ -188,6 +223,42 @@ bool LivePlots::refresh() {
       }
     }
   }
+}
+
+void LivePlots::refreshLoops() {
+  // the last kLoops complete breaths and the one in progress, each from its end-expiration on
+  std::vector<FlowVolumeLoop::Loop> loops;
+  const std::size_t first = m_breaths.size() > kLoops ? m_breaths.size() - kLoops - 1 : 0;
+  if (m_breaths.empty() || !m_hasLatest) return m_loop->setLoops({});
+  std::vector<double> time;
+  std::vector<std::vector<double>> columns;
+  table(m_breaths[first], time, columns);
+  std::size_t k = 0;
+  for (std::size_t b = first; b < m_breaths.size(); ++b) {
+    const double end = b + 1 < m_breaths.size() ? m_breaths[b + 1] : std::numeric_limits<double>::infinity();
+    while (k < time.size() && time[k] < m_breaths[b]) ++k;
+    FlowVolumeLoop::Loop loop;
+    loop.isComplete = b + 1 < m_breaths.size();
+    const double v0 = k < time.size() ? columns[kLung][k] : 0.0;
+    for (std::size_t j = k; j < time.size() && time[j] <= end; ++j) {
+      loop.time.push_back(time[j]);
+      loop.volume.push_back(1e6 * (columns[kLung][j] - v0));
+      loop.flow.push_back(1e3 * columns[kFlow][j]);
+    }
+    if (!loop.time.empty()) loops.push_back(std::move(loop));
+  }
+  m_loop->setLoops(std::move(loops));
+}
+
+bool LivePlots::refresh() {
+  if (!m_isDirty) return false;
+  m_isDirty = false;
+
+  const double from =
+      m_hasLatest && m_window > 0.0 ? m_latest.time - m_window : -std::numeric_limits<double>::infinity();
+  std::vector<double> time;
+  std::vector<std::vector<double>> columns;
+  table(from, time, columns);
   const std::size_t n = time.size();
   auto column = [&](std::size_t c, double scale) {
     std::vector<double> y = c < columns.size() ? columns[c] : std::vector<double>(n, kNaN);
@@ -204,9 +275,13 @@ bool LivePlots::refresh() {
     volume.push_back({"target volume", QColor(230, 90, 20), true, std::move(target), "target"});
   }
   m_plots[0]->setData(time, std::move(volume));
-  // read-out: the two lungs, their split and the tidal volume
+  // read-out: the two lungs, their split and the tidal volume; at a cursor, the lungs there
+  const bool atCursor = std::isfinite(m_cursor);
   QString note;
-  if (n > 0) {
+  if (n > 0 && atCursor) {
+    note =
+        QString("at %1 s: lungs %2 mL").arg(m_cursor, 0, 'f', 2).arg(m_plots[0]->cursorValue(0), 0, 'f', 0);
+  } else if (n > 0) {
     note = QString("lungs %1 mL").arg(1e6 * m_latest.lungVolume, 0, 'f', 0);
     if (std::isfinite(m_latest.rightLungVolume))
       note += QString(" (R %1 L %2)")
@@ -215,6 +290,34 @@ bool LivePlots::refresh() {
     note += QString("  VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
   }
   m_plots[0]->setNote(note);
+
+  // flow [L/s] with the tidal volume and rate; the abdominal and transdiaphragmatic pressures [cmH2O]
+  m_plots[4]->setData(time, {{"flow", QColor(20, 90, 190), false, column(kFlow, 1e3), QString()}});
+  const double rate = breathingRate();
+  QString flowNote = QString("VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
+  if (std::isfinite(rate)) flowNote += QString("  %1 b/min").arg(rate, 0, 'f', 1);
+  if (atCursor)
+    flowNote +=
+        QString("  at %1 s: %2 L/s").arg(m_cursor, 0, 'f', 2).arg(m_plots[4]->cursorValue(0), 0, 'f', 2);
+  if (n > 0) m_plots[4]->setNote(flowNote);
+  std::vector<PlotView::Series> pressures{{"abdominal (gut) pressure", QColor(120, 40, 160), false,
+                                           column(kGutPressure, 1.0 / kPascalPerCmH2O), "Pab (gut)"}};
+  std::vector<double> pdi = column(kPdi, 1.0 / kPascalPerCmH2O);
+  const bool hasPdi = std::any_of(pdi.begin(), pdi.end(), [](double v) { return std::isfinite(v); });
+  if (hasPdi)
+    pressures.push_back({"transdiaphragmatic pressure", QColor(200, 60, 20), false, std::move(pdi), "Pdi"});
+  m_plots[5]->setData(time, std::move(pressures));
+  if (n > 0) {
+    const double pab = atCursor ? m_plots[5]->cursorValue(0) : m_latest.gutPressure / kPascalPerCmH2O;
+    const double pdiNow = hasPdi ? (atCursor ? m_plots[5]->cursorValue(1)
+                                             : m_latest.transdiaphragmaticPressure / kPascalPerCmH2O)
+                                 : std::numeric_limits<double>::quiet_NaN();
+    QString pressureNote = (atCursor ? QString("at %1 s: ").arg(m_cursor, 0, 'f', 2) : QString()) +
+                           QString("Pab %1").arg(pab, 0, 'f', 1);
+    if (hasPdi) pressureNote += QString("  Pdi %1").arg(pdiNow, 0, 'f', 1);
+    m_plots[5]->setNote(pressureNote + " cmH2O");
+  }
+  refreshLoops();
 
   // gut volume error [%]
   m_plots[1]->setData(time,

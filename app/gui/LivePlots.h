@@ -5,7 +5,12 @@
 ///  2. gut volume error [%] with the 0.5 % and 2 % bands;
 ///  3. activations r (solid) and alpha (dashed) per muscle group [-];
 ///  4. mean tension per element of each muscle group [N], plus the force trace of each picked element or
-///  body.
+///  body;
+/// and, on the Physiology tab,
+///  5. lung flow [L/s] with the tidal volume and the breathing rate;
+///  6. the abdominal (gut) and transdiaphragmatic pressures [cmH2O];
+///  and the flow-volume loop of the last breaths (FlowVolumeLoop).
+/// When a cursor is set (a scrubbed instant) the notes read the values at the cursor, not the newest ones.
 /// Memory is bounded whatever the output rate and run length: the last kHistorySeconds are kept in segments
 /// whose quantities are thinned by viz::MinMaxSeries (every peak and trough kept; exact up to kSegmentBuckets
 /// samples per segment, i.e. up to about 85 Hz), and the element forces behind the picked traces at most
@@ -18,8 +23,11 @@
 #include "gui/SimWorker.h"
 #include "viz/MinMaxSeries.h"
 
+class QTabWidget;
+
 namespace pneuma::app {
 
+class FlowVolumeLoop;
 class PlotView;
 
 class LivePlots : public QWidget {
@@ -47,13 +55,24 @@ class LivePlots : public QWidget {
   void setBreathPeriod(double seconds);
   /// Plot cursor at time [s] (NaN hides it), e.g. the scrubbed instant.
   void setCursor(double time);
+  /// [s] the end-expirations that bound the breaths (Snapshot::endExpirationTimes), oldest first.
+  void setBreaths(std::vector<double> endExpirations);
   /// Adds a force trace to the tension plot (at most 4 are kept; the oldest goes first).
   void addTrace(const Trace& trace);
   void clearTraces();
 
+  /// Brings the Physiology tab (flow, loop, pressures) or the Mechanics tab to the front.
+  void showPhysiology(bool isShown);
+
   /// The plots, in the order listed above.
   const std::vector<PlotView*>& plots() const { return m_plots; }
   PlotView* volumePlot() const { return m_plots[0]; }
+  PlotView* flowPlot() const { return m_plots[4]; }
+  PlotView* pressurePlot() const { return m_plots[5]; }
+  FlowVolumeLoop* loop() const { return m_loop; }
+  /// [1/min] breathing rate over the last complete breaths (60 / mean breath duration); NaN before two
+  /// end-expirations.
+  double breathingRate() const;
   /// [m^3] current tidal volume: max - min of the lung volume over the last breath period.
   double tidalVolume() const;
 
@@ -70,12 +89,20 @@ class LivePlots : public QWidget {
     std::vector<float> elementForce;  // [N] signed, per element
   };
   void appendSample(const PlotSample& s);
+  /// The history from time `from` [s] on as a table: sample times and, per segment column, the plotted
+  /// values.
+  void table(double from, std::vector<double>& time, std::vector<std::vector<double>>& columns) const;
+  /// Cuts the history into breaths at the end-expirations and hands the latest to the flow-volume loop.
+  void refreshLoops();
 
   std::deque<Segment> m_segments;
   std::deque<ForceFrame> m_forces;
   PlotSample m_latest;  // the newest sample (for the notes)
   bool m_hasLatest = false;
   std::vector<PlotView*> m_plots;
+  FlowVolumeLoop* m_loop = nullptr;
+  QTabWidget* m_tabs = nullptr;
+  std::vector<double> m_breaths;  // [s] end-expirations
   std::vector<Trace> m_traces;
   double m_window = 20.0;       // [s]
   double m_breathPeriod = 4.0;  // [s]

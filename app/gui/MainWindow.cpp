@@ -18,6 +18,7 @@
 #include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
+#include <QInputDialog>
 #include <QLabel>
 #include <QMenu>
 #include <QMenuBar>
@@ -66,10 +67,12 @@ const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructur
     {"Landmarks", &viz::DisplayOptions::showLandmarks},
     {"Anatomical labels", &viz::DisplayOptions::showLabels}};
 const std::vector<std::pair<const char*, viz::MuscleColouring>> kMuscleColourings{
-    {"Contractive force [N]", viz::MuscleColouring::Force}, {"Muscle group", viz::MuscleColouring::Group}};
+    {"Tension [N]", viz::MuscleColouring::Force},
+    {"Activation \u03b1 [0-1]", viz::MuscleColouring::Activation},
+    {"Muscle group", viz::MuscleColouring::Group}};
 const std::vector<std::pair<const char*, viz::GutColouring>> kGutColourings{
     {"Plain", viz::GutColouring::Plain},
-    {"Pressure [Pa]", viz::GutColouring::Pressure},
+    {"Pressure [cmH2O]", viz::GutColouring::Pressure},
     {"Displacement [mm]", viz::GutColouring::Displacement}};
 const std::vector<std::pair<const char*, viz::SkinDisplay>> kSkinDisplays{
     {"Translucent", viz::SkinDisplay::Translucent},
@@ -243,11 +246,29 @@ void MainWindow::buildActions() {
     if (!m_shown) return;
     const QString path = QFileDialog::getSaveFileName(this, "Export animation", "breathing.ogv",
                                                       "Ogg Theora movie (*.ogv);;PNG sequence (*.png)");
-    if (!path.isEmpty()) exportAnimation(path, m_shown->recordedFrom, m_shown->recordedTo, 25.0);
+    if (path.isEmpty()) return;
+    // the time range: the whole recording unless narrowed
+    bool ok = false;
+    const double from = QInputDialog::getDouble(this, "Export animation", "From [s]", m_shown->recordedFrom,
+                                                m_shown->recordedFrom, m_shown->recordedTo, 2, &ok);
+    if (!ok) return;
+    const double to = QInputDialog::getDouble(this, "Export animation", "To [s]", m_shown->recordedTo, from,
+                                              m_shown->recordedTo, 2, &ok);
+    if (ok) exportAnimation(path, from, to, 25.0);
   });
   exportMenu->addAction("Run as ParaView series (.pvd)\u2026", this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, "Export run", "run.pvd", "ParaView data (*.pvd)");
     if (!path.isEmpty()) exportRun(path);
+  });
+  exportMenu->addAction("Run as glTF 2.0 (.glb)\u2026", this, [this] {
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Export run as glTF", "breathing.glb", "glTF 2.0 binary (*.glb)");
+    if (!path.isEmpty()) exportGltf(path);
+  });
+  exportMenu->addAction("Baked morph targets (.glb)\u2026", this, [this] {
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Bake morph targets", "morphs.glb", "glTF 2.0 binary (*.glb)");
+    if (!path.isEmpty()) bakeMorphTargets(path);
   });
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
@@ -387,6 +408,13 @@ void MainWindow::buildDocks() {
   for (const auto& [label, colouring] : kSkinColourings)
     m_skinColour->addItem(label, static_cast<int>(colouring));
   colourForm->addRow("Skin", m_skinColour);
+  auto* autoRange = new QCheckBox("Auto-range (95th percentile)", colouring);
+  autoRange->setToolTip(
+      "Off: every scale has its fixed range (tension 0-20 N, activation 0-1, gut 0-20 mm, skin 0-10 mm, gut "
+      "pressure \u00b15 cmH2O), the same on every frame and run. On: each scale is topped at the 95th "
+      "percentile of its values so far, rounded up, never shrinking.");
+  colourForm->addRow(autoRange);
+  m_structureChecks.emplace_back(autoRange, &viz::DisplayOptions::isAutoRange);
   displayLayout->addWidget(colouring);
 
   auto* structures = new QGroupBox("Structures", display);
@@ -458,6 +486,9 @@ void MainWindow::buildDocks() {
     showPosture();
   });
 
+  connect(m_params, &ParameterPanel::magnificationEdited, this,
+          [this](double factor) { setMagnification(factor); });
+
   auto* tabs = new QTabWidget(this);
   auto* displayScroll = new QScrollArea(this);
   displayScroll->setWidget(display);
@@ -496,8 +527,9 @@ void MainWindow::syncDisplayWidgets() {
 
 void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
   m_scene->setOptions(options);
+  m_params->setMagnification(options.magnification);
   syncDisplayWidgets();
-  if (m_shown) m_scene->update(m_shown->state, m_shown->metrics);
+  if (m_shown) m_scene->update(m_shown->state, m_shown->metrics, m_shown->endExpiration.get());
   m_view->renderWindow()->Render();
 }
 
@@ -537,6 +569,7 @@ QString MainWindow::openModel(const QString& dir) {
     return message;
   }
   m_document.adopt(opened);
+  m_drive = nullptr;  // a new model starts with the breath style
   const std::shared_ptr<const sim::Model>& model = opened.model;
   m_selected = {};
   m_plots->clearTraces();
@@ -587,6 +620,14 @@ QString MainWindow::openScenario(const QString& path) {
     m_settings = previous;
     return error;
   }
+  m_drive = scenario.drive;
+  if (m_drive) {
+    m_worker->requestScenario(m_drive);
+    if (m_drive->controller == sim::ControllerKind::Affect) {
+      const QSignalBlocker blockAffect(m_affectCombo);
+      m_affectCombo->setCurrentText(QString::fromStdString(m_drive->controllerName));
+    }
+  }
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
   showMessage(QString("Scenario '%1' loaded").arg(scenario.name), 5000);
@@ -595,7 +636,7 @@ QString MainWindow::openScenario(const QString& path) {
 
 QString MainWindow::saveScenario(const QString& path) {
   try {
-    m_document.saveScenario(path, m_settings);
+    m_document.saveScenario(path, m_settings, m_drive.get());
   } catch (const std::exception& e) {
     const QString message = QString("Cannot save scenario '%1': %2").arg(path, e.what());
     report("Scenario not saved", message);
@@ -612,6 +653,7 @@ QString MainWindow::setBreathStyle(const QString& name) {
     report("Unknown breath style", e.what());
     return e.what();
   }
+  m_drive = nullptr;
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(name);
   m_params->setSettings(m_settings, m_document.model());
@@ -645,9 +687,27 @@ QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
   if (!m_worker) return "no model is open";
   m_worker->requestAffect(name.toStdString(), isImmediate ? sim::pattern::SwitchMode::Immediate
                                                           : sim::pattern::SwitchMode::EndOfCycle);
+  // saved with the scenario: the affect pushed last
+  auto drive = std::make_shared<sim::Scenario>();
+  drive->name = name.toStdString();
+  drive->controller = sim::ControllerKind::Affect;
+  drive->controllerName = name.toStdString();
+  m_drive = std::move(drive);
   showMessage(
       QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"),
       5000);
+  return {};
+}
+
+QString MainWindow::setMagnification(double factor) {
+  const std::string error = viz::magnificationError(factor);
+  if (!error.empty()) {
+    report("Motion magnification refused", QString::fromStdString(error));
+    return QString::fromStdString(error);
+  }
+  viz::DisplayOptions o = m_scene->options();
+  o.magnification = factor;
+  setDisplayOptions(o);
   return {};
 }
 
@@ -735,12 +795,13 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   const Snapshot& s = *m_shown;
   QElapsedTimer clock;
   clock.start();
-  if (s.model == m_document.model()) m_scene->update(s.state, s.metrics);
+  if (s.model == m_document.model()) m_scene->update(s.state, s.metrics, s.endExpiration.get());
   m_view->renderWindow()->Render();
   m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
   m_sinceRender.restart();
   ++m_framesRendered;
 
+  m_plots->setBreaths(s.endExpirationTimes);
   m_plots->setCursor(s.isScrubbed ? s.metrics.time : std::numeric_limits<double>::quiet_NaN());
   m_statusTime->setText(
       QString("  t = %1 s%2  ").arg(s.state.time, 0, 'f', 2).arg(s.isScrubbed ? " (recorded)" : ""));
@@ -853,11 +914,19 @@ QString MainWindow::exportViewImage(const QString& path) { return m_export->expo
 
 QString MainWindow::exportAnimation(const QString& path, double from, double to, double fps) {
   if (!m_worker) return m_export->exportAnimation(path, 0.0, 0.0, fps);  // refused: nothing recorded
-  return m_export->exportAnimation(path, from, to, fps);
+  return m_export->exportAnimation(path, from, to, fps, this);
 }
 
 QString MainWindow::exportRun(const QString& pvdPath) {
   return m_export->exportRun(m_worker, m_document.modelDir(), pvdPath);
+}
+
+QString MainWindow::exportGltf(const QString& path) {
+  return m_export->exportGltf(m_worker, m_document.modelDir(), path, false);
+}
+
+QString MainWindow::bakeMorphTargets(const QString& path) {
+  return m_export->exportGltf(m_worker, m_document.modelDir(), path, true);
 }
 
 QImage MainWindow::grabView() {

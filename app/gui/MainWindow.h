@@ -58,6 +58,10 @@ class MainWindow : public QMainWindow {
   /// @return empty, or the error (an unknown name lists the valid ones).
   QString setPosture(const QString& name);
 
+  /// Sets the view's motion magnification (display only, viz::DisplayOptions::magnification).
+  /// @return empty, or the error (outside [viz::kMinMagnification, viz::kMaxMagnification]).
+  QString setMagnification(double factor);
+
   void play();
   void pause();
   /// Runs as fast as possible until simulated time `time` [s], then pauses and shows that instant.
@@ -72,10 +76,16 @@ class MainWindow : public QMainWindow {
   QString exportViewImage(const QString& path);
   /// Renders the recorded run from `from` to `to` [s] at `fps` frames per second, as an Ogg Theora
   /// movie (.ogv) or a PNG sequence (any other suffix: <base>_0000.png, ...). @return empty or the error.
+  /// A progress dialog shows the frames written; its Cancel leaves no file (returns
+  /// ExportController::cancelled()).
   QString exportAnimation(const QString& path, double from, double to, double fps);
   /// Writes the recorded run as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it.
   /// Blocks (processing events) until the worker has written it. @return empty or the error.
   QString exportRun(const QString& pvdPath);
+  /// File > Export > Run as glTF: the recording as a .glb (morph weights and bone poses); "" on success.
+  QString exportGltf(const QString& path);
+  /// File > Export > Baked morph targets: the model's morph targets as a .glb; "" on success.
+  QString bakeMorphTargets(const QString& path);
   /// Pushes an affect preset (de Melo et al. 2010), at the end of the current breath or immediately.
   /// @return empty, or the error (an unknown name lists the valid ones; no model open).
   QString pushAffect(const QString& name, bool isImmediate);
@@ -143,6 +153,9 @@ class MainWindow : public QMainWindow {
   QThread m_thread;
   SimWorker* m_worker = nullptr;
   std::shared_ptr<const Snapshot> m_shown;
+  // what drives the run besides the breath style: a pushed affect or an opened affect or pattern scenario
+  // (saved with the scenario); null while a breath style plays
+  std::shared_ptr<const sim::Scenario> m_drive;
   long long m_generation = -1;
   viz::Pick m_selected;
 

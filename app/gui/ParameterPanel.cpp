@@ -8,6 +8,7 @@
 #include <QVBoxLayout>
 
 #include "pneuma/sim/Error.h"
+#include "viz/ModelScene.h"
 
 namespace pneuma::app {
 
@@ -95,6 +96,30 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
   postureLabel->setToolTip(m_posture->toolTip());
   form->addRow(postureLabel, m_posture);
 
+  // the view's motion magnification: display only, never in the run's numbers
+  m_magnification = new QLineEdit;
+  m_magnification->setToolTip(
+      QString("Display only: the view draws every displacement from the end-expiratory "
+              "pose this many times larger (%1 to %2); plots and exports keep the real "
+              "motion")
+          .arg(viz::kMinMagnification)
+          .arg(viz::kMaxMagnification));
+  setMagnification(viz::kDefaultMagnification);
+  connect(m_magnification, &QLineEdit::editingFinished, this, [this] {
+    bool isNumber = false;
+    const double factor = m_magnification->text().trimmed().toDouble(&isNumber);
+    const std::string error =
+        isNumber ? viz::magnificationError(factor)
+                 : "motion magnification: '" + m_magnification->text().toStdString() + "' is not a number";
+    if (!error.empty()) return refuse(m_magnification, QString::fromStdString(error));
+    m_magnification->setStyleSheet(QString());
+    m_reason->clear();
+    emit magnificationEdited(factor);
+  });
+  auto* magnificationLabel = new QLabel("Motion magnification \u00d7");
+  magnificationLabel->setToolTip(m_magnification->toolTip());
+  form->addRow(magnificationLabel, m_magnification);
+
   m_reason = new QLabel;
   m_reason->setWordWrap(true);
   m_reason->setStyleSheet("color: #b00020;");
@@ -128,6 +153,11 @@ void ParameterPanel::setSettings(const RunSettings& settings, std::shared_ptr<co
   const QSignalBlocker blockPosture(m_posture);
   m_posture->setCurrentText(sim::postureName(m_settings.options.step.posture));
   m_reason->clear();
+}
+
+void ParameterPanel::setMagnification(double factor) {
+  m_magnification->setText(QString::number(factor, 'g', 6));
+  m_magnification->setStyleSheet(QString());
 }
 
 QString ParameterPanel::refusal() const { return m_reason->text(); }

@@ -36,10 +36,16 @@ class ParameterPanel : public QWidget {
   QLineEdit* frequencyField() const { return m_fields.front().edit; }
   /// The posture combo box (for tests).
   QComboBox* postureBox() const { return m_posture; }
+  /// The field editing the motion magnification of the view [-] (display only, viz::DisplayOptions).
+  QLineEdit* magnificationField() const { return m_magnification; }
+  /// Shows the view's motion magnification [-].
+  void setMagnification(double factor);
 
  signals:
   /// A valid edit: apply at the next sync point.
   void settingsEdited(const RunSettings& settings);
+  /// A valid motion magnification [-] in [viz::kMinMagnification, viz::kMaxMagnification].
+  void magnificationEdited(double factor);
 
  private:
   struct Field {
@@ -58,6 +64,7 @@ class ParameterPanel : public QWidget {
   std::vector<Field> m_fields;
   QCheckBox* m_gravity = nullptr;
   QComboBox* m_posture = nullptr;
+  QLineEdit* m_magnification = nullptr;
   QLabel* m_reason = nullptr;
 };
 

@@ -15,6 +15,8 @@
 
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/MorphTargets.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/pattern/PatternController.h"
@@ -37,6 +39,13 @@ struct PlotSample {
   double rightLungVolume = 0.0;  ///< [m^3] NaN for a model without lung surfaces
   double leftLungVolume = 0.0;   ///< [m^3] NaN for a model without lung surfaces
   double gutVolumeError = 0.0;   ///< [-] signed (V - V0) / V0
+  /// [m^3/s] lung flow dV/dt, the backward difference over the output frame (inspiration > 0); NaN at a
+  /// run's first frame
+  double flow = std::numeric_limits<double>::quiet_NaN();
+  double gutPressure = 0.0;  ///< [Pa] abdominal (gut) pressure P of Eq. 4
+  /// [Pa] transdiaphragmatic pressure Pdi = Pab - Ppl (gut pressure minus the cavity's pleural pressure,
+  /// Model.h Cavity); NaN for a model without a pleural pressure (cavity.compliance 0)
+  double transdiaphragmaticPressure = std::numeric_limits<double>::quiet_NaN();
   double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung
                                                                    ///< volume; NaN without one
   sim::Activations activations{};                                  ///< r and alpha per group
@@ -59,6 +68,12 @@ struct Snapshot {
   /// tidal volume, rate and the motion in anatomical axes), refreshed once per simulated second; null before
   /// the first full breath.
   std::shared_ptr<const sim::Summary> breathing;
+  /// The end-expiratory state the shown instant's breath started from (the last volume minimum at or before
+  /// it, after settling): the view magnifies the motion from it (viz::DisplayOptions::magnification). Null
+  /// before the first end-expiration.
+  std::shared_ptr<const sim::State> endExpiration;
+  /// [s] the times of the end-expirations found within the recording, oldest first: the breaths' bounds
+  std::vector<double> endExpirationTimes;
 };
 
 /// [s] span of the run that Snapshot::breathing measures: two breaths at 10 b/m.
@@ -98,9 +113,17 @@ class SimWorker : public QObject {
   /// calibrates the muscle drive on the model (a few simulated seconds, in the worker thread) and
   /// switches to a pattern controller; a later breath-style edit switches back.
   void requestAffect(const std::string& name, sim::pattern::SwitchMode mode);
+  /// Drives the run with the affect or pattern of `scenario` (sim::makeController(): the muscle drive is
+  /// calibrated first, a few simulated seconds in the worker thread).
+  void requestScenario(std::shared_ptr<const sim::Scenario> scenario);
   /// Writes the recorded frames as a ParaView series `outDir`/`baseName`.pvd (viz::VtkSeriesWriter),
   /// then emits exportDone().
   void requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName);
+  /// Writes the recorded frames as a glTF 2.0 .glb at `path` (viz::writeGltf: skin morph weights fitted per
+  /// frame, bone poses; bone meshes from `modelDir`), or with `isBakeOnly` the morph targets alone with a
+  /// demo breath; then emits exportDone(). The morph targets are baked on the model once
+  /// (sim::bakeMorphTargets, a few seconds in the worker thread) and kept until another model is loaded.
+  void requestExportGltf(const std::string& modelDir, const std::string& path, bool isBakeOnly);
 
   /// The latest snapshot and the plot samples produced since the previous call (each handed out once).
   Frame take();
@@ -122,6 +145,10 @@ class SimWorker : public QObject {
   void status(const QString& message);
 
  private:
+  struct GltfRequest {
+    std::string modelDir, path;
+    bool isBakeOnly = false;
+  };
   struct Pending {
     std::optional<bool> isRunning;
     bool doStep = false;
@@ -133,7 +160,9 @@ class SimWorker : public QObject {
     std::optional<double> scrubTime;
     std::optional<double> runUntil;
     std::optional<std::pair<std::string, sim::pattern::SwitchMode>> affect;
+    std::shared_ptr<const sim::Scenario> scenario;
     std::optional<std::array<std::string, 3>> exportRun;  // model dir, out dir, base name
+    std::optional<GltfRequest> exportGltf;
   };
 
   void tick();
@@ -141,15 +170,23 @@ class SimWorker : public QObject {
   void applySettings(const RunSettings& settings);
   void collect(const sim::Simulation& simulation);
   void pushAffect(const std::string& name, sim::pattern::SwitchMode mode);
+  void playScenario(const sim::Scenario& scenario);
   void exportRun(const std::array<std::string, 3>& request);
+  void exportGltf(const GltfRequest& request);
   /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces and the
   /// gut pressure, as measured then: sim::Recorder::restore()).
   void restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const;
   void publish(bool isScrubbed);
+  /// Forgets the end-expirations found (reset, new model, new posture).
+  void clearEndExpirations();
+  /// Follows the lung volume of each output frame and keeps the state at each end-expiration: a volume
+  /// minimum confirmed once the volume has risen kEndExpirationRise of itself above it.
+  void findEndExpiration(const sim::Simulation& simulation);
 
   std::shared_ptr<const sim::Model> m_model;
   std::unique_ptr<sim::Simulation> m_sim;
   sim::pattern::PatternController* m_pattern = nullptr;  // the sim's controller when an affect plays
+  std::unique_ptr<const sim::MorphTargets> m_morphs;     // baked on m_model at the first glTF export
   RunSettings m_settings;
   QTimer* m_timer = nullptr;
 
@@ -168,6 +205,14 @@ class SimWorker : public QObject {
   double m_breathingAt = -1.0;                      // [s] simulated time it was measured at
   std::chrono::steady_clock::time_point m_lastTick;
   std::vector<PlotSample> m_samples;  // collected since the last publish
+  // end-expirations: the confirmed ones within the recording (oldest first), and the search for the next
+  std::vector<std::shared_ptr<const sim::State>> m_endExpirations;
+  bool m_isSeekingMinimum = true;
+  double m_extremeVolume = std::numeric_limits<double>::quiet_NaN();  // [m^3] running minimum or maximum
+  sim::State m_atMinimum;                                             // the state at the running minimum
+  double m_previousTime =
+      std::numeric_limits<double>::quiet_NaN();  // [s] the last output frame, for the flow
+  double m_previousVolume = 0.0;                 // [m^3] its lung volume
 
   std::mutex m_outboxMutex;
   Frame m_outbox;

@@ -1,5 +1,5 @@
-// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--model DIR]`
-// starts, simulates for the given time, saves a grab of the whole window and exits.
+// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--magnify N] [--model
+// DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/LivePlots.h"
 #include "gui/MainWindow.h"
 
 int main(int argc, char** argv) {
@@ -82,17 +83,30 @@ int main(int argc, char** argv) {
                                       "FILE");
   const QCommandLineOption after("after", "With --screenshot: simulated seconds before the grab (default 6).",
                                  "SECONDS", "6");
+  const QCommandLineOption exportGltf(
+      "export-gltf", "With --screenshot: export the recording as a glTF 2.0 .glb to FILE before the grab.",
+      "FILE");
   const QCommandLineOption camera(
       "camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME", "oblique");
   const QCommandLineOption labels("labels",
                                   "Show the anatomical labels and the lung cavity (teaching view).");
   const QCommandLineOption skin("skin", "The skin: translucent (default), opaque or hidden.", "MODE",
                                 "translucent");
+  const QCommandLineOption magnify(
+      "magnify",
+      QString("Motion magnification of the view, display only (%1 to %2, default %3).")
+          .arg(pneuma::viz::kMinMagnification)
+          .arg(pneuma::viz::kMaxMagnification)
+          .arg(pneuma::viz::kDefaultMagnification),
+      "N", QString::number(pneuma::viz::kDefaultMagnification));
+  const QCommandLineOption physiology(
+      "physiology", "Show the Physiology plots (flow, flow-volume loop, pressures) in front.");
   const QCommandLineOption speed("speed", "Simulated seconds per wall second, or 'max' (default 1).", "X",
                                  "1");
   const QCommandLineOption measure(
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
-  parser.addOptions({model, style, affect, posture, camera, labels, skin, speed, screenshot, after, measure});
+  parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
+                     screenshot, after, exportGltf, measure});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -123,6 +137,15 @@ int main(int argc, char** argv) {
   if (parser.isSet(measure) && (!isNumber || !(measureSeconds > 0.0))) {
     std::fprintf(stderr, "pneuma: --measure: expected seconds > 0, got '%s'\n",
                  qPrintable(parser.value(measure)));
+    return 2;
+  }
+
+  const double magnification = parser.value(magnify).toDouble(&isNumber);
+  const std::string magnifyError =
+      isNumber ? pneuma::viz::magnificationError(magnification)
+               : "motion magnification: '" + parser.value(magnify).toStdString() + "' is not a number";
+  if (!magnifyError.empty()) {
+    std::fprintf(stderr, "pneuma: --magnify: %s\n", magnifyError.c_str());
     return 2;
   }
 
@@ -168,6 +191,8 @@ int main(int argc, char** argv) {
   {
     pneuma::viz::DisplayOptions options = window.scene().options();
     options.skin = skinMode->second;
+    options.magnification = magnification;
+    window.plots()->showPhysiology(parser.isSet(physiology));
     if (parser.isSet(labels)) {
       options.showLabels = true;
       options.showCavity = true;
@@ -183,6 +208,7 @@ int main(int argc, char** argv) {
                    qPrintable(window.lastError()));
       return 1;
     }
+    if (parser.isSet(exportGltf) && !window.exportGltf(parser.value(exportGltf)).isEmpty()) return 1;
     QApplication::processEvents();
     const QString file = parser.value(screenshot);
     if (!window.grabWindow().save(file, "PNG")) {

@@ -9,6 +9,7 @@
 #include <vtkCellPicker.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkCoordinate.h>
+#include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
@@ -25,18 +26,22 @@
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkSphereSource.h>
+#include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <initializer_list>
 #include <limits>
+#include <sstream>
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "viz/PlotLayout.h"
 
 namespace pneuma::viz {
 
@@ -66,6 +71,14 @@ vtkSmartPointer<vtkLookupTable> makeForceTable() {
   return table;
 }
 
+// colour scale of activation: dark violet through teal to yellow (viridis-like), distinct from force
+vtkSmartPointer<vtkLookupTable> makeActivationTable() {
+  auto table = makeRampTable({{0.0, 0.27, 0.0, 0.33}, {0.5, 0.13, 0.57, 0.55}, {1.0, 0.99, 0.91, 0.14}});
+  table->SetNanColor(0.62, 0.62, 0.62, 1.0);
+  table->Build();
+  return table;
+}
+
 // colour scale of the gut: deep blue to cyan to white
 vtkSmartPointer<vtkLookupTable> makeGutTable() {
   auto table = makeRampTable({{0.0, 0.17, 0.25, 0.62}, {0.6, 0.25, 0.72, 0.85}, {1.0, 0.88, 0.97, 1.0}});
@@ -77,7 +90,6 @@ vtkSmartPointer<vtkLookupTable> makeGutTable() {
 // fixed range [0, kSkinDisplacementTop] mm
 vtkSmartPointer<vtkLookupTable> makeSkinTable() {
   auto table = makeRampTable({{0.0, 0.93, 0.80, 0.70}, {0.4, 0.98, 0.60, 0.25}, {1.0, 0.70, 0.05, 0.08}});
-  table->SetTableRange(0.0, kSkinDisplacementTop);
   table->Build();
   return table;
 }
@@ -87,8 +99,6 @@ vtkSmartPointer<vtkScalarBarActor> makeScalarBar(vtkLookupTable* table, const ch
   auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
   bar->SetLookupTable(table);
   bar->SetTitle(title);
-  bar->SetNumberOfLabels(5);
-  bar->SetLabelFormat("%-#6.3g");
   bar->SetPosition(0.855, y);
   bar->SetWidth(0.14);
   bar->SetHeight(0.4);
@@ -104,14 +114,33 @@ vtkSmartPointer<vtkScalarBarActor> makeScalarBar(vtkLookupTable* table, const ch
   return bar;
 }
 
-// a rounded-up "nice" number (1, 2, 5 times a power of ten) for colour-scale tops
-double niceCeil(double v) {
-  if (!(v > 0.0)) return 1.0;
-  const double p = std::pow(10.0, std::floor(std::log10(v)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= v) return m * p;
-  return 10.0 * p;
+// legend labels: the plots' ticks (viz::niceTicks, a 1-2-5 step) written with %g (no trailing zeros, and no
+// exponent for 1e-4 <= |v| < 1e6)
+constexpr const char* kLegendFormat = "%g";
+constexpr int kLegendTicks = 5;  // [-] intervals aimed at
+
+// one colour scale: its table and its legend over [lo, hi], labelled as legendLabels() writes them
+void setScale(vtkScalarBarActor* bar, vtkLookupTable* table, double lo, double hi) {
+  double range[2];
+  table->GetTableRange(range);
+  if (range[0] == lo && range[1] == hi && bar->GetUseCustomLabels()) return;
+  table->SetTableRange(lo, hi);
+  vtkNew<vtkDoubleArray> labels;
+  for (double v : niceTicks(lo, hi, kLegendTicks).values) labels->InsertNextValue(v);
+  bar->SetUseCustomLabels(true);
+  bar->SetCustomLabels(labels);
+  bar->SetLabelFormat(kLegendFormat);
 }
+
+// the top of an auto-ranged scale: the kAutoRangePercentile of `values` rounded up, never below `top`
+double autoTop(std::vector<double>& values, double top) {
+  if (values.empty()) return top;
+  const auto k = static_cast<std::ptrdiff_t>(kAutoRangePercentile * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return std::max(top, niceCeil(values[static_cast<std::size_t>(k)]));
+}
+
+constexpr double kPascalPerCmH2O = 98.0665;  // [Pa / cmH2O]
 
 // a teaching label: a caption drawn over the scene (never hidden by it) with a leader to its point
 vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
@@ -150,6 +179,32 @@ vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::st
   normals->SetFeatureAngle(60.0);
   normals->Update();
   return normals->GetOutput();
+}
+
+double niceCeil(double v) {
+  if (!(v > 0.0)) return 1.0;
+  const double p = std::pow(10.0, std::floor(std::log10(v)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * p >= v * (1.0 - 1e-12)) return m * p;
+  return 10.0 * p;
+}
+
+std::vector<std::string> legendLabels(double lo, double hi) {
+  std::vector<std::string> labels;
+  char text[64];
+  for (double v : niceTicks(lo, hi, kLegendTicks).values) {
+    std::snprintf(text, sizeof text, kLegendFormat, v);
+    labels.emplace_back(text);
+  }
+  return labels;
+}
+
+std::string magnificationError(double factor) {
+  if (factor >= kMinMagnification && factor <= kMaxMagnification) return {};
+  std::ostringstream out;
+  out << "motion magnification: " << factor << " is outside [" << kMinMagnification << ", "
+      << kMaxMagnification << "]";
+  return out.str();
 }
 
 const char* groupLabel(sim::ElementGroup g) {
@@ -197,16 +252,26 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkOrientationMarkerWidget> marker;
   vtkSmartPointer<vtkLookupTable> forceTable = makeForceTable();
   vtkSmartPointer<vtkLookupTable> gutTable = makeGutTable();
-  vtkSmartPointer<vtkScalarBarActor> forceBar = makeScalarBar(forceTable, "Contractive\nforce [N]", 0.55);
+  vtkSmartPointer<vtkLookupTable> activationTable = makeActivationTable();
+  vtkSmartPointer<vtkScalarBarActor> forceBar = makeScalarBar(forceTable, "Tension per\nelement [N]", 0.55);
   vtkSmartPointer<vtkScalarBarActor> gutBar = makeScalarBar(gutTable, "Gut", 0.07);
   vtkSmartPointer<vtkLookupTable> skinTable = makeSkinTable();
   vtkSmartPointer<vtkScalarBarActor> skinBar = makeScalarBar(skinTable, "Skin\ndisplacement\n[mm]", 0.31);
+  // "motion x5" at the top left of the view while the motion is magnified
+  vtkSmartPointer<vtkTextActor> motionText = vtkSmartPointer<vtkTextActor>::New();
   DisplayOptions options;
 
   sim::Model model;
-  double maxForceSeen = 0.0;         // [N]
-  double maxDisplacementSeen = 0.0;  // [m] of the current frame
-  double maxPressureSeen = 0.0;      // [Pa] largest |P| since the model was set
+  // the tops of the auto-ranged scales so far (DisplayOptions::isAutoRange): never shrinking
+  double muscleTop = 0.0;           // [N] or [-]
+  double gutDisplacementTop = 0.0;  // [mm]
+  double gutPressureTop = 0.0;      // [cmH2O]
+  double skinTop = 0.0;             // [mm]
+  // the end-expiratory pose the displacements are measured from, posed (rest pose until there is one)
+  double referenceTime = std::numeric_limits<double>::quiet_NaN();  // [s] its State::time
+  sim::PosedGeometry reference;
+  sim::PosedGeometry real;     // the state posed as it is, when the drawn pose is magnified
+  std::vector<double> values;  // scratch for the auto range
 
   // muscle elements, one actor per group (points 2k, 2k+1 are the ends of the group's k-th element)
   struct Group {
@@ -236,9 +301,8 @@ struct ModelScene::Impl {
 
   // the skin, coloured plain or by its displacement from the rest pose
   vtkSmartPointer<vtkPolyData> skin;
-  vtkSmartPointer<vtkFloatArray> skinScalar;  // [mm] displacement from the rest pose
+  vtkSmartPointer<vtkFloatArray> skinScalar;  // [mm] displacement from end-expiration
   vtkSmartPointer<vtkActor> skinActor;
-  Eigen::Matrix3Xd skinRest;  // [m] skin vertices at the rest pose (3 x #V)
 
   // teaching labels: landmarks, group centres, and a few named bones
   struct Label {
@@ -261,7 +325,8 @@ struct ModelScene::Impl {
     lungs = {};
     lungActors = {};
     highlight = Pick{};
-    maxForceSeen = maxDisplacementSeen = maxPressureSeen = 0.0;
+    resetAutoRange();
+    referenceTime = std::numeric_limits<double>::quiet_NaN();
   }
 
   std::vector<vtkProp*> ownedProps() const {
@@ -424,9 +489,6 @@ struct ModelScene::Impl {
       skinActor = scalarSurfaceActor(skin, skinScalar, skinTable, true);
       skinActor->GetProperty()->SetSpecular(0.15);
       skinActor->GetProperty()->SetSpecularPower(12.0);
-      sim::PosedGeometry rest;
-      sim::poseGeometry(model, sim::makeInitialState(model), rest);
-      skinRest = rest.skin;
     }
 
     landmarks = vtkSmartPointer<vtkPolyData>::New();
@@ -485,8 +547,20 @@ struct ModelScene::Impl {
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
   }
 
+  void resetAutoRange() { muscleTop = gutDisplacementTop = gutPressureTop = skinTop = 0.0; }
+
+  std::string motionCaption() const {
+    if (options.magnification == 1.0) return {};
+    std::ostringstream out;
+    out << "motion \u00d7" << options.magnification;
+    return out.str();
+  }
+
   void applyOptions() {
-    const bool byForce = options.muscleColouring == MuscleColouring::Force;
+    const bool byForce = options.muscleColouring != MuscleColouring::Group;  // force or activation
+    const bool byActivation = options.muscleColouring == MuscleColouring::Activation;
+    forceBar->SetLookupTable(byActivation ? activationTable : forceTable);
+    forceBar->SetTitle(byActivation ? "Activation\n\u03b1 [0-1]" : "Tension per\nelement [N]");
     bool anyMuscleShown = false;
     for (int gi = 0; gi < kGroups; ++gi) {
       Group& g = groups[static_cast<std::size_t>(gi)];
@@ -495,6 +569,7 @@ struct ModelScene::Impl {
       // structural springs keep their own colour: they carry no muscle force
       const bool colourByForce = byForce && sim::isMuscleGroup(group);
       g.actor->GetMapper()->SetScalarVisibility(colourByForce);
+      g.actor->GetMapper()->SetLookupTable(byActivation ? activationTable : forceTable);
       const auto rgb = groupColour(group);
       g.actor->GetProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
       const bool shown = options.showGroup[static_cast<std::size_t>(gi)];
@@ -509,7 +584,7 @@ struct ModelScene::Impl {
       const bool coloured = options.gutColouring != GutColouring::Plain;
       gutActor->GetMapper()->SetScalarVisibility(coloured);
       gutActor->GetProperty()->SetColor(0.72, 0.58, 0.82);
-      gutBar->SetTitle(options.gutColouring == GutColouring::Pressure ? "Gut\npressure [Pa]"
+      gutBar->SetTitle(options.gutColouring == GutColouring::Pressure ? "Gut\npressure\n[cmH2O]"
                                                                       : "Gut\ndisplacement\n[mm]");
       gutBar->SetVisibility(options.showGut && coloured);
     }
@@ -527,6 +602,8 @@ struct ModelScene::Impl {
       skinActor->GetMapper()->SetScalarVisibility(isSkinColoured);
     }
     skinBar->SetVisibility(isSkinShown && isSkinColoured);
+    motionText->SetInput(motionCaption().c_str());
+    motionText->SetVisibility(options.magnification != 1.0);
     for (const Label& l : labels) {
       const bool relevant = l.group >= 0      ? options.showGroup[static_cast<std::size_t>(l.group)]
                             : l.landmark >= 0 ? options.showLandmarks
@@ -548,6 +625,19 @@ ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
   m_impl->forceBar->VisibilityOff();
   m_impl->gutBar->VisibilityOff();
   m_impl->skinBar->VisibilityOff();
+  vtkTextActor* motion = m_impl->motionText;
+  motion->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  motion->SetPosition(0.015, 0.94);
+  vtkTextProperty* text = motion->GetTextProperty();
+  text->SetFontSize(18);
+  text->BoldOn();
+  text->ShadowOff();
+  text->SetColor(1.0, 0.86, 0.35);
+  text->SetBackgroundColor(0.08, 0.09, 0.12);
+  text->SetBackgroundOpacity(0.7);
+  motion->PickableOff();
+  r->AddViewProp(motion);
+  m_impl->applyOptions();
 }
 
 ModelScene::~ModelScene() = default;
@@ -590,11 +680,26 @@ void ModelScene::setModel(const sim::Model& model, const std::string& modelDir) 
   setCamera(CameraPreset::Oblique);
 }
 
-void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
+void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
+                        const sim::State* endExpiration) {
   Impl& s = *m_impl;
   const sim::Model& model = s.model;
 
-  sim::poseGeometry(model, state, s.posed);
+  // display only: the motion from the end-expiratory pose magnified, posed by the one posing function
+  const bool isMagnified = endExpiration && s.options.magnification != 1.0;
+  if (isMagnified)
+    sim::poseGeometry(model, sim::magnifyMotion(*endExpiration, state, s.options.magnification), s.posed);
+  else
+    sim::poseGeometry(model, state, s.posed);
+  // the real (unmagnified) pose and the end-expiratory one, for the displacements the colours show
+  if (isMagnified) sim::poseGeometry(model, state, s.real);
+  const sim::PosedGeometry& real = isMagnified ? s.real : s.posed;
+  const double referenceKey = endExpiration ? endExpiration->time : -1.0;
+  if (!(referenceKey == s.referenceTime)) {
+    sim::poseGeometry(model, endExpiration ? *endExpiration : sim::makeInitialState(model), s.reference);
+    s.referenceTime = referenceKey;
+  }
+  const bool isAuto = s.options.isAutoRange;
 
   // bones: rigid transforms body -> world
   for (std::size_t b = 0; b < s.bodies.size(); ++b) {
@@ -605,9 +710,10 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     m->Modified();
   }
 
-  // muscle elements: end positions and contractive force magnitude (NaN = slack = grey)
+  // muscle elements: end positions, and their tension [N] (NaN = slack = grey) or their group's activation
   const bool hasForces = metrics.elementForce.size() == model.elements.size();
-  double maxForce = 0.0;
+  const bool byActivation = s.options.muscleColouring == MuscleColouring::Activation;
+  s.values.clear();
   for (Impl::Group& g : s.groups) {
     if (!g.lines) continue;
     vtkPoints* points = g.lines->GetPoints();
@@ -616,42 +722,49 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
       const auto id = static_cast<vtkIdType>(2 * k);
       points->SetPoint(id, s.posed.elementA(0, e), s.posed.elementA(1, e), s.posed.elementA(2, e));
       points->SetPoint(id + 1, s.posed.elementB(0, e), s.posed.elementB(1, e), s.posed.elementB(2, e));
-      const double tension = hasForces ? std::max(0.0, -metrics.elementForce(e)) : 0.0;
-      const bool isSlack = !(tension > 0.0) || (static_cast<std::size_t>(e) < metrics.isSlack.size() &&
-                                                metrics.isSlack[static_cast<std::size_t>(e)]);
-      g.force->SetValue(static_cast<vtkIdType>(k),
-                        isSlack ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(tension));
-      if (!isSlack && sim::isMuscleGroup(model.elements.group[static_cast<std::size_t>(e)]))
-        maxForce = std::max(maxForce, tension);
+      const sim::ElementGroup group = model.elements.group[static_cast<std::size_t>(e)];
+      double value = std::numeric_limits<double>::quiet_NaN();
+      if (byActivation) {
+        value = metrics.activations[static_cast<std::size_t>(group)].alpha;
+      } else {
+        const double tension = hasForces ? std::max(0.0, -metrics.elementForce(e)) : 0.0;
+        const bool isSlack = !(tension > 0.0) || (static_cast<std::size_t>(e) < metrics.isSlack.size() &&
+                                                  metrics.isSlack[static_cast<std::size_t>(e)]);
+        if (!isSlack) value = tension;
+      }
+      g.force->SetValue(static_cast<vtkIdType>(k), static_cast<float>(value));
+      if (isAuto && std::isfinite(value) && sim::isMuscleGroup(group)) s.values.push_back(value);
     }
     points->Modified();
     g.force->Modified();
   }
-  s.maxForceSeen = std::max(s.maxForceSeen, maxForce);
-  const double top = s.options.forceRange > 0.0 ? s.options.forceRange : niceCeil(s.maxForceSeen);
-  s.forceTable->SetTableRange(0.0, top);
+  if (byActivation) {
+    setScale(s.forceBar, s.activationTable, 0.0, kActivationTop);
+  } else {
+    if (isAuto) s.muscleTop = autoTop(s.values, s.muscleTop);
+    setScale(s.forceBar, s.forceTable, 0.0, isAuto ? std::max(s.muscleTop, 1.0) : kTensionTop);
+  }
 
-  // gut surface and its colour
+  // gut surface, coloured by its real displacement from end-expiration [mm] or its pressure [cmH2O]
   if (s.gut) {
     Impl::setPoints(s.gut, s.posed.gut);
-    double maxDisp = 0.0;
+    const bool byPressure = s.options.gutColouring == GutColouring::Pressure;
+    const double pressure = metrics.gutPressure / kPascalPerCmH2O;
+    s.values.clear();
     for (int n = 0; n < model.nodes.size(); ++n) {
-      const double d = (state.nodePosition.col(n) - model.nodes.rest.col(n)).norm();
-      maxDisp = std::max(maxDisp, d);
-      const double value =
-          s.options.gutColouring == GutColouring::Pressure ? metrics.gutPressure : 1000.0 * d;
-      s.gutScalar->SetValue(n, static_cast<float>(value));
+      const double d = 1000.0 * (real.gut.col(n) - s.reference.gut.col(n)).norm();
+      s.gutScalar->SetValue(n, static_cast<float>(byPressure ? pressure : d));
+      if (isAuto && !byPressure) s.values.push_back(d);
     }
     s.gutScalar->Modified();
-    // the displacement scale follows the current largest displacement (rounded to a nice number)
-    s.maxDisplacementSeen = maxDisp;
-    if (s.options.gutColouring == GutColouring::Pressure) {
-      // the pressure is uniform (Eq. 4): its colour moves over a symmetric scale of the largest |P| seen
-      s.maxPressureSeen = std::max(s.maxPressureSeen, std::abs(metrics.gutPressure));
-      const double p = niceCeil(std::max(s.maxPressureSeen, 1.0));
-      s.gutTable->SetTableRange(-p, p);
+    if (byPressure) {
+      // the pressure is uniform (Eq. 4): its colour moves over a symmetric scale
+      if (isAuto) s.gutPressureTop = std::max(s.gutPressureTop, niceCeil(std::abs(pressure)));
+      const double top = isAuto ? std::max(s.gutPressureTop, 1.0) : kGutPressureTop;
+      setScale(s.gutBar, s.gutTable, -top, top);
     } else {
-      s.gutTable->SetTableRange(0.0, niceCeil(std::max(1000.0 * s.maxDisplacementSeen, 1.0)));
+      if (isAuto) s.gutDisplacementTop = autoTop(s.values, s.gutDisplacementTop);
+      setScale(s.gutBar, s.gutTable, 0.0, isAuto ? std::max(s.gutDisplacementTop, 1.0) : kGutDisplacementTop);
     }
   }
 
@@ -664,13 +777,18 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
   const Eigen::Matrix3Xd& lm = s.posed.landmarks;
   if (s.landmarks) Impl::setPoints(s.landmarks, lm);
 
-  // skin and its displacement from the rest pose [mm]
+  // skin and its real displacement from end-expiration [mm]
   if (s.skin) {
     Impl::setPoints(s.skin, s.posed.skin);
-    for (Eigen::Index v = 0; v < s.posed.skin.cols(); ++v)
-      s.skinScalar->SetValue(v,
-                             static_cast<float>(1000.0 * (s.posed.skin.col(v) - s.skinRest.col(v)).norm()));
+    s.values.clear();
+    for (Eigen::Index v = 0; v < s.posed.skin.cols(); ++v) {
+      const double d = 1000.0 * (real.skin.col(v) - s.reference.skin.col(v)).norm();
+      s.skinScalar->SetValue(v, static_cast<float>(d));
+      if (isAuto) s.values.push_back(d);
+    }
     s.skinScalar->Modified();
+    if (isAuto) s.skinTop = autoTop(s.values, s.skinTop);
+    setScale(s.skinBar, s.skinTable, 0.0, isAuto ? std::max(s.skinTop, 1.0) : kSkinDisplacementTop);
   }
 
   // labels follow their structures
@@ -679,7 +797,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
     if (l.landmark >= 0) {
       at = lm.col(l.landmark);
     } else if (l.body >= 0) {
-      at = state.bodyPosition.col(l.body);
+      at = s.posed.body[static_cast<std::size_t>(l.body)].translation();
     } else {
       // a group is labelled at its element furthest to the subject's right, clear of the midline
       at = Eigen::Vector3d::Constant(-1e9);
@@ -705,7 +823,12 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics) {
   }
 }
 
+const sim::PosedGeometry& ModelScene::posed() const { return m_impl->posed; }
+
+std::string ModelScene::motionCaption() const { return m_impl->motionCaption(); }
+
 void ModelScene::setOptions(const DisplayOptions& options) {
+  if (options.isAutoRange != m_impl->options.isAutoRange) m_impl->resetAutoRange();
   m_impl->options = options;
   m_impl->applyOptions();
 }

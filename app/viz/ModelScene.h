@@ -11,9 +11,11 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
+#include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/State.h"
 
 class vtkPolyData;
@@ -22,18 +24,48 @@ class vtkRenderWindowInteractor;
 
 namespace pneuma::viz {
 
-/// How muscle elements are coloured.
-enum class MuscleColouring { Force, Group };
+/// How muscle elements are coloured: by the tension of each element [N], by its group's activation alpha
+/// [0, 1] (Eq. 2), or by group (Figure 2).
+enum class MuscleColouring { Force, Activation, Group };
 /// How the gut surface is coloured.
 enum class GutColouring { Plain, Pressure, Displacement };
 /// How the skin is shown.
 enum class SkinDisplay { Hidden, Translucent, Opaque };
-/// How the skin is coloured: plain skin tone, or its displacement from the rest pose (the relaxed
-/// end-expiration the model is built at) in mm on the fixed scale [0, kSkinDisplacementTop] (a breathing heat
-/// map: calm breathing moves the chest and belly 1-4 mm, a deep breath 5-15 mm).
+/// How the skin is coloured: plain skin tone, or its displacement from the breath's end-expiratory pose in mm
+/// (a breathing heat map: calm breathing moves the chest and belly 1-4 mm, a deep breath 5-15 mm).
 enum class SkinColouring { Plain, Displacement };
-constexpr double kSkinDisplacementTop = 10.0;  ///< [mm] top of the skin displacement colour scale
-constexpr double kSkinTranslucency = 0.3;      ///< [-] opacity of the translucent skin
+
+/// Fixed colour scales: one range per quantity on every frame of every run, so that a colour always means the
+/// same value and the legend never jumps (DisplayOptions::isAutoRange trades this for a range fitted to the
+/// run). Displacements are the real ones (never magnified), from the breath's end-expiratory pose.
+constexpr double kTensionTop =
+    20.0;  ///< [N] per-element tension: about the largest force of the strip of muscle
+           ///< one element stands for (11-19 N, resources/anatomy/README.md)
+constexpr double kActivationTop = 1.0;         ///< [-] activation alpha, Eq. 2: [0, 1]
+constexpr double kGutDisplacementTop = 20.0;   ///< [mm] gut: a deep breath's dome descent
+constexpr double kSkinDisplacementTop = 10.0;  ///< [mm] skin: a deep breath's chest-wall motion
+constexpr double kGutPressureTop = 20.0;  ///< [cmH2O] gut pressure, on [-top, top] (calm upright: 5-10 cmH2O)
+/// [-] the percentile of the values whose rounded-up value tops an auto-ranged scale
+constexpr double kAutoRangePercentile = 0.95;
+
+/// The labels of a colour legend over [lo, hi], as the legend shows them: the plots' ticks (viz::niceTicks(),
+/// a step of 1, 2 or 5 x 10^n) written without trailing zeros or exponents ("0", "5", ..., "20"; "0", "0.2",
+/// ..., "1").
+std::vector<std::string> legendLabels(double lo, double hi);
+/// The smallest of 1, 2, 5 x 10^n not below `v` (1 for v <= 0): the top of an auto-ranged scale.
+double niceCeil(double v);
+constexpr double kSkinTranslucency = 0.3;  ///< [-] opacity of the translucent skin
+
+/// Motion magnification (display only): the view draws every displacement from the end-expiratory pose
+/// (bones, muscles, gut, lungs, skin) this many times larger (sim::magnifyMotion()), so that calm breathing,
+/// a few millimetres at the chest wall, is visible; the view says so ("motion x5"). Plots, read-outs and
+/// exported numbers are never magnified.
+constexpr double kMinMagnification = 1.0;      ///< [-]
+constexpr double kMaxMagnification = 20.0;     ///< [-]
+constexpr double kDefaultMagnification = 5.0;  ///< [-] makes a calm breath visible across a lecture hall
+/// Empty when `factor` is a valid magnification, else the one-line reason ("motion magnification: 25 is
+/// outside [1, 20]").
+std::string magnificationError(double factor);
 
 /// Camera presets, looking at the whole model.
 enum class CameraPreset { Anterior, Lateral, Superior, Oblique };
@@ -63,7 +95,11 @@ struct DisplayOptions {
   SkinDisplay skin = SkinDisplay::Translucent;
   SkinColouring skinColouring = SkinColouring::Plain;
   std::array<bool, sim::kElementGroupCount> showGroup{true, true, true, true, true, true};
-  double forceRange = 0.0;  ///< [N] top of the force colour scale; 0 = adapt to the largest force seen
+  /// each colour scale topped at the kAutoRangePercentile of its values so far in the run (rounded up by
+  /// niceCeil(), never shrinking until the model or this option changes) instead of its fixed range
+  bool isAutoRange = false;
+  double magnification = kDefaultMagnification;  ///< [-] motion magnification, in [kMinMagnification,
+                                                 ///< kMaxMagnification]
 };
 
 /// What a pick in the view hit.
@@ -93,8 +129,16 @@ class ModelScene {
   void setModel(const sim::Model& model, const std::string& modelDir);
 
   /// Moves everything to `state` and colours it from `metrics` (elementForce [N], gutPressure [Pa]).
-  /// `state` and `metrics` must belong to the model given to setModel().
-  void update(const sim::State& state, const sim::Metrics& metrics);
+  /// `state` and `metrics` must belong to the model given to setModel(). With `endExpiration` (the
+  /// end-expiratory state of the breath, Snapshot::endExpiration) the motion from it is drawn magnified
+  /// DisplayOptions::magnification times; without it the state is drawn as it is.
+  void update(const sim::State& state, const sim::Metrics& metrics,
+              const sim::State* endExpiration = nullptr);
+
+  /// The geometry as drawn by the last update() (magnified) [m].
+  const sim::PosedGeometry& posed() const;
+  /// The caption the view shows for the magnification ("motion \u00d75"; empty at 1x).
+  std::string motionCaption() const;
 
   /// Applies display options (visibility, colouring, translucency).
   void setOptions(const DisplayOptions& options);

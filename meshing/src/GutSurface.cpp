@@ -83,6 +83,9 @@ class GutShape {
 
 double ringAngle(int j, int n) { return 2.0 * M_PI * j / n; }
 
+/// true within kBackHalfAngle of the posterior midline: the fixed back of the wall and of the dome's rim
+bool isBack(double phi) { return std::abs(std::remainder(phi - M_PI, 2.0 * M_PI)) <= kBackHalfAngle + 1e-9; }
+
 /// Triangles between two closed rings (node indices, angles 2 pi j / n), merged by angle.
 void zipRings(const std::vector<int>& lower, const std::vector<int>& upper,
               std::vector<Eigen::Vector3i>& tris) {
@@ -148,9 +151,8 @@ GutSurface buildGut(const AnatomyParams& a, const Skeleton& sk) {
     std::vector<int> ring;
     for (int j = 0; j < res.ringNodes; ++j) {
       const double phi = ringAngle(j, res.ringNodes);
-      const bool isBack = std::abs(std::remainder(phi - M_PI, 2.0 * M_PI)) <= kBackHalfAngle + 1e-9;
-      ring.push_back(
-          addNode(shape.wall(phi, t), k == 0 || isBack ? sim::NodeRegion::Fixed : sim::NodeRegion::Wall));
+      ring.push_back(addNode(shape.wall(phi, t),
+                             k == 0 || isBack(phi) ? sim::NodeRegion::Fixed : sim::NodeRegion::Wall));
     }
     g.wallRing.push_back(ring);
     rings.push_back(ring);
@@ -178,7 +180,10 @@ GutSurface buildGut(const AnatomyParams& a, const Skeleton& sk) {
       const Eigen::Vector3d w = shape.wall(phi, 1.0);
       Eigen::Vector3d p = centre + s * (w - centre);
       p.z() = apexZ + (w.z() - apexZ) * s * s;
-      ring.push_back(addNode(p, sim::NodeRegion::Diaphragm));
+      // the rim's posterior arc (the crura and the arcuate ligaments) is fixed to the back like the wall
+      // below
+      const bool isCrural = r == 0 && isBack(phi);
+      ring.push_back(addNode(p, isCrural ? sim::NodeRegion::Fixed : sim::NodeRegion::Diaphragm));
     }
     g.domeRing.push_back(ring);
     rings.push_back(ring);

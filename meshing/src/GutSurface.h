@@ -1,7 +1,9 @@
 #pragma once
 /// @file GutSurface.h
 /// The sealed gut surface of Section 6: a stack of node rings from the pelvic floor to the costal
-/// margin (the abdominal wall), closed below by a fixed floor cap and above by the diaphragm dome.
+/// margin (the abdominal wall), closed below by a fixed floor cap and above by the diaphragm dome. The back
+/// of the wall and the posterior arc of the dome's rim (the crura on the lumbar spine and the arcuate
+/// ligaments, Gray's Anatomy) are fixed, as the lumbar spine they insert on is.
 
 #include <vector>
 

@@ -10,6 +10,7 @@
 #include <CGAL/convex_hull_3.h>
 
 #include <array>
+#include <cstdint>
 #include <map>
 
 #include "pneuma/sim/Error.h"
@@ -22,6 +23,8 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using SurfaceMesh = CGAL::Surface_mesh<Point>;
 namespace PMP = CGAL::Polygon_mesh_processing;
+
+constexpr double kHullJitter = 1e-7;  // [m] span of the per-point offset that breaks coplanar ties
 
 // copy into a halfedge mesh; false when a face breaks manifoldness
 bool toSurfaceMesh(const TriangleMesh& in, SurfaceMesh& out) {
@@ -99,19 +102,34 @@ TriangleMesh remeshIsotropic(const TriangleMesh& mesh, double targetEdge, const 
 }
 
 TriangleMesh convexHull(const Eigen::Matrix3Xd& points, std::vector<int>& source) {
+  // CGAL triangulates a flat part of the hull (four or more coplanar points: mirror-symmetric ribs give many)
+  // in an order that follows heap addresses, so the same points could give another hull from one process to
+  // the next. A fixed sub-micrometre offset per point puts them in general position, where the hull is
+  // unique; the output keeps the exact input coordinates.
+  auto jitter = [](std::uint64_t i, int k) {
+    std::uint64_t z = (i * 3 + static_cast<std::uint64_t>(k) + 1) * 0x9e3779b97f4a7c15ULL;  // splitmix64
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return kHullJitter * (static_cast<double>(z >> 11) / 9007199254740992.0 - 0.5);  // [m]
+  };
   std::vector<Point> pts;
   std::map<std::array<double, 3>, int> index;
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    pts.emplace_back(points(0, i), points(1, i), points(2, i));
-    index.emplace(std::array<double, 3>{points(0, i), points(1, i), points(2, i)}, static_cast<int>(i));
+    const std::uint64_t u = static_cast<std::uint64_t>(i);
+    const std::array<double, 3> p{points(0, i) + jitter(u, 0), points(1, i) + jitter(u, 1),
+                                  points(2, i) + jitter(u, 2)};
+    pts.emplace_back(p[0], p[1], p[2]);
+    index.emplace(p, static_cast<int>(i));
   }
   SurfaceMesh hull;
   CGAL::convex_hull_3(pts.begin(), pts.end(), hull);
   TriangleMesh out = fromSurfaceMesh(hull);
   source.assign(static_cast<std::size_t>(out.vertexCount()), -1);
   for (int v = 0; v < out.vertexCount(); ++v) {
-    source[static_cast<std::size_t>(v)] =
-        index.at(std::array<double, 3>{out.vertices(0, v), out.vertices(1, v), out.vertices(2, v)});
+    const int i = index.at(std::array<double, 3>{out.vertices(0, v), out.vertices(1, v), out.vertices(2, v)});
+    source[static_cast<std::size_t>(v)] = i;
+    out.vertices.col(v) = points.col(i);
   }
   return out;
 }

@@ -22,6 +22,12 @@ constexpr std::size_t kAppositionRings = 3;  // [-] dome rings inside the rim th
 // the dome node: a spring this long holds the node at its distance from the rib face and lets it slide along
 // the face
 constexpr double kAppositionSlide = 0.2;
+// [m] an apposition spring is as stiff as one reaching this far when its node lies closer to the face: the
+// stiffness grows as 1 / reach, and a node 11 mm in front of a vertebral body got a spring stiff enough for
+// the first linearly implicit step to gain energy (Integrators_test, StrongRibFriction)
+constexpr double kAppositionStiffReach = 0.015;
+constexpr double kVertebralFrontHalfWidth =
+    0.015;  // [m] lateral reach of the apposition points on a vertebral body's front
 constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
 constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
 constexpr double kScaleneLength = 0.06;  // [m] rib 1 to the scalene anchors above it (cervical spine)
@@ -176,7 +182,9 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
 /// Wilson 2016, J Appl Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide
 /// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. Each node of
 /// the first kAppositionRings rings inside the rim gets a two-sided spring (Cartilage group) toward the
-/// nearest point of the inner face of ribs 6-12 within kAppositionReach, anchored kAppositionSlide beyond
+/// nearest point of the inner face of ribs 6-12, or of the front of the vertebral bodies T10-L1 beside the
+/// crura (where the dome lies on the spine; without it the dome's rings over the spine fold backward on
+/// themselves while the model settles), within kAppositionReach, anchored kAppositionSlide beyond
 /// that point on the same line: a long spring resists a change of the node's distance to the face and hardly
 /// a slide across it (a slide s lengthens it by about s^2 / 2 l). Its stiffness and damping along the line
 /// are those of a spring reaching only the rib point, the cartilage group's times `fraction`.
@@ -191,6 +199,14 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
         face.push_back(Endpoint::onBody(b, r.at(s, 0.5 * r.thickness)));
     }
   }
+  // the front of the vertebral bodies T10-L1, on which the dome lies beside the crura: held in the frame of
+  // the fixed lumbar spine (the thoracic segments' sway, about a millimetre, neglected; anchored on those
+  // moving segments, the springs' 0.2 m lever let the linearly implicit step gain energy, Integrators_test)
+  std::vector<Eigen::Vector3d> spineFront(sk.thoracicFront.begin() + 9, sk.thoracicFront.end());
+  spineFront.push_back(sk.lumbarFront.front());
+  for (const Eigen::Vector3d& c : spineFront)
+    for (double x : {-kVertebralFrontHalfWidth, 0.0, kVertebralFrontHalfWidth})
+      face.push_back(Endpoint::onBody(sk.lumbar, c + Eigen::Vector3d(x, 0, 0)));
   for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
     for (int node : gut.domeRing[ring]) {
       const Eigen::Vector3d p = gut.rest.col(node);
@@ -200,7 +216,7 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
       const Endpoint anchor =
           Endpoint::onBody(rib.body, rib.world + kAppositionSlide * (rib.world - p) / reach);
       sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), anchor, 0.0,
-               fraction * (reach + kAppositionSlide) / reach);
+               fraction * (reach + kAppositionSlide) / std::max(reach, kAppositionStiffReach));
     }
   }
 }

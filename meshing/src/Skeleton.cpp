@@ -228,6 +228,8 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
   for (int t = 1; t <= 12; ++t) {
     sk.vertebraTop.push_back(thoracic(t).zTop);
     sk.vertebraCentreY.push_back(thoracic(t).y);
+    const Vertebra& v = thoracic(t);
+    sk.thoracicFront.emplace_back(0.0, v.y + 0.5 * v.depth, 0.5 * (v.zBottom + v.zTop));
   }
   // spine joints at the disc centres, from the lumbar spine upward
   for (std::size_t s = a.spine.thoracicSegments.size(); s-- > 0;) {

@@ -60,11 +60,12 @@ struct Skeleton {
   std::vector<std::array<Eigen::Vector3d, 2>> costalNotch;  ///< [m] sternal attachment of ribs 1..7
   Eigen::Vector3d sternumAxis{0, 0, -1};                    ///< unit direction down the sternum
   Eigen::Vector3d xiphoidTip{0, 0, 0};                      ///< [m] lower end of the sternum
-  Eigen::Vector3d jugularNotch{0, 0, 0};      ///< [m] upper end of the manubrium (suprasternal notch)
-  std::vector<Eigen::Vector3d> sternumInner;  ///< [m] points on the sternum's posterior face
-  std::vector<Eigen::Vector3d> lumbarFront;   ///< [m] anterior points of L1..L3 (crura), top down
-  std::vector<double> vertebraTop;            ///< [m] z of the top of T1..T12
-  std::vector<double> vertebraCentreY;        ///< [m] y of the body centre of T1..T12
+  Eigen::Vector3d jugularNotch{0, 0, 0};       ///< [m] upper end of the manubrium (suprasternal notch)
+  std::vector<Eigen::Vector3d> sternumInner;   ///< [m] points on the sternum's posterior face
+  std::vector<Eigen::Vector3d> lumbarFront;    ///< [m] anterior points of L1..L3 (crura), top down
+  std::vector<double> vertebraTop;             ///< [m] z of the top of T1..T12
+  std::vector<double> vertebraCentreY;         ///< [m] y of the body centre of T1..T12
+  std::vector<Eigen::Vector3d> thoracicFront;  ///< [m] anterior mid-height points of T1..T12
 };
 
 /// Builds the bones and joints of `a`. @throws sim::Error when ribs overlap (naming the rib levels).

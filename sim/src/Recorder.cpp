@@ -25,6 +25,7 @@ void Recorder::record(const State& state, const Metrics& metrics) {
   f.lungVolume = metrics.lungVolume;
   f.gutVolumeError = metrics.gutVolumeError;
   f.gutPressure = metrics.gutPressure;
+  f.activations = metrics.activations;
   m_frames.push_back(std::move(f));
   if (m_capacity > 0 && m_frames.size() > m_capacity) m_frames.pop_front();
 }
@@ -70,6 +71,7 @@ void Recorder::restore(std::size_t i, State& state, Metrics& metrics) const {
   metrics.lungVolume = f.lungVolume;
   metrics.gutVolumeError = f.gutVolumeError;
   metrics.gutPressure = f.gutPressure;
+  metrics.activations = f.activations;
   metrics.elementForce = Eigen::Map<const Eigen::VectorXf>(f.elementForce.data(),
                                                            static_cast<Eigen::Index>(f.elementForce.size()))
                              .cast<double>();

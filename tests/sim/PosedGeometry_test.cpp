@@ -113,5 +113,54 @@ TEST(PosedGeometry, SkinBlockRoundTripsOlderFilesLoadWithoutItAndBadWeightsAreRe
   }
 }
 
+// motion magnification (display only): every posed point moves k times as far from the reference pose, to
+// first order in the motion; bones stay rigid and the rotation's angle is k times the real one
+TEST(PosedGeometry, MagnifiedMotionMovesEveryPosedPointByTheFactor) {
+  const SkinnedToy t;
+  const State reference = makeInitialState(t.m);
+  State s = reference;
+  // a small breath-sized motion: every free body turned 2 mrad and shifted 0.4 mm, every free node moved
+  for (int b = 0; b < t.m.bodies.size(); ++b) {
+    if (t.m.bodies.isFixed[static_cast<std::size_t>(b)]) continue;
+    s.bodyOrientation[static_cast<std::size_t>(b)] =
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.002, Vector3d(1, 0.3 * b, 0.2).normalized()));
+    s.bodyPosition.col(b) += Vector3d(0.0001 * b, 0.0004, -0.0002);
+  }
+  for (int n = 0; n < t.m.nodes.size(); ++n)
+    if (!t.m.nodes.isFixed(n)) s.nodePosition.col(n) += Vector3d(0.0003, -0.0001 * (n % 3), 0.0004);
+
+  PosedGeometry rest, real, shown;
+  poseGeometry(t.m, reference, rest);
+  poseGeometry(t.m, s, real);
+  const double k = 5.0;
+  poseGeometry(t.m, magnifyMotion(reference, s, k), shown);
+  for (const auto& [name, part] : std::vector<std::pair<const char*, Eigen::Matrix3Xd PosedGeometry::*>>{
+           {"elementA", &PosedGeometry::elementA},
+           {"elementB", &PosedGeometry::elementB},
+           {"gut", &PosedGeometry::gut},
+           {"cavity", &PosedGeometry::cavity},
+           {"landmarks", &PosedGeometry::landmarks},
+           {"skin", &PosedGeometry::skin}}) {
+    const Eigen::Matrix3Xd d1 = real.*part - rest.*part, dk = shown.*part - rest.*part;
+    ASSERT_GT(d1.norm(), 1e-6) << name << " moved";
+    // second-order terms of the turned bones: (k theta)^2 r ~ 1e-4 of k times the motion
+    EXPECT_LT((dk - k * d1).norm(), 0.01 * k * d1.norm()) << name;
+  }
+  for (int b = 0; b < t.m.bodies.size(); ++b) {
+    const Eigen::AngleAxisd turn(shown.body[static_cast<std::size_t>(b)].linear());
+    const Eigen::AngleAxisd realTurn(real.body[static_cast<std::size_t>(b)].linear());
+    EXPECT_NEAR(turn.angle(), k * realTurn.angle(), 1e-9) << "body " << b;
+    EXPECT_NEAR((shown.body[static_cast<std::size_t>(b)].linear().transpose() *
+                     shown.body[static_cast<std::size_t>(b)].linear() -
+                 Eigen::Matrix3d::Identity())
+                    .norm(),
+                0.0, 1e-12)
+        << "a bone stays rigid";
+  }
+  // factor 1 is the state itself
+  poseGeometry(t.m, magnifyMotion(reference, s, 1.0), shown);
+  EXPECT_LT((shown.skin - real.skin).norm(), 1e-15);
+}
+
 }  // namespace
 }  // namespace pneuma::sim

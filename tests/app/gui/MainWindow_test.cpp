@@ -6,8 +6,12 @@
 #include <gtest/gtest.h>
 #include <vtkCaptionActor2D.h>
 #include <vtkCoordinate.h>
+#include <vtkDoubleArray.h>
 #include <vtkPropCollection.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkScalarsToColors.h>
+#include <vtkTextActor.h>
 
 #include <QAction>
 #include <QCheckBox>
@@ -15,19 +19,27 @@
 #include <QFile>
 #include <QLabel>
 #include <QLineEdit>
+#include <QProgressDialog>
 #include <QRegularExpression>
 #include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
+#include <QTimer>
 #include <cmath>
 #include <set>
 
 #include "../cli/CliRunner.h"
 #include "GuiTestSupport.h"
+#include "gui/ExportController.h"
+#include "gui/FlowVolumeLoop.h"
 #include "gui/LivePlots.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Resources.h"
+#include "pneuma/sim/Scenario.h"
+#include "viz/GltfWriter.h"
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -324,12 +336,260 @@ TEST_F(DefaultModelWindow, BreathingReadOutShowsTheCalmBreathsMotion) {
   EXPECT_EQ(window.breathingReadout(), "Measured after the first full breath.");
 }
 
+namespace {
+
+// the caption text actors the view shows (the "motion x5" of the magnification among them)
+std::vector<std::string> shownTexts(vtkRenderer* renderer) {
+  std::vector<std::string> texts;
+  vtkPropCollection* props = renderer->GetViewProps();
+  props->InitTraversal();
+  while (vtkProp* prop = props->GetNextProp())
+    if (auto* text = vtkTextActor::SafeDownCast(prop); text && text->GetVisibility() && text->GetInput())
+      texts.emplace_back(text->GetInput());
+  return texts;
+}
+
+}  // namespace
+
+// motion magnification moves what is drawn by the stated factor: at the end of a calm inhale the landmarks'
+// projected screen displacement from the end-expiratory pose is five times larger at 5x than at 1x, the view
+// says "motion x5", and the plotted volume is the real one; a factor outside [1, 20] is refused
+TEST_F(DefaultModelWindow, MagnificationMovesTheDrawnLandmarksByTheFactor) {
+  ASSERT_TRUE(window.runUntil(12.0)) << window.lastError().toStdString();
+  // the end of the last inhale: the largest plotted volume after t = 8.5 s (calm: 15 b/m after 2 s settling)
+  const app::PlotView* plot = window.plots()->volumePlot();
+  const std::vector<double> t = plot->time();  // copies: a refresh replaces the plot's data
+  const std::vector<double> v = plot->series()[0].y;
+  std::size_t peak = 0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] > 8.5 && (peak == 0 || v[k] > v[peak])) peak = k;
+  ASSERT_TRUE(window.scrubTo(t[peak]));
+  const app::Snapshot* shown = window.shown();
+  ASSERT_NE(shown->endExpiration, nullptr) << "an end-expiration found before " << t[peak] << " s";
+  EXPECT_LT(shown->endExpiration->time, t[peak]);
+  EXPECT_GT(shown->endExpiration->time, t[peak] - 4.0) << "the breath's own end-expiration";
+
+  // the landmarks of the end-expiratory pose and as drawn, projected to the screen [px]
+  vtkRenderer* renderer = window.scene().renderer();
+  window.scene().setCamera(viz::CameraPreset::Anterior);
+  window.grabView();
+  sim::PosedGeometry endExpiration;
+  sim::poseGeometry(*window.model(), *shown->endExpiration, endExpiration);
+  auto screen = [&](const Eigen::Vector3d& x) {
+    vtkNew<vtkCoordinate> c;
+    c->SetCoordinateSystemToWorld();
+    c->SetValue(x.x(), x.y(), x.z());
+    const double* d = c->GetComputedDoubleDisplayValue(renderer);
+    return Eigen::Vector2d(d[0], d[1]);
+  };
+  auto drawnDisplacement = [&](double factor) {
+    EXPECT_EQ(window.setMagnification(factor), QString());
+    window.grabView();
+    std::vector<Eigen::Vector2d> d;
+    const Eigen::Matrix3Xd& drawn = window.scene().posed().landmarks;
+    for (Eigen::Index l = 0; l < drawn.cols(); ++l)
+      d.push_back(screen(drawn.col(l)) - screen(endExpiration.landmarks.col(l)));
+    return d;
+  };
+  const std::vector<Eigen::Vector2d> real = drawnDisplacement(1.0);
+  EXPECT_TRUE(shownTexts(renderer).empty() ||
+              std::none_of(shownTexts(renderer).begin(), shownTexts(renderer).end(),
+                           [](const std::string& s) { return s.rfind("motion", 0) == 0; }))
+      << "no caption at 1x";
+  const std::vector<Eigen::Vector2d> magnified = drawnDisplacement(5.0);
+  const std::vector<std::string> texts = shownTexts(renderer);
+  EXPECT_NE(std::find(texts.begin(), texts.end(), "motion \u00d75"), texts.end());
+  // the landmark that moves most on screen (the umbilicus or the xiphoid in an anterior view)
+  std::size_t most = 0;
+  for (std::size_t l = 0; l < real.size(); ++l)
+    if (real[l].norm() > real[most].norm()) most = l;
+  ASSERT_GT(real[most].norm(), 1.0) << "a calm inhale moves a landmark at least a pixel";
+  EXPECT_NEAR(magnified[most].norm() / real[most].norm(), 5.0, 0.25);
+  EXPECT_GT(magnified[most].normalized().dot(real[most].normalized()), 0.99) << "the same direction";
+  // the numbers stay real: the snapshot's volume is the plotted one
+  EXPECT_NEAR(1e6 * shown->metrics.lungVolume, v[peak], 1e-6);
+
+  // out of range: refused with the reason, the factor kept
+  const QString error = window.setMagnification(25.0);
+  EXPECT_TRUE(error.contains("motion magnification: 25 is outside [1, 20]")) << error.toStdString();
+  EXPECT_EQ(window.scene().options().magnification, 5.0);
+  QLineEdit* field = window.parameters()->magnificationField();
+  field->setText("0.5");
+  emit field->editingFinished();
+  EXPECT_TRUE(window.parameters()->refusal().contains("0.5 is outside [1, 20]"))
+      << window.parameters()->refusal().toStdString();
+  EXPECT_EQ(window.scene().options().magnification, 5.0);
+  field->setText("10");
+  emit field->editingFinished();
+  EXPECT_EQ(window.scene().options().magnification, 10.0);
+}
+
+namespace {
+
+// what each shown colour legend says: its title, range and labels as drawn
+std::vector<std::string> shownLegends(vtkRenderer* renderer) {
+  std::vector<std::string> legends;
+  vtkPropCollection* props = renderer->GetViewProps();
+  props->InitTraversal();
+  while (vtkProp* prop = props->GetNextProp()) {
+    auto* bar = vtkScalarBarActor::SafeDownCast(prop);
+    if (!bar || !bar->GetVisibility()) continue;
+    std::string text = std::string(bar->GetTitle()) + " |";
+    EXPECT_TRUE(bar->GetUseCustomLabels()) << bar->GetTitle();
+    vtkDoubleArray* labels = bar->GetCustomLabels();
+    for (vtkIdType i = 0; labels && i < labels->GetNumberOfTuples(); ++i) {
+      char label[64];
+      std::snprintf(label, sizeof label, bar->GetLabelFormat(), labels->GetValue(i));
+      // round numbers: no exponent, no trailing zero after a decimal point
+      EXPECT_TRUE(QRegularExpression("^-?[0-9]+(\\.[0-9]*[1-9])?$").match(label).hasMatch())
+          << bar->GetTitle() << ": label '" << label << "'";
+      text += std::string(" ") + label;
+    }
+    const double* range = bar->GetLookupTable()->GetRange();
+    text += " [" + std::to_string(range[0]) + ", " + std::to_string(range[1]) + "]";
+    legends.push_back(text);
+  }
+  return legends;
+}
+
+}  // namespace
+
+// the colour legends of a recorded run stay fixed across its frames (tension 0-20 N, gut and skin
+// displacement 0-20 and 0-10 mm from end-expiration), with round labels; the auto range (95th percentile)
+// fits the run and never shrinks while it is replayed
+TEST_F(DefaultModelWindow, ColourLegendsOfARecordedRunStayFixedAcrossFrames) {
+  viz::DisplayOptions o = window.scene().options();
+  o.skinColouring = viz::SkinColouring::Displacement;
+  window.setDisplayOptions(o);
+  ASSERT_TRUE(window.runUntil(10.0)) << window.lastError().toStdString();
+  vtkRenderer* renderer = window.scene().renderer();
+  std::vector<std::string> first;
+  for (double t : {2.5, 4.0, 5.2, 6.9, 8.3, 9.9}) {
+    ASSERT_TRUE(window.scrubTo(t));
+    window.grabView();
+    const std::vector<std::string> legends = shownLegends(renderer);
+    ASSERT_EQ(legends.size(), 3u) << "tension, gut and skin";
+    if (first.empty()) first = legends;
+    EXPECT_EQ(legends, first) << "at t = " << t << " s";
+  }
+  EXPECT_EQ(first[0], "Tension per\nelement [N] | 0 5 10 15 20 [0.000000, 20.000000]");
+  EXPECT_EQ(first[1], "Gut\ndisplacement\n[mm] | 0 5 10 15 20 [0.000000, 20.000000]");
+  EXPECT_EQ(first[2], "Skin\ndisplacement\n[mm] | 0 2 4 6 8 10 [0.000000, 10.000000]");
+
+  // auto range: fitted to the values shown, never shrinking as the replay goes on
+  o.isAutoRange = true;
+  window.setDisplayOptions(o);
+  double top = 0.0;
+  for (double t : {3.0, 5.0, 7.0, 9.0}) {
+    ASSERT_TRUE(window.scrubTo(t));
+    const std::vector<std::string> legends = shownLegends(renderer);
+    vtkPropCollection* props = renderer->GetViewProps();
+    props->InitTraversal();
+    while (vtkProp* prop = props->GetNextProp())
+      if (auto* bar = vtkScalarBarActor::SafeDownCast(prop);
+          bar && bar->GetVisibility() && std::string(bar->GetTitle()).rfind("Gut", 0) == 0) {
+        EXPECT_GE(bar->GetLookupTable()->GetRange()[1], top) << "at t = " << t << " s";
+        top = bar->GetLookupTable()->GetRange()[1];
+      }
+  }
+  EXPECT_GE(top, 1.0);
+  EXPECT_LT(top, 100.0) << "the gut moves a few millimetres from end-expiration, not the settling sag";
+}
+
+// the physiology panel: the flow-volume loop closes each calm breath (from one end-expiration to the next the
+// lung volume returns within 5 % of the tidal volume and the flow to near zero), the plotted flow integrates
+// to the plotted volume change, the pressures are in cmH2O, and at a scrubbed instant the notes read that
+// instant
+TEST_F(DefaultModelWindow, FlowVolumeLoopClosesEachBreath) {
+  ASSERT_TRUE(window.runUntil(19.0)) << window.lastError().toStdString();
+  const app::FlowVolumeLoop* loop = window.plots()->loop();
+  int complete = 0;
+  for (const app::FlowVolumeLoop::Loop& l : loop->loops()) {
+    ASSERT_GT(l.time.size(), 10u);
+    const auto [vMin, vMax] = std::minmax_element(l.volume.begin(), l.volume.end());
+    double peakFlow = 0.0, integral = 0.0;  // [L/s], [mL]
+    for (std::size_t k = 0; k < l.flow.size(); ++k) {
+      if (std::isfinite(l.flow[k])) peakFlow = std::max(peakFlow, std::abs(l.flow[k]));
+      if (k > 0) integral += 1e3 * l.flow[k] * (l.time[k] - l.time[k - 1]);
+    }
+    if (!l.isComplete) continue;
+    ++complete;
+    const double tidal = *vMax - *vMin;  // [mL]
+    EXPECT_NEAR(tidal, 530.0, 80.0) << "a calm breath";
+    EXPECT_NEAR(l.volume.front(), 0.0, 1e-9);
+    EXPECT_LT(std::abs(l.volume.back()), 0.05 * tidal)
+        << "the loop closes: breath from " << l.time.front() << " s";
+    EXPECT_LT(std::abs(l.flow.back()), 0.2 * peakFlow) << "ends near zero flow";
+    EXPECT_GT(peakFlow, 0.2) << "calm breathing peaks at a few tenths of a litre per second";
+    EXPECT_NEAR(integral, l.volume.back(), 0.02 * tidal) << "flow [L/s] integrates to the volume [mL]";
+    EXPECT_NEAR(l.time.back() - l.time.front(), 4.0, 0.4) << "15 breaths per minute";
+  }
+  EXPECT_GE(complete, 2);
+  EXPECT_NEAR(window.plots()->breathingRate(), 15.0, 1.0);
+
+  // pressures in cmH2O: the gut's and, the model having a pleural pressure, the transdiaphragmatic one
+  const app::PlotView* pressures = window.plots()->pressurePlot();
+  ASSERT_EQ(pressures->series().size(), 2u);
+  const std::vector<double>& pdi = pressures->series()[1].y;
+  const double pdiLast = pdi.back();
+  EXPECT_GT(pdiLast, 0.0) << "the diaphragm holds the abdomen below the chest";
+  EXPECT_LT(pdiLast, 40.0) << "cmH2O, not Pa";
+
+  // scrubbed: the notes read that instant
+  ASSERT_TRUE(window.scrubTo(15.0));
+  window.plots()->refresh();
+  const double t = window.shown()->metrics.time;
+  const std::string at = QString("at %1 s").arg(t, 0, 'f', 2).toStdString();
+  for (const app::PlotView* plot :
+       {window.plots()->volumePlot(), window.plots()->flowPlot(), window.plots()->pressurePlot()})
+    EXPECT_NE(plot->toPlot().note().find(at), std::string::npos) << plot->toPlot().note();
+  EXPECT_NE(
+      window.plots()->volumePlot()->toPlot().note().find(
+          QString("lungs %1 mL").arg(1e6 * window.shown()->metrics.lungVolume, 0, 'f', 0).toStdString()),
+      std::string::npos)
+      << "the scrubbed volume, not the live one";
+}
+
+// scenarios round-trip whatever drives them: the shipped startle scenario (a pattern with a timeline) opens
+// and plays its target volume; saved, it reopens to the same pattern; after a pushed affect the saved
+// scenario records the affect, not the calm style
+TEST_F(DefaultModelWindow, AffectAndPatternScenariosOpenPlayAndSaveWhatDrivesTheRun) {
+  const QString startle = QString::fromStdString(sim::resourceDir()) + "/scenarios/startle-at-10s.json";
+  ASSERT_EQ(window.openScenario(startle), QString());
+  ASSERT_TRUE(window.runUntil(5.0, 120000)) << window.lastError().toStdString();
+  const app::PlotView* plot = window.plots()->volumePlot();
+  ASSERT_EQ(plot->series().size(), 2u) << "simulated and target volume";
+  const std::vector<double> target = plot->series()[1].y;
+  EXPECT_TRUE(std::any_of(target.begin(), target.end(), [](double v) { return v > 1000.0; }))
+      << "the pattern's target lung volume [mL] is plotted";
+
+  QTemporaryDir dir;
+  const QString saved = dir.filePath("startle.json");
+  ASSERT_EQ(window.saveScenario(saved), QString());
+  const sim::Scenario original = sim::loadScenario(startle.toStdString());
+  const sim::Scenario reread = sim::loadScenario(saved.toStdString());
+  EXPECT_EQ(reread.controller, sim::ControllerKind::Pattern);
+  EXPECT_EQ(reread.patternText, original.patternText);
+  EXPECT_EQ(reread.seed, original.seed);
+  ASSERT_EQ(window.openScenario(saved), QString()) << "the saved scenario reopens";
+
+  ASSERT_EQ(window.setBreathStyle("calm"), QString());
+  ASSERT_EQ(window.pushAffect("panic", true), QString());
+  ASSERT_EQ(window.saveScenario(saved), QString());
+  const sim::Scenario affect = sim::loadScenario(saved.toStdString());
+  EXPECT_EQ(affect.controller, sim::ControllerKind::Affect);
+  EXPECT_EQ(affect.controllerName, "panic");
+  ASSERT_EQ(window.setBreathStyle("deep"), QString());
+  ASSERT_EQ(window.saveScenario(saved), QString());
+  EXPECT_EQ(sim::loadScenario(saved.toStdString()).controllerName, "deep");
+}
+
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(5.0));
   const app::PlotView* plot = w.window.plots()->volumePlot();
   // the live sample nearest to t = 3 s
-  const auto& t = plot->time();
+  const std::vector<double> t = plot->time();  // a copy: the scrub refreshes the plot
   const std::size_t k = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), 3.0) - t.begin());
   ASSERT_LT(k, t.size());
   const double liveVolume = plot->series()[0].y[k];  // [mL]
@@ -487,6 +747,35 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
   EXPECT_NE(w.window.exportRun("/proc/pneuma-no-such-dir/run.pvd"), QString());
 }
 
+// File > Export > Run as glTF and Baked morph targets: the recording's skin fitted onto targets baked from
+// the physics (docs/patterns.md), read back with the skin's vertex count; a bad folder is an error, not a
+// file
+TEST_F(DefaultModelWindow, RunExportsAsGltfWithBakedMorphTargets) {
+  ASSERT_TRUE(window.runUntil(2.5));
+  QTemporaryDir out;
+  ASSERT_EQ(window.exportGltf(out.filePath("run.glb")), QString());
+  const sim::MorphTargets run = viz::readGltfMorphTargets(out.filePath("run.glb").toStdString());
+  ASSERT_EQ(run.targets.size(), 3u);
+  EXPECT_EQ(run.vertexCount(), window.model()->skin.vertexCount());
+  // the breathing target lifts the body: its largest displacement is centimetres, not zero and not metres
+  const double largest = run.targets[0].displacement.colwise().norm().maxCoeff();  // [m]
+  EXPECT_GT(largest, 0.01);
+  EXPECT_LT(largest, 0.1);
+  ASSERT_EQ(window.bakeMorphTargets(out.filePath("morphs.glb")), QString());
+  EXPECT_TRUE(QFile::exists(out.filePath("morphs.glb")));
+  EXPECT_NE(window.exportGltf("/proc/pneuma-no-such-dir/run.glb"), QString());
+  EXPECT_FALSE(QFile::exists("/proc/pneuma-no-such-dir/run.glb"));
+}
+
+TEST(MainWindow, GltfExportOfAModelWithoutSkinIsRefused) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(0.5));
+  QTemporaryDir out;
+  const QString error = w.window.exportGltf(out.filePath("toy.glb"));
+  EXPECT_TRUE(error.contains("has no skin")) << error.toStdString();
+  EXPECT_TRUE(QDir(out.path()).isEmpty());
+}
+
 // the teaching view: no muscle group's caption covers another caption, from any camera preset
 TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
   const std::set<std::string> groupNames = {
@@ -577,6 +866,32 @@ TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
   EXPECT_TRUE(movie.read(4) == "OggS");  // an Ogg container
   EXPECT_GT(movie.size(), 1000);
   EXPECT_TRUE(QDir(out.path()).entryList({"*.tmp-*"}, QDir::Files).isEmpty());
+}
+
+// a movie export shows its progress, and Cancel part-way leaves no file behind (neither the movie nor a
+// temporary), with no error reported
+TEST(MainWindow, CancelledAnimationExportLeavesNoFile) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(1.5));
+  QTemporaryDir out;
+  int shownAt = -1;
+  QTimer clicker;
+  QObject::connect(&clicker, &QTimer::timeout, [&] {
+    for (QProgressDialog* dialog : w.window.findChildren<QProgressDialog*>())
+      if (dialog->isVisible() && dialog->value() >= 3 && shownAt < 0) {
+        shownAt = dialog->value();
+        EXPECT_EQ(dialog->maximum(), 26) << "1 s at 25 fps";
+        dialog->cancel();
+      }
+  });
+  clicker.start(2);
+  const QString error = w.window.exportAnimation(out.filePath("breath.ogv"), 0.4, 1.4, 25.0);
+  clicker.stop();
+  EXPECT_EQ(error, app::ExportController::cancelled());
+  EXPECT_GE(shownAt, 3) << "the progress dialog was shown and counted frames";
+  EXPECT_TRUE(QDir(out.path()).entryList(QDir::Files | QDir::Hidden).isEmpty())
+      << QDir(out.path()).entryList(QDir::Files | QDir::Hidden).join(", ").toStdString();
+  EXPECT_EQ(w.window.lastError(), QString()) << "a cancel is not an error";
 }
 
 TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {

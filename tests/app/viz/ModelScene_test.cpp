@@ -91,5 +91,20 @@ TEST(ModelScene, ActorsAreAtThePosedPositions) {
   EXPECT_EQ(atRest, 0);
 }
 
+// legend labels: evenly spaced on a 1-2-5 step, no stray decimals or exponents
+TEST(ModelScene, LegendLabelsAreRoundNumbersWithoutStrayDecimals) {
+  using Labels = std::vector<std::string>;
+  EXPECT_EQ(viz::legendLabels(0.0, viz::kTensionTop), (Labels{"0", "5", "10", "15", "20"}));
+  EXPECT_EQ(viz::legendLabels(0.0, 1.0), (Labels{"0", "0.2", "0.4", "0.6", "0.8", "1"}));
+  EXPECT_EQ(viz::legendLabels(0.0, 10.0), (Labels{"0", "2", "4", "6", "8", "10"}));
+  EXPECT_EQ(viz::legendLabels(-5.0, 5.0), (Labels{"-4", "-2", "0", "2", "4"}));
+  EXPECT_EQ(viz::legendLabels(0.0, 500.0), (Labels{"0", "100", "200", "300", "400", "500"}));
+  EXPECT_EQ(viz::legendLabels(0.0, 0.05), (Labels{"0", "0.01", "0.02", "0.03", "0.04", "0.05"}));
+  // auto-ranged tops are 1, 2 or 5 x 10^n at or above the value
+  EXPECT_EQ(viz::niceCeil(13.2), 20.0);
+  EXPECT_EQ(viz::niceCeil(20.0), 20.0);
+  EXPECT_EQ(viz::niceCeil(0.31), 0.5);
+}
+
 }  // namespace
 }  // namespace pneuma

@@ -96,7 +96,7 @@ struct Joints {
 enum class NodeRegion : std::uint8_t {
   Wall = 0,       ///< anterior and lateral abdominal wall (moving)
   Diaphragm = 1,  ///< the diaphragm dome (moving)
-  Fixed = 2       ///< the fixed back and bottom
+  Fixed = 2       ///< the fixed back and bottom, and the dome rim's posterior (crural) arc
 };
 
 /// Point masses of the deformable gut surface (Section 6.1).

@@ -30,4 +30,14 @@ struct PosedGeometry {
 /// through its anchors (skinPositions()).
 void poseGeometry(const Model& model, const State& state, PosedGeometry& out);
 
+/// `state` with its motion from `reference` magnified `factor` times, for display (motion magnification: a
+/// calm breath moves the chest wall a few millimetres; at 5x a lecture hall sees it). Pose the result with
+/// poseGeometry(), so that every part stays attached as the model attaches it. With k = factor:
+///   gut nodes and body centres  x = x_ref + k (x - x_ref);
+///   body orientations           q = exp(k log(q q_ref^-1)) q_ref  (the rotation from the reference, k times
+///                                                                   the angle about the same axis).
+/// To first order in the motion every posed point (anchors, lungs, skin) then moves k times as far from its
+/// reference position as in `state`. Velocities and time are `state`'s. factor 1 returns `state`.
+State magnifyMotion(const State& reference, const State& state, double factor);
+
 }  // namespace pneuma::sim

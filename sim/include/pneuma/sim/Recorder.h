@@ -24,6 +24,7 @@ struct RecordedFrame {
   double lungVolume = 0.0;          ///< [m^3]
   double gutVolumeError = 0.0;      ///< [-]
   double gutPressure = 0.0;         ///< [Pa] Metrics::gutPressure, with the kappa of the run at that frame
+  Activations activations{};        ///< r and alpha per group (Metrics::activations)
 };
 
 class Recorder {
@@ -45,7 +46,8 @@ class Recorder {
   /// Simulation::checkpoint()).
   void restore(std::size_t i, State& state) const;
   /// As restore(i, state), and sets the recorded fields of `metrics` to the frame's: time, lungVolume,
-  /// gutVolumeError, gutPressure and elementForce (others are left as they are; isSlack is cleared).
+  /// gutVolumeError, gutPressure, activations and elementForce (others are left as they are; isSlack is
+  /// cleared).
   void restore(std::size_t i, State& state, Metrics& metrics) const;
   void clear() { m_frames.clear(); }
   std::size_t capacity() const { return m_capacity; }

@@ -1,0 +1,91 @@
+#pragma once
+/// @file MorphTargets.h
+/// Breathing as morph targets baked from the physics (docs/patterns.md, "Morph targets").
+///
+/// de Melo, Kenny & Gratch (2010, section *Model*) animate breathing by blending a neutral mesh (maximum
+/// expiration) towards a breathing target (maximum inspiration); here the shapes come from simulation runs
+/// of the skinned model, posed by sim::poseGeometry():
+///   - base:      the skin at the smallest lung volume of a deep-breathing run (upright): the relaxed torso
+///   at
+///                the end of settling, which the deep style does not breathe below,
+///   - breathing: the skin at that breath's maximum inspiration, as a displacement from the base,
+///   - chest:     the tidal displacement of panting (rib-cage dominant), scaled to the deep breath's volume,
+///   - belly:     the tidal displacement of a supine deep breath (abdomen dominant), scaled likewise.
+/// A skin x is then approximated by the linear blend  x ~ base + sum_k w_k D_k.
+
+#include <Eigen/Core>
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pneuma/sim/Model.h"
+
+namespace pneuma::sim {
+
+/// One morph target: a displacement of every skin vertex from the base.
+struct MorphTarget {
+  std::string name;               ///< "breathing", "chest" or "belly"
+  Eigen::Matrix3Xd displacement;  ///< [m] D_k, per skin vertex (3 x #V)
+  double ribCageShare = 0.0;      ///< [-] rib cage's share of the tidal volume of the run it came from
+};
+
+/// The baked shapes and the volume-to-shape calibration of one model.
+struct MorphTargets {
+  Eigen::Matrix3Xd base;             ///< [m] skin at the deep run's smallest lung volume (3 x #V)
+  std::vector<MorphTarget> targets;  ///< breathing, chest, belly (each scaled to the same volume change)
+  double restVolume = 0.0;    ///< [m^3] settled lung volume of the relaxed torso (pattern fraction 0.05)
+  double baseVolume = 0.0;    ///< [m^3] lung volume of the base shape
+  double targetVolume = 0.0;  ///< [m^3] lung volume of the breathing target (weight 1)
+  double volumePerFraction = 2.5e-3;  ///< [m^3] S of the pattern drive: V(v) = restVolume + (v - 0.05) S
+  /// [1/m^3] calibrated volume-to-shape slope: the least-squares line, through the origin, of the summed
+  /// fitted weights of the deep run's frames against their lung volume above baseVolume.
+  double weightPerVolume = 0.0;
+
+  int vertexCount() const { return static_cast<int>(base.cols()); }
+};
+
+/// How far a blend is from a skin, over the vertices [m].
+struct BlendError {
+  double rms = 0.0;  ///< [m] sqrt(mean_v |x_v - blend_v|^2)
+  double max = 0.0;  ///< [m] max_v |x_v - blend_v|
+};
+
+/// Called during a bake with the stage ("deep", "panting", "supine deep") and its progress in [0, 1].
+using BakeProgress = std::function<void(const std::string& stage, double fraction)>;
+
+/// Runs the three breath-style presets (`resourceDir`/presets: deep upright, panting upright, deep supine;
+/// 2 s settling and two breaths each, about 30 simulated seconds) on `model` and extracts the shapes.
+/// @throws Error when the model has no skin, a preset cannot be loaded or a run fails; Interrupted when
+///         `stop` (may be null) is set.
+MorphTargets bakeMorphTargets(std::shared_ptr<const Model> model, const std::string& resourceDir,
+                              const BakeProgress& progress = {}, const std::atomic<bool>* stop = nullptr);
+
+/// Least-squares fit of skins onto the targets: w = argmin |x - base - sum_k w_k D_k|^2 over all vertex
+/// coordinates, solved once through the normal equations (D^T D) w = D^T (x - base).
+class MorphFit {
+ public:
+  explicit MorphFit(const MorphTargets& targets);
+  /// [-] the weights of `skin` (3 x #V) [m], one per target.
+  Eigen::VectorXd weights(const Eigen::Matrix3Xd& skin) const;
+  /// [m] base + sum_k w_k D_k (3 x #V).
+  Eigen::Matrix3Xd blend(const Eigen::VectorXd& weights) const;
+  /// The distance between `skin` and the blend of its fitted weights.
+  BlendError error(const Eigen::Matrix3Xd& skin) const;
+
+ private:
+  Eigen::Matrix3Xd m_base;   // [m] (3 x #V)
+  Eigen::MatrixXd m_basis;   // [m] the displacements as columns (3#V x #K)
+  Eigen::MatrixXd m_normal;  // [m^2] D^T D (#K x #K), inverted
+};
+
+/// de Melo's real-time mapping of a respiration pattern straight to morph weights, without physics.
+/// The pattern's volume fraction v becomes a lung volume V(v) = restVolume + (v - 0.05) volumePerFraction
+/// (the pattern drive's mapping, docs/patterns.md) and an amplitude a = weightPerVolume (V - baseVolume),
+/// at least 0. The balance b (0 all belly, 1 all chest) is read as the rib cage's share of the breath:
+/// the shapes are ordered by their ribCageShare and a is split between the two whose shares enclose b,
+/// linearly in b (all to the nearest one outside their range). @return one weight per target [-].
+Eigen::VectorXd patternWeights(const MorphTargets& targets, double fraction, double balance);
+
+}  // namespace pneuma::sim
