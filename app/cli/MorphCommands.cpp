@@ -91,24 +91,17 @@ void runPlay(const PlayArgs& a) {
   InterruptGuard guard;
   const sim::MorphTargets m = morphTargetsFor(model, a.morphs);
 
-  // the playback: pattern volume and balance -> weights, per frame (the balance smoothed as the controller
-  // does)
+  // the playback: pattern volume and balance -> weights, per frame (sim::MorphPlayer)
   const std::clock_t start = std::clock();
-  sim::pattern::LayerStack stack = sim::pattern::makeLayerStack(pattern, a.seed);
-  stack.setStartVolume(0.05);
-  const double tau = sim::pattern::PatternControllerOptions{}.balanceTimeConstant;  // [s]
+  sim::MorphPlayer player(pattern, a.seed);
   const long long frames = static_cast<long long>(std::floor(a.duration * a.outputRate)) + 1;
   viz::GltfAnimation animation;
   animation.name = a.affect.empty() ? pattern.name : a.affect;
   animation.weights.resize(static_cast<Eigen::Index>(m.targets.size()), frames);
-  double balance = 0.0;
   for (long long f = 0; f < frames; ++f) {
     const double t = static_cast<double>(f) / a.outputRate;  // [s]
-    const double v = stack.sample(t);
-    balance = f == 0 ? stack.balance()
-                     : balance + (stack.balance() - balance) * (1.0 - std::exp(-1.0 / (a.outputRate * tau)));
     animation.time.push_back(t);
-    animation.weights.col(f) = sim::patternWeights(m, v, balance);
+    animation.weights.col(f) = player.weightsAt(m, t);
   }
   const double cpu = static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;  // [s]
   writeGltfOrFail("--gltf", a.gltf, *model, resolveModelDir(a.model), m, {animation});

@@ -133,6 +133,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make
 
   buildDocks();
   buildActions();
+  updatePlaybackAction();
 
   // status bar: model, time, fps and real-time factor
   m_statusModel = new QLabel("No model", this);
@@ -283,6 +284,7 @@ void MainWindow::buildActions() {
   connect(m_playAction, &QAction::toggled, this, [this](bool on) {
     m_playAction->setText(on ? "Pause" : "Play");
     m_playAction->setIcon(style()->standardIcon(on ? QStyle::SP_MediaPause : QStyle::SP_MediaPlay));
+    if (on && m_player) setMorphPlayback(false);  // the physics instead of the playback
     if (m_worker) m_worker->setRunning(on);
   });
   QAction* step = tools->addAction(style()->standardIcon(QStyle::SP_MediaSkipForward), "Step");
@@ -337,6 +339,15 @@ void MainWindow::buildActions() {
     QAction* a = view->addAction(button->text());
     connect(a, &QAction::triggered, button, &QPushButton::click);
   }
+  view->addSeparator();
+  m_playbackAction = view->addAction("&Morph playback");
+  m_playbackAction->setCheckable(true);
+  m_playbackAction->setShortcut(Qt::Key_M);
+  connect(m_playbackAction, &QAction::triggered, this, [this](bool on) { setMorphPlayback(on); });
+  // a new affect while the playback plays: play it from its start
+  connect(m_affectCombo, &QComboBox::currentTextChanged, this, [this] {
+    if (m_player) setMorphPlayback(true);
+  });
   QMenu* simMenu = menuBar()->addMenu("&Simulation");
   simMenu->addAction(m_playAction);
   simMenu->addAction(step);
@@ -569,6 +580,10 @@ QString MainWindow::openModel(const QString& dir) {
     return message;
   }
   m_document.adopt(opened);
+  // the morph targets belong to the previous model
+  setMorphPlayback(false);
+  m_morphs.reset();
+  updatePlaybackAction();
   m_drive = nullptr;  // a new model starts with the breath style
   const std::shared_ptr<const sim::Model>& model = opened.model;
   m_selected = {};
@@ -713,6 +728,85 @@ QString MainWindow::setMagnification(double factor) {
 
 void MainWindow::play() { m_playAction->setChecked(true); }
 
+void MainWindow::updatePlaybackAction() {
+  const sim::Model* m = model();
+  const bool hasSkin = m && m->skin.vertexCount() > 0;
+  m_playbackAction->setEnabled(hasSkin);
+  m_playbackAction->setToolTip(
+      hasSkin ? "Play the toolbar's affect on the skin's baked morph targets alone, without physics "
+                "(de Melo et al. 2010)"
+      : m     ? QString("Morph playback needs a skin: model '%1' has none (rebuild it with pneuma-cli model "
+                        "build)")
+                    .arg(QString::fromStdString(m->name))
+              : QString("Morph playback needs a model with a skin: no model is open"));
+}
+
+QString MainWindow::setMorphPlayback(bool isOn) {
+  const QSignalBlocker block(m_playbackAction);
+  m_playbackAction->setChecked(false);
+  if (!isOn) {
+    m_player.reset();
+    m_scene->setMorphPlayback("");
+    if (m_shown) showSnapshot(m_shown);
+    return {};
+  }
+  const sim::Model* m = model();
+  if (!m_worker || !m) return "morph playback: no model is open";
+  if (m->skin.vertexCount() == 0)
+    return QString("morph playback: model '%1' has no skin").arg(QString::fromStdString(m->name));
+  pause();
+  if (!m_morphs) {
+    // the SimWorker's bake, shared with the glTF export: at most once per model
+    QEventLoop loop;
+    QString error;
+    auto done = connect(m_worker, &SimWorker::morphTargetsReady, &loop, [&](const QString& e) {
+      error = e;
+      loop.quit();
+    });
+    m_worker->requestMorphTargets();
+    loop.exec();
+    disconnect(done);
+    m_morphs = m_worker->morphTargets();
+    if (!m_morphs) {
+      report("Morph playback", "Cannot bake the morph targets: " + error);
+      return "morph playback: " + error;
+    }
+  }
+  const QString affect = m_affectCombo->currentText();
+  try {
+    m_player = std::make_unique<sim::MorphPlayer>(
+        sim::pattern::loadAffect(affect.toStdString(), sim::resourceDir()), 0);
+  } catch (const std::exception& e) {
+    m_player.reset();
+    report("Morph playback", e.what());
+    return QString("morph playback: ") + e.what();
+  }
+  m_playbackAction->setChecked(true);
+  m_scene->setMorphPlayback(affect.toStdString());
+  m_playbackTime = 0.0;
+  showMorphPlaybackAt(0.0);
+  return {};
+}
+
+void MainWindow::showMorphPlaybackAt(double t) {
+  if (!m_player) return;
+  if (t < m_playbackTime) setMorphPlayback(true);  // back in time: the pattern from its start
+  QElapsedTimer clock;
+  clock.start();
+  const Eigen::VectorXd w = m_player->weightsAt(*m_morphs, t);
+  Eigen::Matrix3Xd displacement = Eigen::Matrix3Xd::Zero(3, m_morphs->vertexCount());  // [m]
+  for (std::size_t k = 0; k < m_morphs->targets.size(); ++k)
+    displacement += w(static_cast<Eigen::Index>(k)) * m_morphs->targets[k].displacement;
+  m_scene->updateMorphPlayback(m_morphs->base, displacement);
+  m_view->renderWindow()->Render();
+  m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
+  ++m_framesRendered;
+  m_playbackTime = t;
+  m_playbackFrom = t;
+  m_playbackClock.restart();
+  m_statusTime->setText(QString("  playback t = %1 s  ").arg(t, 0, 'f', 2));
+}
+
 void MainWindow::setSpeed(double speed) {
   const int i = m_speedCombo->findData(speed);
   if (i >= 0)
@@ -762,18 +856,23 @@ bool MainWindow::scrubTo(double time, int timeoutMs) {
 
 void MainWindow::refresh() {
   if (!m_worker) return;
-  Frame frame = m_worker->take();
-  if (!frame.snapshot) return;
-  const bool isNew = frame.snapshot != m_shown;
-  if (frame.snapshot->generation != m_generation) {
-    m_plots->clear();
-    m_generation = frame.snapshot->generation;
+  if (m_player) {
+    // morph playback: a frame at every refresh, on the wall clock
+    showMorphPlaybackAt(m_playbackFrom + static_cast<double>(m_playbackClock.nsecsElapsed()) * 1e-9);
+  } else {
+    Frame frame = m_worker->take();
+    if (!frame.snapshot) return;
+    const bool isNew = frame.snapshot != m_shown;
+    if (frame.snapshot->generation != m_generation) {
+      m_plots->clear();
+      m_generation = frame.snapshot->generation;
+    }
+    m_plots->append(std::move(frame.samples));
+    // a slow 3D render (software GL) waits its turn so that the plots keep the refresh rate
+    const bool isDue = !frame.snapshot->isRunning || m_sinceRender.elapsed() >= 1.5 * m_renderMs;
+    if (isNew && isDue) showSnapshot(frame.snapshot);
+    if (m_plots->refresh()) ++m_plotFrames;
   }
-  m_plots->append(std::move(frame.samples));
-  // a slow 3D render (software GL) waits its turn so that the plots keep the refresh rate
-  const bool isDue = !frame.snapshot->isRunning || m_sinceRender.elapsed() >= 1.5 * m_renderMs;
-  if (isNew && isDue) showSnapshot(frame.snapshot);
-  if (m_plots->refresh()) ++m_plotFrames;
 
   // rates over one-second windows
   const qint64 now = QDateTime::currentMSecsSinceEpoch();

@@ -90,6 +90,20 @@ class MainWindow : public QMainWindow {
   /// @return empty, or the error (an unknown name lists the valid ones; no model open).
   QString pushAffect(const QString& name, bool isImmediate);
 
+  /// View > Morph playback (de Melo et al. 2010, docs/app.md): on, pauses the physics and shows the skin
+  /// driven only by the morph targets (baked once per model by the SimWorker, blocking with events processed
+  /// while it bakes) and the pattern of the toolbar's affect (sim::MorphPlayer), at every display refresh;
+  /// bones, muscles, gut and lungs are hidden. Off, the physics' last instant is shown again.
+  /// @return empty, or the error (no model, a model without a skin, a failed bake).
+  QString setMorphPlayback(bool isOn);
+  bool isMorphPlayback() const { return m_player != nullptr; }
+  /// Shows the morph playback at pattern time `t` [s] from its start and holds it there (scripts and tests;
+  /// the playback's clock resumes from `t`). Going back in time restarts the pattern.
+  void showMorphPlaybackAt(double t);
+  QAction* morphPlaybackAction() const { return m_playbackAction; }
+  /// The morph targets the playback plays (null before its first start on the current model).
+  std::shared_ptr<const sim::MorphTargets> morphTargets() const { return m_morphs; }
+
   /// Renders the 3D view now and returns a grab of the whole window (what the user sees).
   QImage grabWindow();
   /// Renders the 3D view now and returns a grab of the 3D view only.
@@ -141,6 +155,8 @@ class MainWindow : public QMainWindow {
   void select(const viz::Pick& pick);
   void exportPlotInteractive(const PlotView* plot);
   void updateTimeline();
+  /// Enables View > Morph playback for a model with a skin, else disables it with the reason as tooltip.
+  void updatePlaybackAction();
 
   std::unique_ptr<viz::ModelScene> m_scene;
   QVTKOpenGLNativeWidget* m_view = nullptr;
@@ -160,6 +176,14 @@ class MainWindow : public QMainWindow {
   viz::Pick m_selected;
 
   QTimer* m_refresh = nullptr;
+  // morph playback: the action, the model's targets (shared with the SimWorker's glTF export), the player
+  // (null: the physics is shown), its clock and the pattern time it started from
+  QAction* m_playbackAction = nullptr;
+  std::shared_ptr<const sim::MorphTargets> m_morphs;
+  std::unique_ptr<sim::MorphPlayer> m_player;
+  QElapsedTimer m_playbackClock;
+  double m_playbackFrom = 0.0;  // [s]
+  double m_playbackTime = 0.0;  // [s] pattern time shown last
   QAction* m_playAction = nullptr;
   QComboBox* m_styleCombo = nullptr;
   QComboBox* m_speedCombo = nullptr;

@@ -96,6 +96,16 @@ void SimWorker::requestExportGltf(const std::string& modelDir, const std::string
   m_pending.exportGltf = GltfRequest{modelDir, path, isBakeOnly};
 }
 
+void SimWorker::requestMorphTargets() {
+  std::lock_guard lock(m_pendingMutex);
+  m_pending.doBake = true;
+}
+
+std::shared_ptr<const sim::MorphTargets> SimWorker::morphTargets() const {
+  std::lock_guard lock(m_morphsMutex);
+  return m_morphs;
+}
+
 void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir,
                                  const std::string& baseName) {
   std::lock_guard lock(m_pendingMutex);
@@ -132,7 +142,10 @@ void SimWorker::sync() {
   if (p.simulation) {
     m_model = std::move(p.model);
     m_sim = std::move(p.simulation);
-    m_morphs.reset();
+    {
+      std::lock_guard lock(m_morphsMutex);
+      m_morphs.reset();
+    }
     m_pattern = nullptr;
     m_rtf = 0.0;
     m_samples.clear();
@@ -171,6 +184,15 @@ void SimWorker::sync() {
   if (p.affect) pushAffect(p.affect->first, p.affect->second);
   if (p.exportRun) exportRun(*p.exportRun);
   if (p.exportGltf) exportGltf(*p.exportGltf);
+  if (p.doBake) {
+    QString error;
+    try {
+      bake();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    emit morphTargetsReady(error);
+  }
   if (p.doStep) {
     m_isRunning = false;
     m_sim->stepOnce();
@@ -300,17 +322,11 @@ void SimWorker::exportGltf(const GltfRequest& request) {
   QString error;
   try {
     const sim::Recorder& rec = m_sim->recorder();
-    if (m_model->skin.vertexCount() == 0)
-      throw std::runtime_error("model '" + m_model->name +
-                               "' has no skin (rebuild it with pneuma-cli model build)");
+    if (m_model->skin.vertexCount() == 0) bake();  // throws: no skin
     if (!request.isBakeOnly && rec.size() < 2)
       throw std::runtime_error("nothing recorded yet: run the simulation first");
     viz::AtomicFileWriter probe(request.path);  // a folder that cannot be written fails before the bake
-    if (!m_morphs) {
-      emit status("Baking morph targets from deep, panting and supine runs (a few seconds)\u2026");
-      m_morphs =
-          std::make_unique<const sim::MorphTargets>(sim::bakeMorphTargets(m_model, sim::resourceDir()));
-    }
+    bake();
     std::vector<viz::GltfAnimation> animations{viz::breathingDemo(*m_morphs)};
     if (!request.isBakeOnly) {
       viz::GltfAnimationBuilder builder(*m_model, *m_morphs);
@@ -327,6 +343,16 @@ void SimWorker::exportGltf(const GltfRequest& request) {
     error = e.what();
   }
   emit exportDone(error);
+}
+
+void SimWorker::bake() {
+  if (m_model->skin.vertexCount() == 0)
+    throw std::runtime_error("model '" + m_model->name + "' has no skin (rebuild it with pneuma-cli model build)");
+  if (m_morphs) return;
+  emit status("Baking morph targets from deep, panting and supine runs (a few seconds)\u2026");
+  auto morphs = std::make_shared<const sim::MorphTargets>(sim::bakeMorphTargets(m_model, sim::resourceDir()));
+  std::lock_guard lock(m_morphsMutex);
+  m_morphs = std::move(morphs);
 }
 
 void SimWorker::tick() {

@@ -124,6 +124,11 @@ class SimWorker : public QObject {
   /// demo breath; then emits exportDone(). The morph targets are baked on the model once
   /// (sim::bakeMorphTargets, a few seconds in the worker thread) and kept until another model is loaded.
   void requestExportGltf(const std::string& modelDir, const std::string& path, bool isBakeOnly);
+  /// Bakes the model's morph targets unless they are baked already (the same bake as the glTF export's),
+  /// then emits morphTargetsReady().
+  void requestMorphTargets();
+  /// The model's baked morph targets; null before the first bake on the current model. Thread-safe.
+  std::shared_ptr<const sim::MorphTargets> morphTargets() const;
 
   /// The latest snapshot and the plot samples produced since the previous call (each handed out once).
   Frame take();
@@ -141,6 +146,8 @@ class SimWorker : public QObject {
   void targetReached();
   /// A run export finished; `error` is empty on success.
   void exportDone(const QString& error);
+  /// A requestMorphTargets() finished; `error` is empty on success (then morphTargets() has them).
+  void morphTargetsReady(const QString& error);
   /// Progress worth showing in the status bar (e.g. calibration).
   void status(const QString& message);
 
@@ -163,6 +170,7 @@ class SimWorker : public QObject {
     std::shared_ptr<const sim::Scenario> scenario;
     std::optional<std::array<std::string, 3>> exportRun;  // model dir, out dir, base name
     std::optional<GltfRequest> exportGltf;
+    bool doBake = false;
   };
 
   void tick();
@@ -173,6 +181,8 @@ class SimWorker : public QObject {
   void playScenario(const sim::Scenario& scenario);
   void exportRun(const std::array<std::string, 3>& request);
   void exportGltf(const GltfRequest& request);
+  /// Bakes m_morphs on m_model unless it is baked. @throws on a model without a skin or a failed run.
+  void bake();
   /// Recorded frame `i` as a state and the metrics the recording keeps (time, volumes, element forces and the
   /// gut pressure, as measured then: sim::Recorder::restore()).
   void restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& metrics) const;
@@ -186,7 +196,9 @@ class SimWorker : public QObject {
   std::shared_ptr<const sim::Model> m_model;
   std::unique_ptr<sim::Simulation> m_sim;
   sim::pattern::PatternController* m_pattern = nullptr;  // the sim's controller when an affect plays
-  std::unique_ptr<const sim::MorphTargets> m_morphs;     // baked on m_model at the first glTF export
+  // baked on m_model at the first glTF export or playback; written in the worker thread, read by the GUI
+  std::shared_ptr<const sim::MorphTargets> m_morphs;
+  mutable std::mutex m_morphsMutex;
   RunSettings m_settings;
   QTimer* m_timer = nullptr;
 

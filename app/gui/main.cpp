@@ -105,8 +105,12 @@ int main(int argc, char** argv) {
                                  "1");
   const QCommandLineOption measure(
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
+  const QCommandLineOption morphPlayback(
+      "morph-playback",
+      "Show the morph playback of the --affect (default neutral) instead of the physics: the skin on its baked "
+      "morph targets, no physics (de Melo et al. 2010). With --screenshot, --after is the pattern time.");
   parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
-                     screenshot, after, exportGltf, measure});
+                     screenshot, after, exportGltf, measure, morphPlayback});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -200,6 +204,29 @@ int main(int argc, char** argv) {
     window.setDisplayOptions(options);
   }
 
+  const bool isPlayback = parser.isSet(morphPlayback);
+  if (isPlayback && hasModel) {
+    const QString error = window.setMorphPlayback(true);
+    if (!error.isEmpty()) {
+      std::fprintf(stderr, "pneuma: --morph-playback: %s\n", qPrintable(error));
+      return 1;
+    }
+  }
+
+  // grab what the user would see
+  const auto saveScreenshot = [&] {
+    QApplication::processEvents();
+    const QString file = parser.value(screenshot);
+    if (window.grabWindow().save(file, "PNG")) return 0;
+    std::fprintf(stderr, "pneuma: cannot write screenshot '%s'\n", qPrintable(file));
+    return 1;
+  };
+  if (isScripted && isPlayback) {
+    // the playback at pattern time --after, grabbed as the user would see it
+    if (!hasModel) return 1;
+    window.showMorphPlaybackAt(afterSeconds);
+    return saveScreenshot();
+  }
   if (isScripted) {
     // simulate, show that instant, grab what the user would see
     if (!hasModel) return 1;
@@ -209,15 +236,9 @@ int main(int argc, char** argv) {
       return 1;
     }
     if (parser.isSet(exportGltf) && !window.exportGltf(parser.value(exportGltf)).isEmpty()) return 1;
-    QApplication::processEvents();
-    const QString file = parser.value(screenshot);
-    if (!window.grabWindow().save(file, "PNG")) {
-      std::fprintf(stderr, "pneuma: cannot write screenshot '%s'\n", qPrintable(file));
-      return 1;
-    }
-    return 0;
+    return saveScreenshot();
   }
-  if (hasModel) window.play();
+  if (hasModel && !isPlayback) window.play();
   if (parser.isSet(measure)) {
     // report what the status bar shows after the given wall time
     QTimer::singleShot(static_cast<int>(1000.0 * measureSeconds), &window, [&window] {

@@ -259,6 +259,7 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkScalarBarActor> skinBar = makeScalarBar(skinTable, "Skin\ndisplacement\n[mm]", 0.31);
   // "motion x5" at the top left of the view while the motion is magnified
   vtkSmartPointer<vtkTextActor> motionText = vtkSmartPointer<vtkTextActor>::New();
+  std::string playback;  // the affect of the morph playback on show; empty: the physics
   DisplayOptions options;
 
   sim::Model model;
@@ -327,6 +328,7 @@ struct ModelScene::Impl {
     highlight = Pick{};
     resetAutoRange();
     referenceTime = std::numeric_limits<double>::quiet_NaN();
+    playback.clear();
   }
 
   std::vector<vtkProp*> ownedProps() const {
@@ -550,9 +552,9 @@ struct ModelScene::Impl {
   void resetAutoRange() { muscleTop = gutDisplacementTop = gutPressureTop = skinTop = 0.0; }
 
   std::string motionCaption() const {
-    if (options.magnification == 1.0) return {};
     std::ostringstream out;
-    out << "motion \u00d7" << options.magnification;
+    if (!playback.empty()) out << "morph playback: " << playback << ", no physics";
+    if (options.magnification != 1.0) out << (playback.empty() ? "" : " \u00b7 ") << "motion \u00d7" << options.magnification;
     return out.str();
   }
 
@@ -603,7 +605,17 @@ struct ModelScene::Impl {
     }
     skinBar->SetVisibility(isSkinShown && isSkinColoured);
     motionText->SetInput(motionCaption().c_str());
-    motionText->SetVisibility(options.magnification != 1.0);
+    motionText->SetVisibility(!motionCaption().empty());
+    // morph playback: the skin alone, opaque and plain; everything the physics moves is hidden
+    if (!playback.empty()) {
+      for (vtkProp* prop : ownedProps()) prop->SetVisibility(prop == skinActor.GetPointer());
+      for (vtkProp* bar : {forceBar.GetPointer(), gutBar.GetPointer(), skinBar.GetPointer()})
+        bar->SetVisibility(false);
+      if (skinActor) {
+        skinActor->GetProperty()->SetOpacity(1.0);
+        skinActor->GetMapper()->SetScalarVisibility(false);
+      }
+    }
     for (const Label& l : labels) {
       const bool relevant = l.group >= 0      ? options.showGroup[static_cast<std::size_t>(l.group)]
                             : l.landmark >= 0 ? options.showLandmarks
@@ -826,6 +838,18 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
 const sim::PosedGeometry& ModelScene::posed() const { return m_impl->posed; }
 
 std::string ModelScene::motionCaption() const { return m_impl->motionCaption(); }
+
+void ModelScene::setMorphPlayback(const std::string& affect) {
+  m_impl->playback = affect;
+  m_impl->applyOptions();
+}
+
+const std::string& ModelScene::morphPlayback() const { return m_impl->playback; }
+
+void ModelScene::updateMorphPlayback(const Eigen::Matrix3Xd& base, const Eigen::Matrix3Xd& displacement) {
+  if (!m_impl->skin || base.cols() != m_impl->skin->GetNumberOfPoints()) return;
+  Impl::setPoints(m_impl->skin, base + m_impl->options.magnification * displacement);
+}
 
 void ModelScene::setOptions(const DisplayOptions& options) {
   if (options.isAutoRange != m_impl->options.isAutoRange) m_impl->resetAutoRange();

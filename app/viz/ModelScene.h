@@ -137,8 +137,21 @@ class ModelScene {
 
   /// The geometry as drawn by the last update() (magnified) [m].
   const sim::PosedGeometry& posed() const;
-  /// The caption the view shows for the magnification ("motion \u00d75"; empty at 1x).
+  /// The caption the view shows: the morph playback, if on, and the magnification ("morph playback: panic, no
+  /// physics \u00b7 motion \u00d75"; "motion \u00d75"; empty at 1x without playback).
   std::string motionCaption() const;
+
+  /// Morph playback (de Melo et al. 2010, docs/app.md): with a non-empty `affect` the view shows the skin
+  /// alone, opaque and plain, and hides the bones, muscles, gut, lungs, landmarks, labels and colour bars
+  /// (they are not moved by the playback); the caption names the affect. Empty: back to the physics view
+  /// (the next update() moves the skin back).
+  void setMorphPlayback(const std::string& affect);
+  /// The affect of the morph playback on show; empty when the physics is shown.
+  const std::string& morphPlayback() const;
+  /// Moves the skin to base + magnification x displacement (both 3 x #V [m], posed by sim::poseGeometry():
+  /// sim::MorphTargets::base and the blend's displacement sum_k w_k D_k). Ignored when the sizes differ
+  /// from the model's skin.
+  void updateMorphPlayback(const Eigen::Matrix3Xd& base, const Eigen::Matrix3Xd& displacement);
 
   /// Applies display options (visibility, colouring, translucency).
   void setOptions(const DisplayOptions& options);

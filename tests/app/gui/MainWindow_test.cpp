@@ -25,6 +25,9 @@
 #include <QSvgRenderer>
 #include <QTextStream>
 #include <QTimer>
+#include <QElapsedTimer>
+#include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <set>
 
@@ -36,6 +39,8 @@
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
+#include "pneuma/sim/MorphTargets.h"
+#include "pneuma/sim/pattern/Pattern.h"
 #include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
@@ -917,4 +922,85 @@ TEST(App, WithoutADisplayExplainsAndExitsTwo) {
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("no display"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pneuma-cli"), std::string::npos) << r.err;
+}
+
+namespace {
+
+// pixels of a 3D-view grab that belong to a drawn body: redder than blue (the backdrop is blue-grey)
+std::vector<bool> bodyMask(const QImage& image) {
+  std::vector<bool> mask;
+  mask.reserve(static_cast<std::size_t>(image.width() * image.height()));
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const QColor c = image.pixelColor(x, y);
+      mask.push_back(c.red() > c.blue() + 20);
+    }
+  return mask;
+}
+
+void waitMs(int ms) {
+  QElapsedTimer clock;
+  clock.start();
+  while (clock.elapsed() < ms) QApplication::processEvents(QEventLoop::AllEvents, 10);
+}
+
+}  // namespace
+
+// de Melo's morph playback: the physics pauses, the caption says so, and the skin driven by the pattern
+// alone breathes: its drawn silhouette at the pattern's end-inspiration differs from its end-expiration,
+// half a breath earlier (both found by playing the same pattern on the same targets, sim::MorphPlayer);
+// off again, the physics' instant comes back, not advanced
+TEST_F(DefaultModelWindow, MorphPlaybackBreathesTheSkinWithThePhysicsPaused) {
+  ASSERT_TRUE(window.morphPlaybackAction()->isEnabled());
+  window.play();
+  ASSERT_EQ(window.setMorphPlayback(true), QString());
+  EXPECT_TRUE(window.isMorphPlayback());
+  EXPECT_TRUE(window.morphPlaybackAction()->isChecked());
+  const std::vector<std::string> texts = shownTexts(window.scene().renderer());
+  EXPECT_NE(std::find(texts.begin(), texts.end(), "morph playback: neutral, no physics \u00b7 motion \u00d75"),
+            texts.end());
+
+  // the end-expiration and end-inspiration of the second breath, from the weights' sum
+  const std::shared_ptr<const sim::MorphTargets> morphs = window.morphTargets();
+  ASSERT_NE(morphs, nullptr);
+  sim::MorphPlayer player(sim::pattern::loadAffect("neutral", sim::resourceDir()), 0);
+  double low = 1e9, high = -1e9, tLow = 0.0, tHigh = 0.0;
+  for (double t = 0.0; t < 12.0; t += 0.05) {
+    const double a = player.weightsAt(*morphs, t).sum();
+    if (t > 4.0 && a < low) std::tie(low, tLow) = std::make_pair(a, t);
+    if (t > 4.0 && a > high) std::tie(high, tHigh) = std::make_pair(a, t);
+  }
+  ASSERT_GT(high, low + 0.1) << "the neutral breath moves the weights";
+  window.showMorphPlaybackAt(std::min(tLow, tHigh));
+  const std::vector<bool> first = bodyMask(window.grabView());
+  window.showMorphPlaybackAt(std::max(tLow, tHigh));
+  const std::vector<bool> second = bodyMask(window.grabView());
+  int moved = 0, body = 0;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    moved += first[i] != second[i];
+    body += first[i];
+  }
+  EXPECT_GT(body, static_cast<int>(first.size()) / 10) << "the skin covers the view's middle";
+  EXPECT_GT(moved, 1000) << "the silhouette moves between end-expiration and end-inspiration";
+
+  // the physics stayed paused
+  waitMs(300);
+  ASSERT_EQ(window.setMorphPlayback(false), QString());
+  EXPECT_FALSE(window.morphPlaybackAction()->isChecked());
+  waitMs(300);
+  ASSERT_NE(window.shown(), nullptr);
+  const double paused = window.shown()->state.time;
+  waitMs(500);
+  EXPECT_EQ(window.shown()->state.time, paused);
+  for (const std::string& text : shownTexts(window.scene().renderer()))
+    EXPECT_EQ(text.find("morph playback"), std::string::npos) << text;
+}
+
+TEST(MainWindow, MorphPlaybackOfAModelWithoutSkinIsDisabledWithTheReason) {
+  ToyWindow w;
+  EXPECT_FALSE(w.window.morphPlaybackAction()->isEnabled());
+  EXPECT_TRUE(w.window.morphPlaybackAction()->toolTip().contains("needs a skin")) <<
+      w.window.morphPlaybackAction()->toolTip().toStdString();
+  EXPECT_TRUE(w.window.setMorphPlayback(true).contains("has no skin"));
+  EXPECT_FALSE(w.window.isMorphPlayback());
 }

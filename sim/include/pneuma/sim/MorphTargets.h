@@ -21,6 +21,8 @@
 #include <vector>
 
 #include "pneuma/sim/Model.h"
+#include "pneuma/sim/pattern/LayerStack.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 namespace pneuma::sim {
 
@@ -87,5 +89,23 @@ class MorphFit {
 /// the shapes are ordered by their ribCageShare and a is split between the two whose shares enclose b,
 /// linearly in b (all to the nearest one outside their range). @return one weight per target [-].
 Eigen::VectorXd patternWeights(const MorphTargets& targets, double fraction, double balance);
+
+/// de Melo's real-time playback of a pattern on the targets, as a game engine plays it: the pattern's layer
+/// stack sampled at increasing times, its balance b smoothed first-order as the physics controller smooths it
+/// (b += (b_layer - b) (1 - exp(-dt / tau)), tau = PatternControllerOptions::balanceTimeConstant), and
+/// patternWeights() of the two. No physics. Used by `pneuma-cli play` and the app's morph playback.
+class MorphPlayer {
+ public:
+  /// Plays `pattern` (seeded irregularity `seed`) from t = 0, starting from the rest volume (fraction 0.05).
+  MorphPlayer(const pattern::Pattern& pattern, std::uint64_t seed);
+  /// [-] one weight per target of `targets` at time `t` [s] (t >= 0, not decreasing between calls).
+  /// @throws Error when t decreases or is not finite.
+  Eigen::VectorXd weightsAt(const MorphTargets& targets, double t);
+
+ private:
+  pattern::LayerStack m_stack;
+  double m_balance = 0.0;  // [-] smoothed balance
+  double m_time = -1.0;    // [s] of the last call; < 0 before the first
+};
 
 }  // namespace pneuma::sim
