@@ -243,6 +243,12 @@ int main(int argc, char** argv) {
     // report what the status bar shows after the given wall time
     QTimer::singleShot(static_cast<int>(1000.0 * measureSeconds), &window, [&window] {
       const auto* shown = window.shown();
+      if (window.isMorphPlayback()) {
+        std::printf("morph playback: 3D view %.1f fps (%.1f ms per render), no physics\n", window.renderFps(),
+                    window.renderMilliseconds());
+        QApplication::exit(0);
+        return;
+      }
       std::printf(
           "3D view %.1f fps (%.1f ms per render), plots %.1f Hz, real-time factor %.2f, simulated %.2f s\n",
           window.renderFps(), window.renderMilliseconds(), window.plotRate(),
