@@ -732,13 +732,14 @@ void MainWindow::updatePlaybackAction() {
   const sim::Model* m = model();
   const bool hasSkin = m && m->skin.vertexCount() > 0;
   m_playbackAction->setEnabled(hasSkin);
-  m_playbackAction->setToolTip(
-      hasSkin ? "Play the toolbar's affect on the skin's baked morph targets alone, without physics "
-                "(de Melo et al. 2010)"
-      : m     ? QString("Morph playback needs a skin: model '%1' has none (rebuild it with pneuma-cli model "
-                        "build)")
-                    .arg(QString::fromStdString(m->name))
-              : QString("Morph playback needs a model with a skin: no model is open"));
+  QString tip =
+      "Play the toolbar's affect on the skin's baked morph targets alone, without physics (de Melo "
+      "et al. 2010)";
+  if (!m) tip = "Morph playback needs a model with a skin: no model is open";
+  if (m && !hasSkin)
+    tip = QString("Morph playback needs a skin: model '%1' has none (rebuild it with pneuma-cli model build)")
+              .arg(QString::fromStdString(m->name));
+  m_playbackAction->setToolTip(tip);
 }
 
 QString MainWindow::setMorphPlayback(bool isOn) {

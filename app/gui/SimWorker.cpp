@@ -322,7 +322,7 @@ void SimWorker::exportGltf(const GltfRequest& request) {
   QString error;
   try {
     const sim::Recorder& rec = m_sim->recorder();
-    if (m_model->skin.vertexCount() == 0) bake();  // throws: no skin
+    if (m_model->skin.vertexCount() == 0) bake();  // the no-skin error before any other (bake() throws it)
     if (!request.isBakeOnly && rec.size() < 2)
       throw std::runtime_error("nothing recorded yet: run the simulation first");
     viz::AtomicFileWriter probe(request.path);  // a folder that cannot be written fails before the bake
@@ -347,7 +347,8 @@ void SimWorker::exportGltf(const GltfRequest& request) {
 
 void SimWorker::bake() {
   if (m_model->skin.vertexCount() == 0)
-    throw std::runtime_error("model '" + m_model->name + "' has no skin (rebuild it with pneuma-cli model build)");
+    throw std::runtime_error("model '" + m_model->name +
+                             "' has no skin (rebuild it with pneuma-cli model build)");
   if (m_morphs) return;
   emit status("Baking morph targets from deep, panting and supine runs (a few seconds)\u2026");
   auto morphs = std::make_shared<const sim::MorphTargets>(sim::bakeMorphTargets(m_model, sim::resourceDir()));

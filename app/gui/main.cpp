@@ -107,8 +107,9 @@ int main(int argc, char** argv) {
       "measure", "Run for SECONDS of wall time, print render fps and real-time factor, exit.", "SECONDS");
   const QCommandLineOption morphPlayback(
       "morph-playback",
-      "Show the morph playback of the --affect (default neutral) instead of the physics: the skin on its baked "
-      "morph targets, no physics (de Melo et al. 2010). With --screenshot, --after is the pattern time.");
+      "Show the morph playback of the --affect (default neutral) instead of the physics: the skin on its "
+      "baked morph targets, no physics (de Melo et al. 2010). With --screenshot, --after is the pattern "
+      "time.");
   parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
                      screenshot, after, exportGltf, measure, morphPlayback});
   if (!parser.parse(arguments)) {

@@ -554,7 +554,8 @@ struct ModelScene::Impl {
   std::string motionCaption() const {
     std::ostringstream out;
     if (!playback.empty()) out << "morph playback: " << playback << ", no physics";
-    if (options.magnification != 1.0) out << (playback.empty() ? "" : " \u00b7 ") << "motion \u00d7" << options.magnification;
+    if (options.magnification != 1.0)
+      out << (playback.empty() ? "" : " \u00b7 ") << "motion \u00d7" << options.magnification;
     return out.str();
   }
 

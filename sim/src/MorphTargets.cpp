@@ -174,17 +174,17 @@ Eigen::VectorXd patternWeights(const MorphTargets& targets, double fraction, dou
   return w;
 }
 
-
 MorphPlayer::MorphPlayer(const pattern::Pattern& pattern, std::uint64_t seed)
     : m_stack(pattern::makeLayerStack(pattern, seed)) {
   m_stack.setStartVolume(0.05);
 }
 
 Eigen::VectorXd MorphPlayer::weightsAt(const MorphTargets& targets, double t) {
-  const double v = m_stack.sample(t);  // throws when t decreases
+  const double v = m_stack.sample(t);                                          // throws when t decreases
   const double tau = pattern::PatternControllerOptions{}.balanceTimeConstant;  // [s]
-  m_balance = m_time < 0.0 ? m_stack.balance()
-                           : m_balance + (m_stack.balance() - m_balance) * (1.0 - std::exp(-(t - m_time) / tau));
+  m_balance = m_time < 0.0
+                  ? m_stack.balance()
+                  : m_balance + (m_stack.balance() - m_balance) * (1.0 - std::exp(-(t - m_time) / tau));
   m_time = t;
   return patternWeights(targets, v, m_balance);
 }

@@ -16,6 +16,7 @@
 #include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
+#include <QElapsedTimer>
 #include <QFile>
 #include <QLabel>
 #include <QLineEdit>
@@ -25,11 +26,10 @@
 #include <QSvgRenderer>
 #include <QTextStream>
 #include <QTimer>
-#include <QElapsedTimer>
 #include <algorithm>
-#include <tuple>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include "../cli/CliRunner.h"
 #include "GuiTestSupport.h"
@@ -40,10 +40,10 @@
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/MorphTargets.h"
-#include "pneuma/sim/pattern/Pattern.h"
 #include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/pattern/Pattern.h"
 #include "viz/GltfWriter.h"
 
 using namespace pneuma;
@@ -957,8 +957,9 @@ TEST_F(DefaultModelWindow, MorphPlaybackBreathesTheSkinWithThePhysicsPaused) {
   EXPECT_TRUE(window.isMorphPlayback());
   EXPECT_TRUE(window.morphPlaybackAction()->isChecked());
   const std::vector<std::string> texts = shownTexts(window.scene().renderer());
-  EXPECT_NE(std::find(texts.begin(), texts.end(), "morph playback: neutral, no physics \u00b7 motion \u00d75"),
-            texts.end());
+  EXPECT_NE(
+      std::find(texts.begin(), texts.end(), "morph playback: neutral, no physics \u00b7 motion \u00d75"),
+      texts.end());
 
   // the end-expiration and end-inspiration of the second breath, from the weights' sum
   const std::shared_ptr<const sim::MorphTargets> morphs = window.morphTargets();
@@ -999,8 +1000,8 @@ TEST_F(DefaultModelWindow, MorphPlaybackBreathesTheSkinWithThePhysicsPaused) {
 TEST(MainWindow, MorphPlaybackOfAModelWithoutSkinIsDisabledWithTheReason) {
   ToyWindow w;
   EXPECT_FALSE(w.window.morphPlaybackAction()->isEnabled());
-  EXPECT_TRUE(w.window.morphPlaybackAction()->toolTip().contains("needs a skin")) <<
-      w.window.morphPlaybackAction()->toolTip().toStdString();
+  EXPECT_TRUE(w.window.morphPlaybackAction()->toolTip().contains("needs a skin"))
+      << w.window.morphPlaybackAction()->toolTip().toStdString();
   EXPECT_TRUE(w.window.setMorphPlayback(true).contains("has no skin"));
   EXPECT_FALSE(w.window.isMorphPlayback());
 }
