@@ -81,7 +81,8 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
   }
   const int given =
       !a.style.empty() + !a.affect.empty() + !a.pattern.empty() + !a.trace.empty() + !a.scenario.empty();
-  if (given != 1) fail(kExitBadInput, "give exactly one of --style, --affect, --pattern, --trace or --scenario");
+  if (given != 1)
+    fail(kExitBadInput, "give exactly one of --style, --affect, --pattern, --trace or --scenario");
   if (!a.style.empty()) s.controller = sim::ControllerKind::Style, s.controllerName = a.style;
   if (!a.affect.empty()) s.controller = sim::ControllerKind::Affect, s.controllerName = a.affect;
   if (!a.pattern.empty()) s.controller = sim::ControllerKind::Pattern, s.controllerName = a.pattern;
@@ -209,7 +210,8 @@ void runSimulate(const SimulateArgs& args) {
     try {
       simulation->advance(total, [&](const sim::Simulation& s) {
         if (s.controller().tracksVolume())
-          record.append(s.latestMetrics(), s.controller().targetFraction(), s.controller().measuredFraction());
+          record.append(s.latestMetrics(), s.controller().targetFraction(),
+                        s.controller().measuredFraction());
         else
           record.append(s.latestMetrics());
         if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());

@@ -275,11 +275,12 @@ std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared
     return std::make_unique<BreathStyleController>(styleOf(scenario, resourceDir));
   // parse the pattern or trace first (cheap, reports bad names and fields), then calibrate the drive
   const auto calibrate = [&] {
-    return pattern::calibrateDrive(std::move(model), scenario.options, pattern::DriveCalibration{}.contractionR,
-                                   stop);
+    return pattern::calibrateDrive(std::move(model), scenario.options,
+                                   pattern::DriveCalibration{}.contractionR, stop);
   };
   if (scenario.controller == ControllerKind::Trace) {
-    pattern::VolumeTrace trace = named(scenario, [&] { return pattern::loadVolumeTrace(scenario.controllerName); });
+    pattern::VolumeTrace trace =
+        named(scenario, [&] { return pattern::loadVolumeTrace(scenario.controllerName); });
     return std::make_unique<pattern::PatternController>(std::move(trace), calibrate());
   }
   const pattern::Pattern p = patternOf(scenario, resourceDir);

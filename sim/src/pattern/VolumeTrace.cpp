@@ -109,16 +109,25 @@ VolumeTrace parseVolumeTrace(const std::string& text, const std::string& sourceN
         col.index = c, col.header = h;
         const auto close = h.find(']', open == std::string::npos ? 0 : open);
         if (open == std::string::npos || close == std::string::npos)
-          throw Error(where(lineNo, col) + "missing unit (write '" + name + (isTime ? " [s]'" : " [L]' or '" + name + " [mL]'") + ")");
+          throw Error(where(lineNo, col) + "missing unit (write '" + name +
+                      (isTime ? " [s]'" : " [L]' or '" + name + " [mL]'") + ")");
         const std::string unit = trim(h.substr(open + 1, close - open - 1));
         if (isTime && unit == "s") continue;
-        if (isVolume && unit == "L") { col.toSi = 1e-3; continue; }
-        if (isVolume && unit == "mL") { col.toSi = 1e-6; continue; }
+        if (isVolume && unit == "L") {
+          col.toSi = 1e-3;
+          continue;
+        }
+        if (isVolume && unit == "mL") {
+          col.toSi = 1e-6;
+          continue;
+        }
         throw Error(where(lineNo, col) + "unknown unit '" + excerptOf(unit) + "' (use " +
                     (isTime ? "s" : "L or mL") + ")");
       }
       if (time.index < 0 || vol.index < 0)
-        throw Error(sourceName + ":" + std::to_string(lineNo) + ": header needs a 'time [s]' and a 'volume [L]' (or [mL]) column, got '" + excerptOf(trimmed) + "'");
+        throw Error(sourceName + ":" + std::to_string(lineNo) +
+                    ": header needs a 'time [s]' and a 'volume [L]' (or [mL]) column, got '" +
+                    excerptOf(trimmed) + "'");
       continue;
     }
     double value[2];
@@ -148,13 +157,15 @@ VolumeTrace parseVolumeTrace(const std::string& text, const std::string& sourceN
     lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
     if (hi - lo > kMaxTraceSwing)
       throw Error(where(rowLine[i], vol) + "volume swing " + std::to_string((hi - lo) * 1e3) +
-                  " L exceeds the " + std::to_string(kMaxTraceSwing * 1e3).substr(0, 3) + " L a lung can hold");
+                  " L exceeds the " + std::to_string(kMaxTraceSwing * 1e3).substr(0, 3) +
+                  " L a lung can hold");
   }
 
   // 1. resample: the mean of the rows' piecewise-linear curve over each step's window [s - h/2, s + h/2]
   // (held beyond the ends), through its running integral C(x) = integral from t_0 to x of V
   std::vector<double> area(t.size(), 0.0);  // [m^3 s] C(t_i)
-  for (std::size_t i = 1; i < t.size(); ++i) area[i] = area[i - 1] + 0.5 * (v[i] + v[i - 1]) * (t[i] - t[i - 1]);
+  for (std::size_t i = 1; i < t.size(); ++i)
+    area[i] = area[i - 1] + 0.5 * (v[i] + v[i - 1]) * (t[i] - t[i - 1]);
   const auto integral = [&](double x) {
     if (x <= t.front()) return (x - t.front()) * v.front();
     if (x >= t.back()) return area.back() + (x - t.back()) * v.back();

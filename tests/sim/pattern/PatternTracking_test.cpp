@@ -149,7 +149,8 @@ namespace {
 double followTrace(VolumeTrace trace) {
   SimulationOptions options;
   const double duration = trace.duration();
-  Simulation sim(defaultModel(), std::make_unique<PatternController>(std::move(trace), calibration()), options);
+  Simulation sim(defaultModel(), std::make_unique<PatternController>(std::move(trace), calibration()),
+                 options);
   sim.advance(options.settleTime + duration);
   return sim.controller().trackingRmsPercent();
 }
@@ -167,7 +168,8 @@ TEST(TraceTracking, FollowsTheModelsOwnCalmBreathingPlayedBack) {
   REQUIRE_DEFAULT_MODEL();
   // record calm breathing as timeseries.csv writes it (time [s], lung volume [mL] at the output frames)
   SimulationOptions options;
-  Simulation calm(defaultModel(), std::make_unique<BreathStyleController>(loadBreathStyle("calm", kResources + "/presets")),
+  Simulation calm(defaultModel(),
+                  std::make_unique<BreathStyleController>(loadBreathStyle("calm", kResources + "/presets")),
                   options);
   calm.advance(options.settleTime + 16.0);
   std::ostringstream csv;
@@ -175,7 +177,8 @@ TEST(TraceTracking, FollowsTheModelsOwnCalmBreathingPlayedBack) {
   csv << "time [s],lung_volume [mL]\n";
   const Trace& recorded = calm.trace();
   for (std::size_t i = 0; i < recorded.size(); ++i)
-    if (recorded.time[i] >= options.settleTime) csv << recorded.time[i] << "," << recorded.lungVolume[i] * 1e6 << "\n";
+    if (recorded.time[i] >= options.settleTime)
+      csv << recorded.time[i] << "," << recorded.lungVolume[i] * 1e6 << "\n";
   const double rms = followTrace(parseVolumeTrace(csv.str(), "calm", kDriveTimeStep));
   RecordProperty("tracking_rms_pct", std::to_string(rms));
   EXPECT_LT(rms, 5.0);

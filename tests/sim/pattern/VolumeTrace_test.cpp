@@ -1,5 +1,7 @@
 // Unit: reading and preparing a measured volume trace (VolumeTrace.h): units, resampling, the zero-phase
 // low-pass, the offset to the minimum, and one-line errors naming the line and column.
+#include "pneuma/sim/pattern/VolumeTrace.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +9,6 @@
 #include <string>
 
 #include "pneuma/sim/Error.h"
-#include "pneuma/sim/pattern/VolumeTrace.h"
 
 using namespace pneuma::sim;
 using namespace pneuma::sim::pattern;
@@ -22,7 +23,8 @@ std::string csv(const char* unit, double rate, double seconds, F f) {
   std::ostringstream out;
   out.precision(12);
   out << "time [s],volume [" << unit << "]\n";
-  for (int k = 0; k <= static_cast<int>(std::round(seconds * rate)); ++k) out << k / rate << "," << f(k / rate) << "\n";
+  for (int k = 0; k <= static_cast<int>(std::round(seconds * rate)); ++k)
+    out << k / rate << "," << f(k / rate) << "\n";
   return out.str();
 }
 
@@ -70,12 +72,16 @@ TEST(VolumeTrace, RejectsBadInputNamingTheLineAndColumn) {
   EXPECT_EQ(errorOf(ok), "");
   EXPECT_EQ(errorOf("time [s],volume [L]\n0,2.4\n0.5,2.6\n0.5,2.4\n"),
             "t.csv:4: column 1 'time [s]': time must increase, got 0.5 after line 3");
-  EXPECT_EQ(errorOf("time,volume [L]\n0,2.4\n1,2.5\n"), "t.csv:1: column 1 'time': missing unit (write 'time [s]')");
+  EXPECT_EQ(errorOf("time,volume [L]\n0,2.4\n1,2.5\n"),
+            "t.csv:1: column 1 'time': missing unit (write 'time [s]')");
   EXPECT_EQ(errorOf("time [s],volume [cc]\n0,2.4\n1,2.5\n"),
             "t.csv:1: column 2 'volume [cc]': unknown unit 'cc' (use L or mL)");
-  EXPECT_EQ(errorOf("time [s],volume [L]\n0,2.4\n1,nan\n"), "t.csv:3: column 2 'volume [L]': not a finite number: 'nan'");
-  EXPECT_EQ(errorOf("time [s],volume [L]\n0,2.4\n1,-0.1\n"), "t.csv:3: column 2 'volume [L]': negative volume -0.1");
-  EXPECT_NE(errorOf("time [s],volume [L]\n0,0.5\n1,2.5\n2,6.0\n").find("t.csv:4: column 2 'volume [L]': volume swing 5.5"),
+  EXPECT_EQ(errorOf("time [s],volume [L]\n0,2.4\n1,nan\n"),
+            "t.csv:3: column 2 'volume [L]': not a finite number: 'nan'");
+  EXPECT_EQ(errorOf("time [s],volume [L]\n0,2.4\n1,-0.1\n"),
+            "t.csv:3: column 2 'volume [L]': negative volume -0.1");
+  EXPECT_NE(errorOf("time [s],volume [L]\n0,0.5\n1,2.5\n2,6.0\n")
+                .find("t.csv:4: column 2 'volume [L]': volume swing 5.5"),
             std::string::npos);
   EXPECT_NE(errorOf("t [s],v [L]\n0,1\n1,2\n").find("t.csv:1: header needs"), std::string::npos);
   EXPECT_NE(errorOf("time [s],volume [L]\n0,2.4\n").find("at least two rows"), std::string::npos);

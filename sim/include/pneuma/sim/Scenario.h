@@ -90,9 +90,9 @@ void checkController(const Scenario& scenario, const std::string& resourceDir);
 
 /// The controller a scenario asks for: a BreathStyleController for a style (presets in
 /// `resourceDir`/presets), or a pattern::PatternController for an affect (`resourceDir`/presets/affect)
-/// or a pattern, or following a volume trace (VolumeTrace.h), seeded with `scenario.seed` and calibrated on `model` with pattern::calibrateDrive()
-/// (a few simulated seconds per muscle group) under `scenario.options`; `stop` (may be null) stops the
-/// calibration (Simulation::setStopFlag()).
+/// or a pattern, or following a volume trace (VolumeTrace.h), seeded with `scenario.seed` and calibrated on
+/// `model` with pattern::calibrateDrive() (a few simulated seconds per muscle group) under
+/// `scenario.options`; `stop` (may be null) stops the calibration (Simulation::setStopFlag()).
 /// @throws Error "controller.<kind>: <reason>", listing the valid names for an unknown style or affect;
 ///         Interrupted when `*stop` became true during the calibration.
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,

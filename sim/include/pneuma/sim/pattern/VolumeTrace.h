@@ -10,8 +10,9 @@
 ///
 /// Preparation, in this order:
 ///  1. resampling to the drive's step h = kDriveTimeStep (100 Hz): sample k (time k h after the first row) is
-///     the mean of the rows' piecewise-linear curve over [k h - h/2, k h + h/2] (a box anti-alias filter for a
-///     denser recording; for a sparser one, nearly linear interpolation: a 10 ms box keeps 99.98 % of 1 Hz);
+///     the mean of the rows' piecewise-linear curve over [k h - h/2, k h + h/2] (a box anti-alias filter for
+///     a denser recording; for a sparser one, nearly linear interpolation: a 10 ms box keeps 99.98 % of 1
+///     Hz);
 ///  2. a zero-phase low-pass: a second-order Butterworth (bilinear transform, cut-off kTraceCutoff) run
 ///     forwards then backwards, so the filtered curve has no lag; |H(f)|^2 = 1 / (1 + (f / f_c)^4);
 ///  3. offset: volumes are stored relative to the filtered curve's minimum, which the controller places at
@@ -33,9 +34,9 @@ inline constexpr double kMaxTraceSwing = 5e-3;
 
 /// A trace ready to follow: uniform samples relative to the trace's minimum.
 struct VolumeTrace {
-  std::string name;              ///< for display, e.g. the file name
-  double timeStep = 0.01;        ///< [s] h, the sample spacing
-  std::vector<double> volume;    ///< [m^3] V(k h) - min V, k = 0 .. n-1; time 0 is the first row's time
+  std::string name;            ///< for display, e.g. the file name
+  double timeStep = 0.01;      ///< [s] h, the sample spacing
+  std::vector<double> volume;  ///< [m^3] V(k h) - min V, k = 0 .. n-1; time 0 is the first row's time
   /// [m^3] volume above the minimum at time t [s], linear between samples, held beyond both ends.
   double sample(double t) const;
   /// [s] time of the last sample.
