@@ -15,8 +15,8 @@
 
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Metrics.h"
-#include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/MorphTargets.h"
+#include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/pattern/PatternController.h"
