@@ -167,7 +167,7 @@ class PySimulation {
     d["abdomen_tidal"] = m.abdomenTidal;
     d["rib_cage_fraction"] = m.ribCageShare();
     d["rc_ab_phase"] = m.phaseAngle;
-    d["tracking_rms_pct"] = m_pattern != nullptr ? m_pattern->tracking().rmsPercentOfPeakToPeak() : sim::kNaN;
+    d["tracking_rms_pct"] = m_sim->controller().trackingRmsPercent();
     d["real_time_factor"] = s.realTimeFactor;
     d["steps"] = s.steps;
     d["dt"] = s.dt;
@@ -183,8 +183,8 @@ class PySimulation {
     m_frames.lungVolume.push_back(m.lungVolume);
     m_frames.abdomenVolume.push_back(m.abdomenVolume);
     m_frames.gutVolumeError.push_back(m.gutVolumeError);
-    m_frames.target.push_back(m_pattern != nullptr ? m_pattern->targetFraction() : sim::kNaN);
-    m_frames.measured.push_back(m_pattern != nullptr ? m_pattern->measuredFraction() : sim::kNaN);
+    m_frames.target.push_back(m_sim->controller().targetFraction());
+    m_frames.measured.push_back(m_sim->controller().measuredFraction());
     for (const sim::GroupActivation& g : m.activations) {
       m_frames.alpha.push_back(g.alpha);
       m_frames.r.push_back(g.r);

@@ -2,6 +2,7 @@
 /// `pneuma-cli simulate`: one run of a breath style, an affect, a pattern file or a scenario file.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -36,7 +37,7 @@ namespace fs = std::filesystem;
 /// the scenario's or the default value).
 struct SimulateArgs {
   std::string model;
-  std::string style, affect, scenario, pattern;
+  std::string style, affect, scenario, pattern, trace;
   double duration = 0.0;  // [s]
   std::string out;
   std::string gltf;         // .glb of the run (skin morph weights and bones), "" for none
@@ -78,11 +79,14 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
       fail(kExitBadInput, e.what());
     }
   }
-  const int given = !a.style.empty() + !a.affect.empty() + !a.pattern.empty() + !a.scenario.empty();
-  if (given != 1) fail(kExitBadInput, "give exactly one of --style, --affect, --pattern or --scenario");
+  const int given =
+      !a.style.empty() + !a.affect.empty() + !a.pattern.empty() + !a.trace.empty() + !a.scenario.empty();
+  if (given != 1)
+    fail(kExitBadInput, "give exactly one of --style, --affect, --pattern, --trace or --scenario");
   if (!a.style.empty()) s.controller = sim::ControllerKind::Style, s.controllerName = a.style;
   if (!a.affect.empty()) s.controller = sim::ControllerKind::Affect, s.controllerName = a.affect;
   if (!a.pattern.empty()) s.controller = sim::ControllerKind::Pattern, s.controllerName = a.pattern;
+  if (!a.trace.empty()) s.controller = sim::ControllerKind::Trace, s.controllerName = a.trace;
   if (s.name.empty()) s.name = s.controllerName.empty() ? "run" : fs::path(s.controllerName).stem().string();
   applySets(a.sets, s.options);
 
@@ -90,7 +94,14 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
     checkOption(sim::kDurationRange, "--duration", a.duration);
     s.duration = a.duration;
   }
-  if (a.scenario.empty() && !a.isGiven("--duration"))
+  // a trace runs for its own length unless told otherwise
+  if (!a.trace.empty() && !a.isGiven("--duration")) {
+    try {
+      s.duration = std::max(sim::pattern::loadVolumeTrace(a.trace).duration(), sim::kDurationRange.lo);
+    } catch (const sim::Error& e) {
+      fail(kExitBadInput, std::string("--trace: ") + e.what());
+    }
+  } else if (a.scenario.empty() && !a.isGiven("--duration"))
     fail(kExitBadInput, "--duration is required (simulated seconds)");
   if (a.isGiven("--output-rate")) {
     checkOption(sim::kOutputRateRange, "--output-rate", a.outputRate);
@@ -198,9 +209,9 @@ void runSimulate(const SimulateArgs& args) {
     ProgressBar bar(scenario.name, total);
     try {
       simulation->advance(total, [&](const sim::Simulation& s) {
-        const auto* pattern = dynamic_cast<const sim::pattern::PatternController*>(&s.controller());
-        if (pattern != nullptr)
-          record.append(s.latestMetrics(), pattern->targetFraction(), pattern->measuredFraction());
+        if (s.controller().tracksVolume())
+          record.append(s.latestMetrics(), s.controller().targetFraction(),
+                        s.controller().measuredFraction());
         else
           record.append(s.latestMetrics());
         if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());
@@ -284,10 +295,9 @@ void runSimulate(const SimulateArgs& args) {
   j["max_gut_volume_error_pct"] = ran ? jsonNumber(sum.maxGutVolumeError * 100.0) : none;
   j["mean_gut_volume_error_pct"] = ran ? jsonNumber(sum.meanGutVolumeError * 100.0) : none;
   writeMotion(sum.motion, j);
-  const auto* pattern =
-      simulation ? dynamic_cast<const sim::pattern::PatternController*>(&simulation->controller()) : nullptr;
-  j["tracking_rms_pct"] =
-      pattern != nullptr ? jsonNumber(pattern->tracking().rmsPercentOfPeakToPeak()) : none;
+  j["tracking_rms_pct"] = simulation && simulation->controller().tracksVolume()
+                              ? jsonNumber(simulation->controller().trackingRmsPercent())
+                              : none;
   const bool blended = gltf && gltf->frames() > 0;
   const sim::BlendError blend = blended ? gltf->error() : sim::BlendError{};
   j["morph_blend_rms_mm"] = blended ? jsonNumber(blend.rms * 1e3) : none;
@@ -340,8 +350,12 @@ void addSimulateCommand(CLI::App& app) {
       cmd->add_option("--affect", args->affect, "Affect preset (neutral, startle, ... see docs/cli.md)");
   cmd->add_option("--scenario", args->scenario, "Scenario file (JSON); other options override it");
   auto* pattern = cmd->add_option("--pattern", args->pattern, "Pattern file (JSON, docs/patterns.md)");
-  style->excludes(affect)->excludes(pattern);
-  affect->excludes(pattern);
+  auto* trace = cmd->add_option("--trace", args->trace,
+                                "Volume-against-time CSV to follow ('time [s],volume [L]' or [mL]; "
+                                "docs/patterns.md); --duration defaults to its length");
+  style->excludes(affect)->excludes(pattern)->excludes(trace);
+  affect->excludes(pattern)->excludes(trace);
+  pattern->excludes(trace);
   cmd->add_option("--duration", args->duration, "Simulated seconds after the settling phase (> 0)");
   cmd->add_option("--out", args->out, "Output directory (created if missing)")->required();
   cmd->add_flag("--force", args->force, "Replace the results of an earlier run in --out");

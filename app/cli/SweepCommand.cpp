@@ -129,7 +129,8 @@ sim::Sweep loadChecked(const SweepArgs& a) {
   for (sim::SweepVariant& v : sweep.variants) {
     sim::Scenario& s = v.scenario;
     if (s.model != "default") s.model = fs::absolute(s.model).lexically_normal().string();
-    if (s.controller == sim::ControllerKind::Pattern && s.patternText.empty())
+    if ((s.controller == sim::ControllerKind::Pattern && s.patternText.empty()) ||
+        s.controller == sim::ControllerKind::Trace)
       s.controllerName = fs::absolute(s.controllerName).lexically_normal().string();
   }
   return sweep;

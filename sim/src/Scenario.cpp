@@ -47,12 +47,16 @@ void parseGroupScales(const Field& f, std::array<double, kElementGroupCount>& ou
 }
 
 void parseController(const Field& c, const std::string& baseDir, Scenario& s) {
-  c.allowKeys({"style", "affect", "pattern"});
-  const int count = c.has("style") + c.has("affect") + c.has("pattern");
-  if (count != 1) c.fail("needs exactly one of \"style\", \"affect\" or \"pattern\"");
+  c.allowKeys({"style", "affect", "pattern", "trace"});
+  const int count = c.has("style") + c.has("affect") + c.has("pattern") + c.has("trace");
+  if (count != 1) c.fail("needs exactly one of \"style\", \"affect\", \"pattern\" or \"trace\"");
   if (c.has("style")) {
     s.controller = ControllerKind::Style;
     s.controllerName = c.at("style").string();
+  } else if (c.has("trace")) {
+    s.controller = ControllerKind::Trace;
+    s.controllerName = c.at("trace").string();
+    if (!s.controllerName.empty()) s.controllerName = resolve(s.controllerName, baseDir);
   } else if (c.has("affect")) {
     s.controller = ControllerKind::Affect;
     s.controllerName = c.at("affect").string();
@@ -122,6 +126,8 @@ const char* controllerKindName(ControllerKind k) {
       return "affect";
     case ControllerKind::Pattern:
       return "pattern";
+    case ControllerKind::Trace:
+      return "trace";
   }
   return "style";
 }
@@ -255,7 +261,9 @@ pattern::Pattern patternOf(const Scenario& s, const std::string& resourceDir) {
 }  // namespace
 
 void checkController(const Scenario& scenario, const std::string& resourceDir) {
-  if (scenario.controller == ControllerKind::Style)
+  if (scenario.controller == ControllerKind::Trace)
+    named(scenario, [&] { return pattern::loadVolumeTrace(scenario.controllerName); });
+  else if (scenario.controller == ControllerKind::Style)
     validateBreathStyle(styleOf(scenario, resourceDir));
   else
     patternOf(scenario, resourceDir);
@@ -265,11 +273,18 @@ std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared
                                            const std::string& resourceDir, const std::atomic<bool>* stop) {
   if (scenario.controller == ControllerKind::Style)
     return std::make_unique<BreathStyleController>(styleOf(scenario, resourceDir));
-  // parse the pattern first (cheap, reports bad names and fields), then calibrate the drive on the model
+  // parse the pattern or trace first (cheap, reports bad names and fields), then calibrate the drive
+  const auto calibrate = [&] {
+    return pattern::calibrateDrive(std::move(model), scenario.options,
+                                   pattern::DriveCalibration{}.contractionR, stop);
+  };
+  if (scenario.controller == ControllerKind::Trace) {
+    pattern::VolumeTrace trace =
+        named(scenario, [&] { return pattern::loadVolumeTrace(scenario.controllerName); });
+    return std::make_unique<pattern::PatternController>(std::move(trace), calibrate());
+  }
   const pattern::Pattern p = patternOf(scenario, resourceDir);
-  const pattern::DriveCalibration calibration = pattern::calibrateDrive(
-      std::move(model), scenario.options, pattern::DriveCalibration{}.contractionR, stop);
-  return pattern::makePatternController(p, scenario.seed, calibration);
+  return pattern::makePatternController(p, scenario.seed, calibrate());
 }
 
 void saveScenario(const Scenario& scenario, const std::string& path) {

@@ -232,6 +232,20 @@ PatternController::PatternController(LayerStack stack, DriveCalibration calibrat
   m_balance = m_stack.balance();
 }
 
+PatternController::PatternController(VolumeTrace trace, DriveCalibration calibration,
+                                     PatternControllerOptions options)
+    : PatternController(LayerStack(), calibration, options, trace.name) {
+  if (trace.volume.empty()) throw Error("trace '" + trace.name + "': no samples");
+  m_trace = std::make_shared<const VolumeTrace>(std::move(trace));
+}
+
+double PatternController::sampleTarget(double tau) {
+  if (!m_trace) return m_stack.sample(tau);
+  const double v = m_calibration.restFraction + m_trace->sample(tau) / m_calibration.volumePerFraction;
+  const double s = std::clamp(tau / kTraceBlend, 0.0, 1.0), w = 1.0 - s * s * (3.0 - 2.0 * s);  // smoothstep
+  return w * m_traceStart + (1.0 - w) * v;
+}
+
 double PatternController::volumeToFraction(double volume) const {
   return m_calibration.restFraction + (volume - m_calibration.restVolume) / m_calibration.volumePerFraction;
 }
@@ -251,7 +265,7 @@ void PatternController::restart() {
   m_restVolumeSeen = 0.0;
   m_lastTime = m_lastFrameControlTime = m_startTime = 0.0;
   m_lastFrameTime = -1.0;
-  m_target = m_targetRate = m_measured = m_error = m_integral = 0.0;
+  m_target = m_targetRate = m_measured = m_error = m_integral = m_traceStart = 0.0;
   m_balance = m_stack.balance();
   m_tracking = TrackingStats();
 }
@@ -275,16 +289,17 @@ Activations PatternController::activations(double t, const Metrics& latest) {
     m_lastTime = t;
     m_lastFrameTime = latest.time;
     m_lastFrameControlTime = t;
-    m_stack.setStartVolume(m_calibration.restVolume > 0.0 && latest.lungVolume > 0.0
-                               ? volumeToFraction(latest.lungVolume)
-                               : m_calibration.restFraction);
+    m_traceStart = m_calibration.restVolume > 0.0 && latest.lungVolume > 0.0
+                       ? volumeToFraction(latest.lungVolume)
+                       : m_calibration.restFraction;
+    m_stack.setStartVolume(m_traceStart);
   }
   const double dt = t - m_lastTime;
   m_lastTime = t;
 
   // target, and the feed-forward demand: its distance from rest, and its rate (backward difference)
   const double previousTarget = m_target;
-  m_target = m_stack.sample(t - m_startTime);
+  m_target = sampleTarget(t - m_startTime);
   const double feedForward = m_target - m_calibration.restFraction;
   m_targetRate = dt > 0.0 ? (m_target - previousTarget) / dt : 0.0;
 
@@ -339,7 +354,7 @@ Activations PatternController::distribute(double demand, double rate, double bal
 
 std::string PatternController::describe() const {
   std::ostringstream os;
-  os << "pattern '" << m_description << "'";
+  os << (m_trace ? "volume trace '" : "pattern '") << m_description << "'";
   if (!m_stack.currentLayerName().empty()) os << " (playing '" << m_stack.currentLayerName() << "')";
   return os.str();
 }
@@ -359,6 +374,7 @@ void PatternController::saveState(CheckpointWriter& out) const {
   Eigen::Vector3d t(m_tracking.sumSquaredError, m_tracking.targetMin, m_tracking.targetMax);
   out.write("pattern.tracking.values", t);
   m_stack.saveState(out, "pattern.stack");
+  if (m_trace) out.write("pattern.traceStart", m_traceStart);
 }
 
 void PatternController::loadState(CheckpointReader& in) {
@@ -388,6 +404,7 @@ void PatternController::loadState(CheckpointReader& in) {
   m_tracking.targetMin = t(1);
   m_tracking.targetMax = t(2);
   m_stack.loadState(in, "pattern.stack");
+  if (m_trace) m_traceStart = in.readDouble("pattern.traceStart");
 }
 
 std::unique_ptr<PatternController> makePatternController(const Pattern& pattern, std::uint64_t seed,

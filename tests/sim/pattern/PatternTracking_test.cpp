@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "DefaultModel.h"
+#include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/pattern/PatternController.h"
 
 using namespace pneuma::sim;
@@ -139,3 +141,45 @@ TEST_P(PatternSuspension, HoldsTheVolumeForTheWholeSuspension) {
 
 INSTANTIATE_TEST_SUITE_P(Presets, PatternSuspension,
                          ::testing::Values("disgust", "surprise", "startle", "pain"), presetName);
+
+// issue 19: a measured volume trace is followed through the same drive; tracking RMS < 5 % of the trace's
+// peak-to-peak on the shipped synthetic example and on the model's own calm breathing played back
+namespace {
+
+double followTrace(VolumeTrace trace) {
+  SimulationOptions options;
+  const double duration = trace.duration();
+  Simulation sim(defaultModel(), std::make_unique<PatternController>(std::move(trace), calibration()),
+                 options);
+  sim.advance(options.settleTime + duration);
+  return sim.controller().trackingRmsPercent();
+}
+
+}  // namespace
+
+TEST(TraceTracking, FollowsTheShippedExampleTrace) {
+  REQUIRE_DEFAULT_MODEL();
+  const double rms = followTrace(loadVolumeTrace(kResources + "/traces/calm-sigh.csv"));
+  RecordProperty("tracking_rms_pct", std::to_string(rms));
+  EXPECT_LT(rms, 5.0);
+}
+
+TEST(TraceTracking, FollowsTheModelsOwnCalmBreathingPlayedBack) {
+  REQUIRE_DEFAULT_MODEL();
+  // record calm breathing as timeseries.csv writes it (time [s], lung volume [mL] at the output frames)
+  SimulationOptions options;
+  Simulation calm(defaultModel(),
+                  std::make_unique<BreathStyleController>(loadBreathStyle("calm", kResources + "/presets")),
+                  options);
+  calm.advance(options.settleTime + 16.0);
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "time [s],lung_volume [mL]\n";
+  const Trace& recorded = calm.trace();
+  for (std::size_t i = 0; i < recorded.size(); ++i)
+    if (recorded.time[i] >= options.settleTime)
+      csv << recorded.time[i] << "," << recorded.lungVolume[i] * 1e6 << "\n";
+  const double rms = followTrace(parseVolumeTrace(csv.str(), "calm", kDriveTimeStep));
+  RecordProperty("tracking_rms_pct", std::to_string(rms));
+  EXPECT_LT(rms, 5.0);
+}

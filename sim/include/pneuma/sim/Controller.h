@@ -4,6 +4,7 @@
 /// ratio r(t) and an activation alpha(t) that enter the muscle law, Eq. 2:
 ///   F = min[-alpha kac (l - r l0) - kpe (l - l0) - b dl/dt, 0].
 
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
@@ -33,6 +34,18 @@ class Controller {
   /// min(defaultTimeStep(integrator), maxTimeStep()) (resolveOptions(), Simulation.h). Infinity (the
   /// default) when any step will do; a feedback controller tuned against the plant at a given step says so.
   virtual double maxTimeStep() const { return std::numeric_limits<double>::infinity(); }
+
+  /// What every tracking controller (one that drives the lung volume toward a target curve: an affect, a
+  /// pattern, a measured trace) reports, in its volume-fraction units v = v_rest + (V - V_rest) / S
+  /// (PatternController.h); NaN for a controller without a volume target (a breath style).
+  /// [-] target fraction v_T at the last control time.
+  virtual double targetFraction() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// [-] fraction of the last measured lung volume v_M.
+  virtual double measuredFraction() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// [%] RMS of v_T - v_M over the frames compared, as a percentage of the target's peak-to-peak.
+  virtual double trackingRmsPercent() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Whether this controller has a volume target (targetFraction() is then a number once control starts).
+  bool tracksVolume() const { return !std::isnan(trackingRmsPercent()); }
 
   /// Writes what activations() depends on besides the construction parameters (clocks, integrals, random
   /// streams, learned values, pushed layers), for an exact restart from a file (Simulation::save(),

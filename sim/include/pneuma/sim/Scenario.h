@@ -10,7 +10,8 @@
 ///     "model": "default",                         // or a model directory, relative to the scenario file
 ///     "duration_s": 30, "seed": 1,
 ///     "controller": {"style": "calm"},            // or {"affect": "startle"}, or {"pattern": "file.json"},
-///                                                 // or {"pattern": { ...inline pattern file... }}
+///                                                 // or {"pattern": { ...inline pattern file... }},
+///                                                 // or {"trace": "volume.csv"} (VolumeTrace.h)
 ///     "overrides": {"integrator": "implicit-euler-joints", "dt_s": 0.002, "settle_time_s": 2,
 ///                   "gravity": true, "posture": "upright", "joint_friction_scale": 1, "kappa_pa": 2e4,
 ///                   "active_gain_scale": {"diaphragm": 1.1}, "passive_gain_scale": {"cartilage": 2}},
@@ -30,9 +31,9 @@ namespace pneuma::sim {
 constexpr int kScenarioFormatVersion = 1;
 
 /// What drives the muscles.
-enum class ControllerKind { Style, Affect, Pattern };
+enum class ControllerKind { Style, Affect, Pattern, Trace };
 
-/// Stable names "style", "affect", "pattern".
+/// Stable names "style", "affect", "pattern", "trace".
 const char* controllerKindName(ControllerKind k);
 
 /// Which files a run writes (at SimulationOptions::outputRate, the file's outputs.output_rate_hz).
@@ -51,7 +52,7 @@ struct Scenario {
   std::uint64_t seed = 0;         ///< seed of the pattern irregularity streams
   ControllerKind controller = ControllerKind::Style;
   std::string controllerName;  ///< Style: preset name; Affect: affect name; Pattern: pattern file path (""
-                               ///< when inline)
+                               ///< when inline); Trace: volume-trace CSV path
   std::string patternText;     ///< Pattern given inline: the pattern file's JSON text ("" otherwise)
   SimulationOptions options;   ///< overrides: step options, dt, settle time; outputs.output_rate_hz
   ScenarioOutputs outputs;
@@ -89,9 +90,9 @@ void checkController(const Scenario& scenario, const std::string& resourceDir);
 
 /// The controller a scenario asks for: a BreathStyleController for a style (presets in
 /// `resourceDir`/presets), or a pattern::PatternController for an affect (`resourceDir`/presets/affect)
-/// or a pattern, seeded with `scenario.seed` and calibrated on `model` with pattern::calibrateDrive()
-/// (a few simulated seconds per muscle group) under `scenario.options`; `stop` (may be null) stops the
-/// calibration (Simulation::setStopFlag()).
+/// or a pattern, or following a volume trace (VolumeTrace.h), seeded with `scenario.seed` and calibrated on
+/// `model` with pattern::calibrateDrive() (a few simulated seconds per muscle group) under
+/// `scenario.options`; `stop` (may be null) stops the calibration (Simulation::setStopFlag()).
 /// @throws Error "controller.<kind>: <reason>", listing the valid names for an unknown style or affect;
 ///         Interrupted when `*stop` became true during the calibration.
 std::unique_ptr<Controller> makeController(const Scenario& scenario, std::shared_ptr<const Model> model,

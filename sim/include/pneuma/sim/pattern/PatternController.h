@@ -43,6 +43,7 @@
 #include "pneuma/sim/Controller.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/pattern/Pattern.h"
+#include "pneuma/sim/pattern/VolumeTrace.h"
 
 namespace pneuma::sim::pattern {
 
@@ -135,6 +136,12 @@ class PatternController : public Controller {
   /// its first breath cross-fades from the lung volume measured then, so a controller installed mid-run
   /// (Simulation::setController()) takes over without a jump. Control time going backwards
   /// (Simulation::reset()) restarts the pattern from its initial stack.
+  /// Follows a measured volume trace instead of a pattern: v_T(t) = v_rest + trace.sample(t) / S, i.e. the
+  /// trace's minimum at the rest volume, cross-faded (smoothstep over kTraceBlend) from the fraction measured
+  /// when control starts; after the trace's end its last volume holds. Same feedback and drive as a pattern.
+  /// @throws Error as the pattern constructor, or when the trace has no samples.
+  PatternController(VolumeTrace trace, DriveCalibration calibration, PatternControllerOptions options = {});
+
   Activations activations(double t, const Metrics& latest) override;
   std::string describe() const override;
   std::unique_ptr<Controller> clone() const override;
@@ -150,9 +157,11 @@ class PatternController : public Controller {
   void push(const std::vector<Layer>& playOrder, SwitchMode mode);
 
   /// [-] target fraction v_T at the last control time.
-  double targetFraction() const { return m_target; }
+  double targetFraction() const override { return m_target; }
   /// [-] fraction of the last measured lung volume (0 before the rest volume is known).
-  double measuredFraction() const { return m_measured; }
+  double measuredFraction() const override { return m_measured; }
+  /// tracking().rmsPercentOfPeakToPeak().
+  double trackingRmsPercent() const override { return m_tracking.rmsPercentOfPeakToPeak(); }
   /// [-] fraction of a lung volume [m^3] under this controller's mapping.
   double volumeToFraction(double volume) const;
   /// [m^3] lung volume of a fraction under this controller's mapping.
@@ -162,6 +171,8 @@ class PatternController : public Controller {
   const DriveCalibration& calibration() const { return m_calibration; }
 
  private:
+  // [-] v_T at pattern time tau [s]
+  double sampleTarget(double tau);
   // demand d [-], target rate [1/s] and balance b [-] -> alphas
   Activations distribute(double demand, double rate, double balance) const;
   void restart();  // back to the state at construction
@@ -185,7 +196,12 @@ class PatternController : public Controller {
   double m_integral = 0.0;              // [-] I = ki * integral(e dt), clamped
   double m_balance = 0.5;               // [-] smoothed balance
   TrackingStats m_tracking;
+  std::shared_ptr<const VolumeTrace> m_trace;  // the trace followed instead of m_stack; null for a pattern
+  double m_traceStart = 0.0;                   // [-] fraction measured when control started (trace blend)
 };
+
+/// [s] cross-fade from the measured volume into a followed trace (LayerStack's longest blend).
+inline constexpr double kTraceBlend = 0.4;
 
 /// A PatternController playing the affect preset NAME from `resourceDir` (resources/) on `model`.
 /// @throws Error "unknown affect 'NAME' (valid: ...)" or a preset/calibration error.
