@@ -67,6 +67,19 @@ class GltfBuilder {
     return static_cast<int>(m_gltf.accessors.size()) - 1;
   }
 
+  /// A triangle primitive of positions `x` (with bounds), normals `n` (3 x #V) and `triangles` (3 x #T).
+  tinygltf::Primitive triangleMesh(const Eigen::Matrix3Xf& x, const Eigen::Matrix3Xf& n,
+                                   const Eigen::Matrix<std::uint32_t, 3, Eigen::Dynamic>& triangles,
+                                   int material) {
+    tinygltf::Primitive p;
+    p.mode = TINYGLTF_MODE_TRIANGLES;
+    p.material = material;
+    p.attributes["POSITION"] = floats(x, true, TINYGLTF_TARGET_ARRAY_BUFFER);
+    p.attributes["NORMAL"] = floats(n, false, TINYGLTF_TARGET_ARRAY_BUFFER);
+    p.indices = indices(triangles);
+    return p;
+  }
+
  private:
   int view(const void* data, std::size_t bytes, int target) {
     std::vector<unsigned char>& buffer = m_gltf.buffers.front().data;
@@ -198,12 +211,7 @@ void writeGltf(const std::string& path, const sim::Model& model, const std::stri
   const Triangles skinTriangles = skin.triangles.cast<std::uint32_t>();
   const Eigen::Matrix3Xf base = toGltf(targets.base);
   const Eigen::Matrix3Xf baseNormals = vertexNormals(base, skinTriangles);
-  tinygltf::Primitive skinPrimitive;
-  skinPrimitive.mode = TINYGLTF_MODE_TRIANGLES;
-  skinPrimitive.material = skinMaterial;
-  skinPrimitive.attributes["POSITION"] = build.floats(base, true, TINYGLTF_TARGET_ARRAY_BUFFER);
-  skinPrimitive.attributes["NORMAL"] = build.floats(baseNormals, false, TINYGLTF_TARGET_ARRAY_BUFFER);
-  skinPrimitive.indices = build.indices(skinTriangles);
+  tinygltf::Primitive skinPrimitive = build.triangleMesh(base, baseNormals, skinTriangles, skinMaterial);
   std::vector<tinygltf::Value> targetNames;
   tinygltf::Mesh skinMesh;
   skinMesh.name = "skin";
@@ -250,12 +258,7 @@ void writeGltf(const std::string& path, const sim::Model& model, const std::stri
       Eigen::Matrix3Xf x, n;
       Triangles triangles;
       boneMesh((std::filesystem::path(modelDir) / file).string(), name, x, n, triangles);
-      tinygltf::Primitive p;
-      p.mode = TINYGLTF_MODE_TRIANGLES;
-      p.material = boneMaterial;
-      p.attributes["POSITION"] = build.floats(x, true, TINYGLTF_TARGET_ARRAY_BUFFER);
-      p.attributes["NORMAL"] = build.floats(n, false, TINYGLTF_TARGET_ARRAY_BUFFER);
-      p.indices = build.indices(triangles);
+      const tinygltf::Primitive p = build.triangleMesh(x, n, triangles, boneMaterial);
       tinygltf::Mesh mesh;
       mesh.name = name;
       mesh.primitives.push_back(p);
