@@ -273,7 +273,7 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   double elastic = 0.0;
   for (int e = 0; e < el.size(); ++e) {
     const double l = (anchorPosition(el.endB, e, state) - anchorPosition(el.endA, e, state)).norm();
-    const MuscleParams p = muscleParams(model, e, act, options);
+    const MuscleParams p = muscleParams(model, work.constants, e, act, options);
     elastic += isMuscleGroup(el.group[at(e)]) ? muscleEnergy(l, p) : springEnergy(l, p.restLength, p.kpe);
   }
   if (work.constants.restGutVolume > 0.0)

@@ -32,14 +32,25 @@ std::string resolve(const std::string& path, const std::string& baseDir) {
 }
 
 // {"diaphragm": 1.2, ...} -> per-group scale factors (>= 0)
-void parseGroupScales(const Field& f, std::array<double, kElementGroupCount>& out) {
+// the halves of the diaphragm an active gain scale may name besides the groups
+// (StepOptions::hemidiaphragmActiveScale)
+constexpr std::array<const char*, 2> kHemidiaphragmNames = {"diaphragm_left", "diaphragm_right"};
+
+// `halves`: where "diaphragm_left" and "diaphragm_right" go, or null when the scale has no halves (passive)
+void parseGroupScales(const Field& f, std::array<double, kElementGroupCount>& out,
+                      std::array<double, 2>* halves) {
   if (!f.isObject()) f.fail("must be an object of group names to scale factors");
   for (const std::string& key : f.keys()) {
+    if (halves && (key == kHemidiaphragmNames[0] || key == kHemidiaphragmNames[1])) {
+      (*halves)[key == kHemidiaphragmNames[0] ? 0 : 1] = f.at(key).nonNegative();
+      continue;
+    }
     ElementGroup g;
     if (!groupFromName(key, g)) {
       std::string valid;
       for (int i = 0; i < kElementGroupCount; ++i)
         valid += std::string(i ? ", " : "") + groupName(static_cast<ElementGroup>(i));
+      if (halves) valid += std::string(", ") + kHemidiaphragmNames[0] + ", " + kHemidiaphragmNames[1];
       f.at(key).fail("unknown muscle group (valid: " + valid + ")");
     }
     out[static_cast<std::size_t>(g)] = f.at(key).nonNegative();
@@ -97,8 +108,10 @@ void parseOverrides(const Field& o, SimulationOptions& opt) {
   if (o.has("joint_friction_scale")) opt.step.jointFrictionScale = o.at("joint_friction_scale").nonNegative();
   if (o.has("gut_drag_scale")) opt.step.gutDragScale = o.at("gut_drag_scale").nonNegative();
   if (o.has("kappa_pa")) opt.step.kappa = o.at("kappa_pa").positive();
-  if (o.has("active_gain_scale")) parseGroupScales(o.at("active_gain_scale"), opt.step.activeGainScale);
-  if (o.has("passive_gain_scale")) parseGroupScales(o.at("passive_gain_scale"), opt.step.passiveGainScale);
+  if (o.has("active_gain_scale"))
+    parseGroupScales(o.at("active_gain_scale"), opt.step.activeGainScale, &opt.step.hemidiaphragmActiveScale);
+  if (o.has("passive_gain_scale"))
+    parseGroupScales(o.at("passive_gain_scale"), opt.step.passiveGainScale, nullptr);
 }
 
 void parseOutputs(const Field& o, ScenarioOutputs& out, SimulationOptions& opt) {
@@ -224,6 +237,8 @@ std::string serializeScenario(const Scenario& s) {
   o["gut_drag_scale"] = st.gutDragScale;
   if (st.kappa) o["kappa_pa"] = *st.kappa;
   o["active_gain_scale"] = groupScalesJson(st.activeGainScale);
+  for (std::size_t side = 0; side < 2; ++side)
+    o["active_gain_scale"][kHemidiaphragmNames[side]] = st.hemidiaphragmActiveScale[side];
   o["passive_gain_scale"] = groupScalesJson(st.passiveGainScale);
   j["outputs"] = {{"output_rate_hz", s.options.outputRate},
                   {"csv", s.outputs.csv},

@@ -71,6 +71,12 @@ std::string describeBlowUpCause(double dt) {
 
 }  // namespace
 
+double hemidiaphragmScale(const Model& model, const StepConstants& c, int e, const StepOptions& o) {
+  if (model.elements.group[at(e)] != ElementGroup::Diaphragm) return 1.0;
+  const double s = c.elementRightShare(e);
+  return o.hemidiaphragmActiveScale[0] * (1.0 - s) + o.hemidiaphragmActiveScale[1] * s;
+}
+
 StepWork makeStepWork(const Model& model) {
   StepWork w;
   const int nb = model.bodies.size(), nn = model.nodes.size(), ne = model.elements.size(),
@@ -79,11 +85,16 @@ StepWork makeStepWork(const Model& model) {
       model.gut.triangles.cols() > 0 ? enclosedVolume(model.nodes.rest, model.gut.triangles) : 0.0;
   w.outputs.gutVolume = w.constants.restGutVolume;
   if (model.nodes.size() > 0) w.constants.restGutCentroid = model.nodes.rest.rowwise().mean();
+  const State rest = makeInitialState(model);
   if (model.cavity.triangles.cols() > 0) {
-    const State rest = makeInitialState(model);
     anchorPositions(model.cavity.vertices, rest, w.scratch.cavityPosition);
     w.constants.restCavityVolume = enclosedVolume(w.scratch.cavityPosition, model.cavity.triangles);
   }
+  // each element's side: the x of its rest midpoint
+  w.constants.elementRightShare.resize(ne);
+  for (int e = 0; e < ne; ++e)
+    w.constants.elementRightShare(e) = rightShare(0.5 * (anchorPosition(model.elements.endA, e, rest).x() +
+                                                         anchorPosition(model.elements.endB, e, rest).x()));
   std::vector<int> wall;
   for (Eigen::Index f = 0; f < model.gut.triangles.cols(); ++f) {
     int count = 0;

@@ -80,7 +80,7 @@ void accumulateElementForces(const Model& model, const State& s, const Activatio
     const double l = std::max(delta.norm(), 1e-12);
     const Vector3d d = delta / l;
     const double ldot = d.dot(vb - va);
-    const MuscleParams p = muscleParams(model, e, act, o);
+    const MuscleParams p = muscleParams(model, w.constants, e, act, o);
 
     double f = 0.0, k = 0.0, b = 0.0;
     if (isMuscleGroup(el.group[at(e)])) {

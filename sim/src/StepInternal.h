@@ -28,13 +28,15 @@ inline double effectiveDrag(const Model& model, const StepOptions& o) {
   return model.gut.drag * o.gutDragScale;
 }
 
-// muscle parameters of element e under the group's activation and gain scales
-inline MuscleParams muscleParams(const Model& model, int e, const Activations& act, const StepOptions& o) {
+// muscle parameters of element e under the group's activation and gain scales (and its half's, for the
+// diaphragm)
+inline MuscleParams muscleParams(const Model& model, const StepConstants& c, int e, const Activations& act,
+                                 const StepOptions& o) {
   const int g = static_cast<int>(model.elements.group[at(e)]);
   const GroupActivation& ga = act[at(g)];
   MuscleParams p;
   p.restLength = effectiveRestLength(model, e, o);
-  p.kac = model.elements.kac(e) * o.activeGainScale[at(g)];
+  p.kac = model.elements.kac(e) * o.activeGainScale[at(g)] * hemidiaphragmScale(model, c, e, o);
   p.kpe = model.elements.kpe(e) * o.passiveGainScale[at(g)];
   p.damping = model.elements.damping(e) * o.passiveGainScale[at(g)];
   p.alpha = ga.alpha;

@@ -105,6 +105,12 @@ void validateStepOptions(const StepOptions& o) {
     if (!std::isfinite(o.passiveGainScale[at(g)]) || o.passiveGainScale[at(g)] < 0.0)
       fail("passiveGainScale." + name, o.passiveGainScale[at(g)], "must be finite and >= 0");
   }
+  for (int side = 0; side < 2; ++side) {
+    const double v = o.hemidiaphragmActiveScale[at(side)];
+    if (!std::isfinite(v) || v < 0.0)
+      fail(side == 0 ? "hemidiaphragmActiveScale.left" : "hemidiaphragmActiveScale.right", v,
+           "must be finite and >= 0");
+  }
   if (o.jointIterations < 1) fail("jointIterations", o.jointIterations, "must be >= 1");
   if (!(o.jointTolerance > 0.0)) fail("jointTolerance", o.jointTolerance, "must be > 0");
   if (o.cgMaxIterations < 1) fail("cgMaxIterations", o.cgMaxIterations, "must be >= 1");

@@ -86,8 +86,26 @@ TEST(Scenario, OverridesReachTheSimulationOptions) {
   EXPECT_TRUE(s.outputs.vtk);
 }
 
+// the halves of the diaphragm are scaled on their own (a paralysed hemidiaphragm), for the active gain only,
+// and survive a save
+TEST(Scenario, HemidiaphragmScalesAreReadAndSaved) {
+  const Scenario s =
+      parseScenario(with(R"("overrides": {"active_gain_scale": {"diaphragm_left": 0}})"), "h.json", "");
+  EXPECT_EQ(s.options.step.hemidiaphragmActiveScale[0], 0.0);
+  EXPECT_EQ(s.options.step.hemidiaphragmActiveScale[1], 1.0);
+  EXPECT_EQ(s.options.step.activeGainScale[static_cast<int>(ElementGroup::Diaphragm)], 1.0);
+  const Scenario back = parseScenario(serializeScenario(s), "h.json", "");
+  EXPECT_EQ(back.options.step.hemidiaphragmActiveScale, s.options.step.hemidiaphragmActiveScale);
+  expectError(with(R"("overrides": {"passive_gain_scale": {"diaphragm_right": 0}})"),
+              {"overrides.passive_gain_scale.diaphragm_right: unknown muscle group"});
+  expectError(with(R"("overrides": {"active_gain_scale": {"diaphragm_right": -1}})"),
+              {"overrides.active_gain_scale.diaphragm_right"});
+}
+
 TEST(Scenario, SerializeThenParseIsTheIdentity) {
-  for (const auto& entry : fs::directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios")) {
+  for (const auto& entry :
+       fs::recursive_directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios")) {
+    if (!entry.is_regular_file()) continue;
     const Scenario a = loadScenario(entry.path().string());
     const std::string text = serializeScenario(a);
     const Scenario b = parseScenario(text, "round.json", entry.path().parent_path().string());

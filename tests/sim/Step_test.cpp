@@ -283,3 +283,34 @@ TEST(Posture, GravityPointsAlongThePostureAxisAndIsTheGradientOfItsEnergy) {
 
 }  // namespace
 }  // namespace pneuma::sim
+
+namespace pneuma::sim {
+namespace {
+
+// the diaphragm's halves follow the side of each strand's rest midpoint (RAS: +x right), strands on the
+// midline belong to both, and a paralysed half scales only its own strands' active gain
+TEST(Step, HemidiaphragmHalvesFollowTheSideOfTheRestMidpoint) {
+  const Model toy = test::makeToyTorso();
+  const StepWork w = makeStepWork(toy);
+  const State rest = makeInitialState(toy);
+  StepOptions leftParalysed;
+  leftParalysed.hemidiaphragmActiveScale = {0.0, 1.0};
+  const StepOptions normal;
+  int left = 0, right = 0;
+  for (int e = 0; e < toy.elements.size(); ++e) {
+    const double x = 0.5 * (anchorPosition(toy.elements.endA, e, rest).x() +
+                            anchorPosition(toy.elements.endB, e, rest).x());
+    const double share = w.constants.elementRightShare(e);
+    EXPECT_EQ(share, x > 1e-3 ? 1.0 : x < -1e-3 ? 0.0 : 0.5) << "element " << e << " at x = " << x;
+    EXPECT_EQ(hemidiaphragmScale(toy, w.constants, e, normal), 1.0);
+    const bool isDiaphragm = toy.elements.group[static_cast<std::size_t>(e)] == ElementGroup::Diaphragm;
+    EXPECT_EQ(hemidiaphragmScale(toy, w.constants, e, leftParalysed), isDiaphragm ? share : 1.0);
+    left += isDiaphragm && share == 0.0 ? 1 : 0;
+    right += isDiaphragm && share == 1.0 ? 1 : 0;
+  }
+  EXPECT_GT(left, 0);  // both halves have strands of their own
+  EXPECT_GT(right, 0);
+}
+
+}  // namespace
+}  // namespace pneuma::sim

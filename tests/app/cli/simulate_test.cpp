@@ -398,8 +398,8 @@ TEST(CliSimulate, BadInputIsOneLineErrorAndExit2) {
 
 TEST(CliScenario, CheckAcceptsTheExamplesAndNamesTheFailingPath) {
   std::vector<std::string> args{"scenario", "check"};
-  for (const auto& e : fs::directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios"))
-    args.push_back(e.path().string());
+  for (const auto& e : fs::recursive_directory_iterator(std::string(PNEUMA_RESOURCE_DIR) + "/scenarios"))
+    if (e.is_regular_file()) args.push_back(e.path().string());
   auto r = runCli(args);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(pneuma::test::lineCount(r.out), static_cast<int>(args.size()) - 2)

@@ -73,6 +73,10 @@ struct StepOptions {
   std::array<double, kElementGroupCount> activeGainScale{1, 1, 1, 1, 1, 1};  ///< [-] multiplies kac per group
   std::array<double, kElementGroupCount> passiveGainScale{1, 1, 1,
                                                           1, 1, 1};  ///< [-] multiplies kpe and b per group
+  /// [-] {left, right}: multiplies kac of each half of the diaphragm on top of activeGainScale; each
+  /// hemidiaphragm has its own phrenic nerve, so 0 on one side is a paralysed hemidiaphragm (its passive
+  /// stiffness stays). The halves are split by StepConstants::elementRightShare.
+  std::array<double, 2> hemidiaphragmActiveScale{1, 1};
   int jointIterations = 30;      ///< [-] max Gauss-Seidel sweeps of the joint solver
   double jointTolerance = 1e-5;  ///< [m] position projection stops below this joint error
   int cgMaxIterations = 200;  ///< [-] implicit Euler: max CG iterations (typically 0-8; up to ~90 in the step
@@ -86,6 +90,24 @@ struct StepOptions {
       1e-2;  ///< [-] implicit Euler: relative residual of the CG solve (preconditioner norm);
              ///< 1e-2 changes validate figures by at most 0.3 % against 1e-4 (docs/cli.md)
 };
+
+/// [m] Half-width of the midline band: a strand whose rest midpoint lies within it belongs to both halves.
+constexpr double kMidlineHalfWidth = 1e-3;
+
+/// [-] Share of a strand in the body's right half from the x [m] of its rest midpoint (RAS: +x is the
+/// subject's right): 1 for x > kMidlineHalfWidth, 0 for x < -kMidlineHalfWidth, 0.5 in between (the strands
+/// on the midline, to the xiphoid and along the crura, are driven half by each side; their x is 0 up to
+/// rounding, so its sign alone would split them at random).
+inline double rightShare(double x) {
+  return x > kMidlineHalfWidth ? 1.0 : x < -kMidlineHalfWidth ? 0.0 : 0.5;
+}
+
+struct StepConstants;
+
+/// [-] The factor on kac of element `e` for the hemidiaphragm it belongs to,
+/// left (1 - s) + right s with s = StepConstants::elementRightShare(e) and {left, right} =
+/// StepOptions::hemidiaphragmActiveScale; exactly 1 when both halves are at 1, and 1 for every other group.
+double hemidiaphragmScale(const Model& model, const StepConstants& c, int e, const StepOptions& o);
 
 /// [Pa] The gut's bulk modulus kappa of Eq. 4 a step uses: StepOptions::kappa when set, else
 /// Model::gut.kappa. The one rule for it; resolveOptions() (Simulation.h) reports it with the time step to
@@ -119,6 +141,8 @@ struct StepConstants {
   /// gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
   Eigen::Matrix3Xi wallTriangles;
   double restCavityVolume = 0.0;  ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
+  /// [-] each element's share in the body's right half, rightShare() of the x of its rest midpoint (#E)
+  Eigen::VectorXd elementRightShare;
   /// body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
   Eigen::Matrix2Xi endpointBody;
   /// the node when an endpoint is exactly one node (weight 1), else -1 (2 x #E)
