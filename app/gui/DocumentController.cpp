@@ -28,6 +28,7 @@ DocumentController::OpenedScenario DocumentController::readScenario(const QStrin
   const sim::Scenario scenario = sim::loadScenario(path.toStdString());
   OpenedScenario opened;
   opened.name = QString::fromStdString(scenario.name);
+  opened.description = QString::fromStdString(scenario.description);
   if (scenario.controller == sim::ControllerKind::Style) {
     opened.settings.style = sim::loadBreathStyle(scenario.controllerName);
   } else {

@@ -25,6 +25,7 @@ class DocumentController {
   /// A scenario read from disk: the settings it asks for and its model's directory.
   struct OpenedScenario {
     QString name;
+    QString description;  ///< the scenario's explanation (a teaching preset: what to watch and why)
     RunSettings settings;
     QString modelDir;
     /// the scenario itself when an affect or a pattern drives it (null for a breath style): the worker makes

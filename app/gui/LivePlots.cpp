@@ -29,6 +29,7 @@ enum Column : std::size_t { kTime, kLung, kTarget, kGut, kFlow, kGutPressure, kP
 constexpr double kPascalPerCmH2O = 98.0665;  // [Pa / cmH2O]
 constexpr int kLoops = 3;                    // complete breaths drawn in the flow-volume loop
 constexpr std::size_t kColumnsPerGroup = 3;
+const QColor kOverlayColour(90, 90, 90);  // an overlaid run, dashed
 
 const std::vector<sim::ElementGroup>& muscleGroups() {
   static const std::vector<sim::ElementGroup> groups = [] {
@@ -92,12 +93,26 @@ LivePlots::LivePlots(QWidget* parent) : QWidget(parent), m_cursor(kNaN) {
   physiology->addWidget(m_loop);
   physiology->addWidget(m_plots[5]);
 
+  // one time axis: zooming or scrolling one plot moves them all
+  for (PlotView* plot : m_plots)
+    connect(plot, &PlotView::viewChanged, this, [this](double window, double end) {
+      for (PlotView* p : m_plots) {
+        p->setWindow(window);
+        p->setViewEnd(end);
+      }
+    });
+
   m_tabs = new QTabWidget(this);
   m_tabs->addTab(splitter, "Mechanics");
   m_tabs->addTab(physiology, "Physiology");
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(m_tabs);
+}
+
+void LivePlots::setOverlay(RunOverlay overlay) {
+  m_overlay = std::move(overlay);
+  m_isDirty = true;
 }
 
 void LivePlots::showPhysiology(bool isShown) { m_tabs->setCurrentIndex(isShown ? 1 : 0); }
@@ -254,8 +269,8 @@ bool LivePlots::refresh() {
   if (!m_isDirty) return false;
   m_isDirty = false;
 
-  const double from =
-      m_hasLatest && m_window > 0.0 ? m_latest.time - m_window : -std::numeric_limits<double>::infinity();
+  // the whole history: the plots show their span of it and scroll over the rest
+  const double from = -std::numeric_limits<double>::infinity();
   std::vector<double> time;
   std::vector<std::vector<double>> columns;
   table(from, time, columns);
@@ -266,6 +281,22 @@ bool LivePlots::refresh() {
     return y;
   };
 
+  // the overlaid run's quantity `of` times `scale` at the plotted times, dashed (none without an overlay)
+  const bool hasOverlay = !m_overlay.samples.empty();
+  auto overlaid = [&](const QString& what, double PlotSample::*of, double scale) {
+    std::vector<double> y(n, kNaN);
+    const std::vector<PlotSample>& o = m_overlay.samples;
+    for (std::size_t k = 0, j = 0; k < n && !o.empty(); ++k) {
+      while (j + 1 < o.size() && o[j + 1].time <= time[k]) ++j;
+      if (time[k] < o.front().time || time[k] > o.back().time) continue;
+      const PlotSample& a = o[j];
+      const PlotSample& b = o[std::min(j + 1, o.size() - 1)];
+      const double w = b.time > a.time ? (time[k] - a.time) / (b.time - a.time) : 0.0;
+      y[k] = scale * ((1.0 - w) * a.*of + w * b.*of);
+    }
+    return PlotView::Series{m_overlay.name + " " + what, kOverlayColour, true, std::move(y), m_overlay.name};
+  };
+
   // lung volume [mL], with the affect pattern's target when one plays
   std::vector<PlotView::Series> volume{
       {"lung volume", QColor(20, 90, 190), false, column(kLung, 1e6), QString()}};
@@ -273,6 +304,10 @@ bool LivePlots::refresh() {
   if (std::any_of(target.begin(), target.end(), [](double v) { return std::isfinite(v); })) {
     volume[0].legend = "simulated";
     volume.push_back({"target volume", QColor(230, 90, 20), true, std::move(target), "target"});
+  }
+  if (hasOverlay) {
+    if (volume[0].legend.isEmpty()) volume[0].legend = "this run";
+    volume.push_back(overlaid("lung volume", &PlotSample::lungVolume, 1e6));
   }
   m_plots[0]->setData(time, std::move(volume));
   // read-out: the two lungs, their split and the tidal volume; at a cursor, the lungs there
@@ -292,7 +327,12 @@ bool LivePlots::refresh() {
   m_plots[0]->setNote(note);
 
   // flow [L/s] with the tidal volume and rate; the abdominal and transdiaphragmatic pressures [cmH2O]
-  m_plots[4]->setData(time, {{"flow", QColor(20, 90, 190), false, column(kFlow, 1e3), QString()}});
+  std::vector<PlotView::Series> flow{{"flow", QColor(20, 90, 190), false, column(kFlow, 1e3), QString()}};
+  if (hasOverlay) {
+    flow[0].legend = "this run";
+    flow.push_back(overlaid("flow", &PlotSample::flow, 1e3));
+  }
+  m_plots[4]->setData(time, std::move(flow));
   const double rate = breathingRate();
   QString flowNote = QString("VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
   if (std::isfinite(rate)) flowNote += QString("  %1 b/min").arg(rate, 0, 'f', 1);
@@ -306,6 +346,13 @@ bool LivePlots::refresh() {
   const bool hasPdi = std::any_of(pdi.begin(), pdi.end(), [](double v) { return std::isfinite(v); });
   if (hasPdi)
     pressures.push_back({"transdiaphragmatic pressure", QColor(200, 60, 20), false, std::move(pdi), "Pdi"});
+  if (hasOverlay) {
+    PlotView::Series pab =
+        overlaid("abdominal (gut) pressure", &PlotSample::gutPressure, 1.0 / kPascalPerCmH2O);
+    pab.legend = "Pab " + m_overlay.name;
+    if (std::any_of(pab.y.begin(), pab.y.end(), [](double v) { return std::isfinite(v); }))
+      pressures.push_back(std::move(pab));
+  }
   m_plots[5]->setData(time, std::move(pressures));
   if (n > 0) {
     const double pab = atCursor ? m_plots[5]->cursorValue(0) : m_latest.gutPressure / kPascalPerCmH2O;

@@ -10,6 +10,7 @@
 ///  5. lung flow [L/s] with the tidal volume and the breathing rate;
 ///  6. the abdominal (gut) and transdiaphragmatic pressures [cmH2O];
 ///  and the flow-volume loop of the last breaths (FlowVolumeLoop).
+/// A second run (RunOverlay) may be drawn dashed over plots 1, 5 and 6.
 /// When a cursor is set (a scrubbed instant) the notes read the values at the cursor, not the newest ones.
 /// Memory is bounded whatever the output rate and run length: the last kHistorySeconds are kept in segments
 /// whose quantities are thinned by viz::MinMaxSeries (every peak and trough kept; exact up to kSegmentBuckets
@@ -20,6 +21,7 @@
 #include <deque>
 #include <vector>
 
+#include "gui/RunOverlay.h"
 #include "gui/SimWorker.h"
 #include "viz/MinMaxSeries.h"
 
@@ -60,6 +62,12 @@ class LivePlots : public QWidget {
   /// Adds a force trace to the tension plot (at most 4 are kept; the oldest goes first).
   void addTrace(const Trace& trace);
   void clearTraces();
+
+  /// Draws a second run over the volume, flow and pressure plots (runs side by side): dashed grey, named
+  /// after it in the legends, at the plots' own sample times (linear between its frames, a gap outside
+  /// them). An overlay with no samples removes it.
+  void setOverlay(RunOverlay overlay);
+  const RunOverlay& overlay() const { return m_overlay; }
 
   /// Brings the Physiology tab (flow, loop, pressures) or the Mechanics tab to the front.
   void showPhysiology(bool isShown);
@@ -104,6 +112,7 @@ class LivePlots : public QWidget {
   QTabWidget* m_tabs = nullptr;
   std::vector<double> m_breaths;  // [s] end-expirations
   std::vector<Trace> m_traces;
+  RunOverlay m_overlay;
   double m_window = 20.0;       // [s]
   double m_breathPeriod = 4.0;  // [s]
   double m_cursor;              // [s]

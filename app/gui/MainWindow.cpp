@@ -10,10 +10,12 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDir>
 #include <QDockWidget>
 #include <QElapsedTimer>
 #include <QEventLoop>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -24,6 +26,7 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QMouseEvent>
+#include <QProgressDialog>
 #include <QPushButton>
 #include <QScrollArea>
 #include <QSlider>
@@ -348,6 +351,28 @@ void MainWindow::buildActions() {
   connect(m_affectCombo, &QComboBox::currentTextChanged, this, [this] {
     if (m_player) setMorphPlayback(true);
   });
+  // scenarios: the teaching presets, and a second run drawn over the plots
+  QMenu* scenarios = menuBar()->addMenu("S&cenarios");
+  QMenu* teaching = scenarios->addMenu("&Teaching");
+  for (const QString& path : teachingPresets())
+    teaching->addAction(QFileInfo(path).completeBaseName().replace('-', ' '), this,
+                        [this, path] { openTeachingPreset(path); });
+  scenarios->addSeparator();
+  scenarios->addAction("Compare with &calm breathing", this, [this] {
+    overlayScenario(QString::fromStdString(sim::resourceDir()) + "/scenarios/calm.json");
+  });
+  scenarios->addAction("Compare with a &scenario\u2026", this, [this] {
+    const QString path =
+        QFileDialog::getOpenFileName(this, "Compare with a scenario", QString(), "Scenario (*.json)");
+    if (!path.isEmpty()) overlayScenario(path);
+  });
+  scenarios->addAction("Compare with a &recording\u2026", this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, "Compare with a recording (pneuma-cli simulate)",
+                                                      QString(), "Recording (timeseries.csv)");
+    if (!path.isEmpty()) overlayRecording(path);
+  });
+  scenarios->addAction("&Remove the comparison", this, &MainWindow::clearOverlay);
+
   QMenu* simMenu = menuBar()->addMenu("&Simulation");
   simMenu->addAction(m_playAction);
   simMenu->addAction(step);
@@ -514,6 +539,25 @@ void MainWindow::buildDocks() {
   leftDock->setWidget(tabs);
   addDockWidget(Qt::LeftDockWidgetArea, leftDock);
   resizeDocks({leftDock, plotDock}, {262, 400}, Qt::Horizontal);
+
+  // left, below: what the opened scenario is about (teaching presets explain what to watch)
+  m_scenarioNote = new QLabel(this);
+  m_scenarioNote->setWordWrap(true);
+  m_scenarioNote->setTextFormat(Qt::PlainText);
+  m_scenarioNote->setAlignment(Qt::AlignTop | Qt::AlignLeft);
+  m_scenarioNote->setMargin(6);
+  auto* noteScroll = new QScrollArea(this);
+  noteScroll->setWidget(m_scenarioNote);
+  noteScroll->setWidgetResizable(true);
+  noteScroll->setFrameShape(QFrame::NoFrame);
+  noteScroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  m_scenarioDock = new QDockWidget("Scenario", this);
+  m_scenarioDock->setObjectName("scenario");
+  m_scenarioDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable |
+                              QDockWidget::DockWidgetClosable);
+  m_scenarioDock->setWidget(noteScroll);
+  addDockWidget(Qt::LeftDockWidgetArea, m_scenarioDock);
+  m_scenarioDock->hide();
 }
 
 void MainWindow::syncDisplayWidgets() {
@@ -579,6 +623,9 @@ QString MainWindow::openModel(const QString& dir) {
     report("Model not loaded", message);
     return message;
   }
+  // a comparison run belongs to the previous model
+  if (QFileInfo(opened.dir).canonicalFilePath() != QFileInfo(m_document.modelDir()).canonicalFilePath())
+    m_plots->setOverlay({});
   m_document.adopt(opened);
   // the morph targets belong to the previous model
   setMorphPlayback(false);
@@ -645,9 +692,69 @@ QString MainWindow::openScenario(const QString& path) {
   }
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
+  m_scenarioNote->setText(scenario.description.isEmpty() ? scenario.name
+                                                         : scenario.name + "\n\n" + scenario.description);
+  m_scenarioDock->show();
   showMessage(QString("Scenario '%1' loaded").arg(scenario.name), 5000);
   return {};
 }
+
+QStringList MainWindow::teachingPresets() {
+  const QDir dir(QString::fromStdString(sim::resourceDir()) + "/scenarios/teaching");
+  QStringList paths;
+  for (const QString& name : dir.entryList({"*.json"}, QDir::Files, QDir::Name)) paths << dir.filePath(name);
+  return paths;
+}
+
+QString MainWindow::openTeachingPreset(const QString& path) {
+  const QString error = openScenario(path);
+  if (!error.isEmpty()) return error;
+  return overlayScenario(QString::fromStdString(sim::resourceDir()) + "/scenarios/calm.json");
+}
+
+QString MainWindow::scenarioExplanation() const { return m_scenarioNote->text(); }
+
+QString MainWindow::overlayScenario(const QString& path) {
+  if (!m_document.model()) return "No model open";
+  QProgressDialog progress(QString("Running %1 to compare\u2026").arg(QFileInfo(path).fileName()), "Cancel",
+                           0, 1000, this);
+  progress.setWindowModality(Qt::WindowModal);
+  progress.setMinimumDuration(300);
+  RunOverlay overlay;
+  try {
+    overlay = runScenarioOverlay(path, m_document.model(), m_document.modelDir(), [&](double fraction) {
+      progress.setValue(static_cast<int>(std::lround(1000.0 * fraction)));
+      QApplication::processEvents();
+      return !progress.wasCanceled();
+    });
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot compare with '%1': %2").arg(path, e.what());
+    report("No comparison", message);
+    return message;
+  }
+  if (overlay.samples.empty()) return "cancelled";
+  const QString name = overlay.name;
+  m_plots->setOverlay(std::move(overlay));
+  showMessage(QString("Comparing with '%1' (dashed)").arg(name), 5000);
+  return {};
+}
+
+QString MainWindow::overlayRecording(const QString& path) {
+  if (!m_document.model()) return "No model open";
+  try {
+    RunOverlay overlay = readRecordingOverlay(path, *m_document.model());
+    const QString name = overlay.name;
+    m_plots->setOverlay(std::move(overlay));
+    showMessage(QString("Comparing with the recording '%1' (dashed)").arg(name), 5000);
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot compare with '%1': %2").arg(path, e.what());
+    report("No comparison", message);
+    return message;
+  }
+  return {};
+}
+
+void MainWindow::clearOverlay() { m_plots->setOverlay({}); }
 
 QString MainWindow::saveScenario(const QString& path) {
   try {

@@ -21,6 +21,7 @@
 class QAction;
 class QCheckBox;
 class QComboBox;
+class QDockWidget;
 class QLabel;
 class QPushButton;
 class QSlider;
@@ -50,6 +51,23 @@ class MainWindow : public QMainWindow {
   QString openModel(const QString& dir);
   /// Loads a scenario file (model, style, parameters). Same failure behaviour as openModel().
   QString openScenario(const QString& path);
+  /// Scenarios > Teaching: the teaching presets shipped in <resources>/scenarios/teaching, sorted by file
+  /// name.
+  static QStringList teachingPresets();
+  /// Opens a teaching preset (openScenario()) and overlays calm upright breathing (<resources>/scenarios/
+  /// calm.json) to compare with. @return empty or the error.
+  QString openTeachingPreset(const QString& path);
+  /// The opened scenario's name and description as shown in the Scenario panel (empty before one).
+  QString scenarioExplanation() const;
+  /// Runs the scenario at `path` on the window's model and draws it dashed over the volume, flow and
+  /// pressure plots (RunOverlay.h), with a progress dialog whose Cancel leaves the plots as they were.
+  /// A scenario of another model is refused with a message naming both. @return empty or the error.
+  QString overlayScenario(const QString& path);
+  /// Draws a recording (a pneuma-cli simulate folder or its timeseries.csv) dashed over the volume and flow
+  /// plots; a recording of another model is refused with a message naming both. @return empty or the error.
+  QString overlayRecording(const QString& path);
+  /// Removes the overlaid run.
+  void clearOverlay();
   /// Writes the current model, style and parameters as a scenario file. @return empty or the error.
   QString saveScenario(const QString& path);
   /// Selects a breath style preset by name ("calm", "deep", "panting", "forced-exhale").
@@ -197,7 +215,9 @@ class MainWindow : public QMainWindow {
   std::vector<QCheckBox*> m_groupChecks;
   std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique
   QLabel* m_selection = nullptr;
-  QLabel* m_breathing = nullptr;  // Snapshot::breathing, in people's units
+  QLabel* m_breathing = nullptr;          // Snapshot::breathing, in people's units
+  QLabel* m_scenarioNote = nullptr;       // the opened scenario's name and description
+  QDockWidget* m_scenarioDock = nullptr;  // holds m_scenarioNote, shown once a scenario is opened
   QSlider* m_timeline = nullptr;
   QLabel* m_timeLabel = nullptr;
   QLabel* m_statusModel = nullptr;

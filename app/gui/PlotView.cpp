@@ -1,8 +1,10 @@
 #include "gui/PlotView.h"
 
 #include <QContextMenuEvent>
+#include <QMouseEvent>
 #include <QPainter>
 #include <QPainterPath>
+#include <QWheelEvent>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -22,11 +24,13 @@ QColor toQColor(const viz::Color& c) { return QColor::fromRgbF(c.r, c.g, c.b); }
 // the export is the screen plot at this many times its size (at least), fonts and lines scaled alike
 constexpr double kMinExportScale = 2.0;
 constexpr double kExportWidth = 960.0;  // [px] the export's width when the widget is narrower than half of it
+constexpr double kZoomStep = 1.25;      // [-] span factor per wheel notch
+constexpr double kMinWindow = 1.0;      // [s] narrowest span
 
 }  // namespace
 
 PlotView::PlotView(QString title, QString yLabel, QWidget* parent)
-    : QWidget(parent), m_title(std::move(title)), m_yLabel(std::move(yLabel)), m_cursor(kNaN) {
+    : QWidget(parent), m_title(std::move(title)), m_yLabel(std::move(yLabel)), m_cursor(kNaN), m_end(kNaN) {
   setMinimumSize(260, 150);
   setSizePolicy(QSizePolicy::Expanding, QSizePolicy::Expanding);
 }
@@ -47,8 +51,62 @@ void PlotView::setWindow(double seconds) {
   update();
 }
 
+void PlotView::setViewEnd(double time) {
+  m_end = time;
+  update();
+}
+
 void PlotView::setCursor(double time) {
   m_cursor = time;
+  // follow the timeline: a cursor outside the span brings the span to it; back live, follow the newest
+  if (std::isnan(time)) {
+    m_end = kNaN;
+  } else if (m_window > 0.0 && !m_time.empty() && (time < shownEnd() - m_window || time > shownEnd())) {
+    m_end = std::min(m_time.back(), time + 0.5 * m_window);
+  }
+  update();
+}
+
+void PlotView::wheelEvent(QWheelEvent* event) {
+  if (m_time.empty() || event->angleDelta().y() == 0) return;
+  const viz::PlotLayout L = layout();
+  const double span = m_window > 0.0 ? m_window : m_time.back() - m_time.front();
+  const double end = shownEnd();
+  // the time under the mouse stays where it is
+  const double at = std::clamp(
+      L.x.lo + (event->position().x() - L.area.left) / std::max(1.0, L.area.width()) * (L.x.hi - L.x.lo),
+      end - span, end);
+  const double full = std::max(kMinWindow, m_time.back() - m_time.front());
+  const double next =
+      std::clamp(event->angleDelta().y() > 0 ? span / kZoomStep : span * kZoomStep, kMinWindow, full);
+  const double newEnd = at + (end - at) * next / span;
+  m_window = next;
+  m_end = newEnd >= m_time.back() ? kNaN : newEnd;
+  emit viewChanged(m_window, m_end);
+  update();
+}
+
+void PlotView::mousePressEvent(QMouseEvent* event) {
+  if (event->button() == Qt::LeftButton) m_dragFrom = event->localPos().x();
+}
+
+void PlotView::mouseMoveEvent(QMouseEvent* event) {
+  if (!(event->buttons() & Qt::LeftButton) || m_time.empty()) return;
+  const viz::PlotLayout L = layout();
+  const double secondsPerPixel = (L.x.hi - L.x.lo) / std::max(1.0, L.area.width());
+  const double x = event->localPos().x();
+  const double end =
+      std::clamp(shownEnd() - (x - m_dragFrom) * secondsPerPixel,
+                 m_time.front() + std::min(m_window, m_time.back() - m_time.front()), m_time.back());
+  m_dragFrom = x;
+  m_end = end >= m_time.back() ? kNaN : end;
+  emit viewChanged(m_window, m_end);
+  update();
+}
+
+void PlotView::mouseDoubleClickEvent(QMouseEvent*) {
+  m_end = kNaN;
+  emit viewChanged(m_window, m_end);
   update();
 }
 
@@ -64,10 +122,21 @@ QString PlotView::unit() const {
   return open >= 0 ? m_yLabel.mid(open) : QString();
 }
 
+double PlotView::shownEnd() const {
+  if (m_time.empty()) return 0.0;
+  return std::isnan(m_end) ? m_time.back() : std::min(m_end, m_time.back());
+}
+
 std::size_t PlotView::firstShown() const {
   if (m_time.empty() || m_window <= 0.0) return 0;
-  const double from = m_time.back() - m_window;
+  const double from = shownEnd() - m_window;
   return static_cast<std::size_t>(std::lower_bound(m_time.begin(), m_time.end(), from) - m_time.begin());
+}
+
+std::size_t PlotView::endShown() const {
+  if (m_time.empty() || m_window <= 0.0 || std::isnan(m_end)) return m_time.size();
+  return static_cast<std::size_t>(std::upper_bound(m_time.begin(), m_time.end(), shownEnd()) -
+                                  m_time.begin());
 }
 
 double PlotView::cursorValue(std::size_t i) const {
@@ -87,18 +156,20 @@ viz::Plot PlotView::toPlot(double scale) const {
   viz::Plot plot(m_title.toStdString(), "time [s]", m_yLabel.toStdString());
   plot.setNote(m_note.toStdString());
   plot.setIncludeZero(m_includeZero);
-  // x range: the rolling window ending at the newest sample (starting at the first one early on)
+  // x range: the rolling window ending at the newest sample or the scrolled-to end (starting at the first one
+  // early on)
   const double t0 = m_time.empty() ? 0.0 : m_time.front();
-  const double tLast = m_time.empty() ? 0.0 : m_time.back();
+  const double tLast = shownEnd();
   const double tStart = m_window > 0.0 ? std::max(t0, tLast - m_window) : t0;
   const double tEnd = m_window > 0.0 ? std::max(tLast, tStart + m_window) : std::max(tLast, t0 + 1.0);
   plot.setXRange(tStart, std::max(tEnd, tStart + 1e-6));
-  const std::size_t first = firstShown();
-  const std::vector<double> x(m_time.begin() + static_cast<std::ptrdiff_t>(first), m_time.end());
+  const std::size_t first = firstShown(), last = endShown();
+  const std::vector<double> x(m_time.begin() + static_cast<std::ptrdiff_t>(first),
+                              m_time.begin() + static_cast<std::ptrdiff_t>(std::max(first, last)));
   for (const Series& s : m_series) {
     viz::Plot::Series out;
     out.label = s.legend.toStdString();
-    const std::size_t n = std::min(s.y.size(), m_time.size());
+    const std::size_t n = std::min({s.y.size(), m_time.size(), last});
     out.y.assign(s.y.begin() + static_cast<std::ptrdiff_t>(std::min(first, n)),
                  s.y.begin() + static_cast<std::ptrdiff_t>(n));
     out.x.assign(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(out.y.size()));
@@ -138,7 +209,7 @@ std::string PlotView::toCsv() const {
   csv << "time [s]";
   for (const Series& s : m_series) csv << ',' << s.name.toStdString() << ' ' << u;
   csv << '\n';
-  for (std::size_t k = firstShown(); k < m_time.size(); ++k) {
+  for (std::size_t k = firstShown(); k < endShown(); ++k) {
     csv << m_time[k];
     for (const Series& s : m_series) csv << ',' << s.y[k];
     csv << '\n';
@@ -262,9 +333,12 @@ void PlotView::paintEvent(QPaintEvent*) {
     p.setPen(QPen(QColor(20, 110, 200), 1.5));
     p.drawLine(QPointF(cx, area.top()), QPointF(cx, area.bottom()));
     QStringList lines{QString("t = %1 s").arg(m_cursor, 0, 'f', 2)};
+    const QString u = unit();  // "[mL]" -> "mL"
+    const QString unitName = u.size() >= 2 ? u.mid(1, u.size() - 2) : QString();
     for (std::size_t i = 0; i < m_series.size() && lines.size() < 4; ++i) {
       const double v = cursorValue(i);
-      if (std::isfinite(v)) lines << QString("%1 %2").arg(m_series[i].name).arg(v, 0, 'g', 4);
+      if (std::isfinite(v))
+        lines << QString("%1 %2 %3").arg(m_series[i].name).arg(v, 0, 'g', 4).arg(unitName);
     }
     const QString readOut = lines.join('\n');
     QRectF readOutBox = fm.boundingRect(QRect(0, 0, 400, 200), 0, readOut);

@@ -40,9 +40,15 @@ class PlotView : public QWidget {
   /// Replaces the data: shared time samples [s] and one Series per curve (each of time.size() values).
   void setData(std::vector<double> time, std::vector<Series> series);
   void setReferences(std::vector<Reference> references);
-  /// Time span shown [s], ending at the newest sample (0 = everything).
+  /// Time span shown [s], ending at the newest sample or at viewEnd() (0 = everything).
   void setWindow(double seconds);
-  /// Vertical cursor at time [s] (NaN hides it); the read-out lists each series' value there.
+  double window() const { return m_window; }
+  /// Right edge of the shown span [s]; NaN follows the newest sample (the default). The wheel zooms the span
+  /// (about the time under the mouse), a drag scrolls it, a double click follows the newest sample again.
+  void setViewEnd(double time);
+  double viewEnd() const { return m_end; }
+  /// Vertical cursor at time [s] (NaN hides it); the read-out lists each series' value there in the y unit.
+  /// A cursor outside the shown span scrolls the span to centre it (the plots follow the timeline).
   void setCursor(double time);
   /// One line of text under the title, e.g. "tidal volume 498 mL".
   void setNote(QString note);
@@ -69,13 +75,21 @@ class PlotView : public QWidget {
  signals:
   /// The user asked for the context menu (export actions).
   void contextMenuRequested(const QPoint& globalPos);
+  /// The user zoomed or scrolled: the new span [s] and right edge [s] (NaN: following the newest sample).
+  void viewChanged(double window, double end);
 
  protected:
   void paintEvent(QPaintEvent* event) override;
   void contextMenuEvent(QContextMenuEvent* event) override;
+  void wheelEvent(QWheelEvent* event) override;
+  void mousePressEvent(QMouseEvent* event) override;
+  void mouseMoveEvent(QMouseEvent* event) override;
+  void mouseDoubleClickEvent(QMouseEvent* event) override;
 
  private:
   std::size_t firstShown() const;
+  std::size_t endShown() const;  // one past the last sample shown
+  double shownEnd() const;       // [s] right edge of the span
   viz::PlotLayout layoutOf(const viz::Plot& plot) const;
   QString unit() const;
 
@@ -85,8 +99,10 @@ class PlotView : public QWidget {
   std::vector<double> m_time;
   std::vector<Series> m_series;
   std::vector<Reference> m_references;
-  double m_window = 20.0;  // [s]
-  double m_cursor;         // [s], NaN = none
+  double m_window = 20.0;   // [s]
+  double m_cursor;          // [s], NaN = none
+  double m_end;             // [s] right edge, NaN = the newest sample
+  double m_dragFrom = 0.0;  // [px] x of the last drag position
   bool m_includeZero = false;
 };
 

@@ -29,8 +29,8 @@ std::vector<std::string> fields(const std::string& line) {
 
 }  // namespace
 
-RunOverlay runScenarioOverlay(const QString& path, std::shared_ptr<const sim::Model> model, const QString& modelDir,
-                              const std::function<bool(double)>& progress) {
+RunOverlay runScenarioOverlay(const QString& path, std::shared_ptr<const sim::Model> model,
+                              const QString& modelDir, const std::function<bool(double)>& progress) {
   const sim::Scenario scenario = sim::loadScenario(path.toStdString());
   // the same model, or nothing to compare
   const QString wanted = scenario.model == "default" ? DocumentController::defaultModelDir()

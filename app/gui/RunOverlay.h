@@ -24,8 +24,8 @@ struct RunOverlay {
 /// after each frame and stops the run by returning false (then the result is empty).
 /// @throws std::exception naming the file: a bad scenario, or one that names another model directory than
 ///         `modelDir` ("overlay: <file> runs the model in '<dir>', the window shows '<dir>'").
-RunOverlay runScenarioOverlay(const QString& path, std::shared_ptr<const sim::Model> model, const QString& modelDir,
-                              const std::function<bool(double)>& progress = {});
+RunOverlay runScenarioOverlay(const QString& path, std::shared_ptr<const sim::Model> model,
+                              const QString& modelDir, const std::function<bool(double)>& progress = {});
 
 /// Reads a recording: `path` is a timeseries.csv of `pneuma-cli simulate` (columns "time [s]" and
 /// "lung_volume [mL]"; flow is the backward difference, pressures are not recorded there) or its folder.

@@ -215,7 +215,7 @@ void SimWorker::applySettings(const RunSettings& settings) {
   m_settings = settings;
 }
 
-void SimWorker::collect(const sim::Simulation& simulation) {
+PlotSample plotSample(const sim::Simulation& simulation, double previousTime, double previousVolume) {
   const sim::Metrics& m = simulation.latestMetrics();
   PlotSample s;
   s.time = m.time;
@@ -223,16 +223,22 @@ void SimWorker::collect(const sim::Simulation& simulation) {
   s.rightLungVolume = m.rightLungVolume;
   s.leftLungVolume = m.leftLungVolume;
   s.gutVolumeError = m.gutVolumeError;
-  if (m.time > m_previousTime) s.flow = (m.lungVolume - m_previousVolume) / (m.time - m_previousTime);
-  m_previousTime = m.time;
-  m_previousVolume = m.lungVolume;
+  if (m.time > previousTime) s.flow = (m.lungVolume - previousVolume) / (m.time - previousTime);
   s.gutPressure = m.gutPressure;
-  if (m_model->cavity.compliance > 0.0)
+  if (simulation.model().cavity.compliance > 0.0)
     s.transdiaphragmaticPressure = m.gutPressure - simulation.stepWork().outputs.pleuralPressure;
-  s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
-                             : std::numeric_limits<double>::quiet_NaN();
   s.activations = m.activations;
   s.groupMeanTension = m.groupMeanTension;
+  return s;
+}
+
+void SimWorker::collect(const sim::Simulation& simulation) {
+  const sim::Metrics& m = simulation.latestMetrics();
+  PlotSample s = plotSample(simulation, m_previousTime, m_previousVolume);
+  m_previousTime = m.time;
+  m_previousVolume = m.lungVolume;
+  s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
+                             : std::numeric_limits<double>::quiet_NaN();
   s.elementForce.assign(m.elementForce.data(), m.elementForce.data() + m.elementForce.size());
   m_samples.push_back(std::move(s));
   findEndExpiration(simulation);

@@ -53,6 +53,12 @@ struct PlotSample {
   std::vector<float> elementForce;                                 ///< [N] signed, per element (#E)
 };
 
+/// The plotted quantities of `simulation`'s latest frame, the one rule for the live plots and an overlaid run
+/// (RunOverlay.h): flow is the backward difference from the previous frame at `previousTime` [s] with lung
+/// volume `previousVolume` [m^3] (NaN when `previousTime` is NaN or not earlier); targetVolume stays NaN and
+/// elementForce empty.
+PlotSample plotSample(const sim::Simulation& simulation, double previousTime, double previousVolume);
+
 /// What the GUI draws at one instant, copied out of the simulation.
 struct Snapshot {
   std::shared_ptr<const sim::Model> model;  ///< the model the state belongs to

@@ -110,8 +110,16 @@ int main(int argc, char** argv) {
       "Show the morph playback of the --affect (default neutral) instead of the physics: the skin on its "
       "baked morph targets, no physics (de Melo et al. 2010). With --screenshot, --after is the pattern "
       "time.");
+  const QCommandLineOption scenario(
+      "scenario", "Open a scenario file (e.g. a teaching preset in resources/scenarios/teaching) at start.",
+      "FILE");
+  const QCommandLineOption compare(
+      "compare",
+      "Draw a second run dashed over the plots: a scenario (.json) run on the same model, or a recording "
+      "(a pneuma-cli simulate folder or its timeseries.csv).",
+      "FILE");
   parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
-                     screenshot, after, exportGltf, measure, morphPlayback});
+                     screenshot, after, exportGltf, measure, morphPlayback, scenario, compare});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -191,6 +199,15 @@ int main(int argc, char** argv) {
   if (hasModel && parser.isSet(affect)) {
     // an unknown name is reported by the window (dialog, or stderr when scripted)
     if (!window.pushAffect(parser.value(affect), true).isEmpty() && isScripted) return 2;
+  }
+  if (hasModel && parser.isSet(scenario) && !window.openScenario(parser.value(scenario)).isEmpty() &&
+      isScripted)
+    return 2;
+  if (hasModel && parser.isSet(compare)) {
+    const QString path = parser.value(compare);
+    const QString error =
+        path.endsWith(".json") ? window.overlayScenario(path) : window.overlayRecording(path);
+    if (!error.isEmpty() && isScripted) return 2;
   }
   window.scene().setCamera(preset->second);
   {

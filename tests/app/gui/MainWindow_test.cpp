@@ -1005,3 +1005,96 @@ TEST(MainWindow, MorphPlaybackOfAModelWithoutSkinIsDisabledWithTheReason) {
   EXPECT_TRUE(w.window.setMorphPlayback(true).contains("has no skin"));
   EXPECT_FALSE(w.window.isMorphPlayback());
 }
+
+namespace {
+
+// a copy of the shipped calm scenario, shortened to `seconds` after settling, in `dir`
+QString shortCalm(const QTemporaryDir& dir, double seconds) {
+  sim::Scenario calm = sim::loadScenario(sim::resourceDir() + "/scenarios/calm.json");
+  calm.name = "calm-short";
+  calm.duration = seconds;
+  const QString path = dir.filePath("calm-short.json");
+  sim::saveScenario(calm, path.toStdString());
+  return path;
+}
+
+// the volume plot's series named `name`, null when absent
+const app::PlotView::Series* seriesNamed(const app::PlotView* plot, const QString& name) {
+  for (const app::PlotView::Series& s : plot->series())
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+// a teaching preset opens with its explanation on show; the normal run drawn dashed over it carries that
+// run's own volumes, and the paralysed run breathes less than the normal one beside it
+TEST_F(DefaultModelWindow, TeachingPresetShowsItsExplanationAndTheNormalRunDashed) {
+  const QStringList presets = MainWindow::teachingPresets();
+  EXPECT_EQ(presets.size(), 6) << presets.join(", ").toStdString();
+  const QString left =
+      QString::fromStdString(sim::resourceDir()) + "/scenarios/teaching/paralysed-left-hemidiaphragm.json";
+  ASSERT_TRUE(presets.contains(left));
+  ASSERT_EQ(window.openScenario(left), QString());
+  EXPECT_TRUE(window.scenarioExplanation().startsWith("paralysed-left-hemidiaphragm"));
+  EXPECT_TRUE(window.scenarioExplanation().contains("Laroche et al. 1988"));
+
+  QTemporaryDir dir;
+  ASSERT_EQ(window.overlayScenario(shortCalm(dir, 6.0)), QString());
+  ASSERT_TRUE(window.runUntil(7.5, 180000)) << window.lastError().toStdString();
+  const app::PlotView* plot = window.plots()->volumePlot();
+  const app::PlotView::Series* normal = seriesNamed(plot, "calm-short lung volume");
+  ASSERT_NE(normal, nullptr) << "the compared run is plotted";
+  EXPECT_TRUE(normal->isDashed);
+  EXPECT_EQ(normal->legend, "calm-short");
+  // at every plotted time the overlaid run sampled too, the dashed value is that run's volume there [mL]
+  const std::vector<app::PlotSample>& run = window.plots()->overlay().samples;
+  ASSERT_GT(run.size(), 100u);
+  int matched = 0;
+  for (std::size_t k = 0; k < plot->time().size(); ++k) {
+    const auto at = std::lower_bound(run.begin(), run.end(), plot->time()[k],
+                                     [](const app::PlotSample& s, double t) { return s.time < t; });
+    if (at == run.end() || std::abs(at->time - plot->time()[k]) > 1e-9) continue;
+    EXPECT_NEAR(normal->y[k], 1e6 * at->lungVolume, 1e-6) << "at " << plot->time()[k] << " s";
+    ++matched;
+  }
+  EXPECT_GT(matched, 100);
+  // over the last breath, the paralysed run's swing is well below the normal one's
+  const auto swing = [&](const std::vector<double>& y) {
+    double lo = 1e300, hi = -1e300;
+    for (std::size_t k = 0; k < y.size(); ++k)
+      if (plot->time()[k] >= 3.5 && std::isfinite(y[k])) lo = std::min(lo, y[k]), hi = std::max(hi, y[k]);
+    return hi - lo;
+  };
+  EXPECT_LT(swing(plot->series()[0].y), 0.9 * swing(normal->y));
+  // the flow plot has its dashed twin too, and removing the comparison removes both
+  EXPECT_NE(seriesNamed(window.plots()->flowPlot(), "calm-short flow"), nullptr);
+  window.clearOverlay();
+  window.plots()->refresh();
+  EXPECT_EQ(seriesNamed(window.plots()->volumePlot(), "calm-short lung volume"), nullptr);
+}
+
+// a run of another model is not drawn: a scenario of the default model or a recording of it, over the toy
+// torso, each gives a message naming both models
+TEST(MainWindow, ComparisonWithAnotherModelIsRefusedWithAMessage) {
+  ToyWindow w;
+  const QString calm = QString::fromStdString(sim::resourceDir()) + "/scenarios/calm.json";
+  const QString error = w.window.overlayScenario(calm);
+  EXPECT_TRUE(error.contains("runs the model in")) << error.toStdString();
+  EXPECT_TRUE(error.contains("the window shows '" + w.modelDir + "'")) << error.toStdString();
+
+  QTemporaryDir dir;
+  QFile summary(dir.filePath("summary.json"));
+  ASSERT_TRUE(summary.open(QIODevice::WriteOnly));
+  summary.write(R"({"model_name": "adult_male"})");
+  summary.close();
+  QFile csv(dir.filePath("timeseries.csv"));
+  ASSERT_TRUE(csv.open(QIODevice::WriteOnly));
+  csv.write("time [s],lung_volume [mL]\n0,4500\n0.1,4510\n");
+  csv.close();
+  const QString recording = w.window.overlayRecording(dir.filePath("timeseries.csv"));
+  EXPECT_TRUE(recording.contains("was recorded on model 'adult_male', the window shows '" +
+                                 QString::fromStdString(w.window.model()->name) + "'"))
+      << recording.toStdString();
+  EXPECT_TRUE(w.window.plots()->overlay().samples.empty()) << "nothing is drawn";
+}

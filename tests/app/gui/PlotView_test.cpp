@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <QApplication>
+#include <QMouseEvent>
+#include <QWheelEvent>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -90,4 +93,51 @@ TEST(PlotView, TicksLieInsideTheBoxAndLabelsDoNotOverlap) {
   for (const viz::PlotLayout::Text& t : L.yTickLabels) EXPECT_LE(t.box.right, L.area.left);
   EXPECT_GT(L.area.top, L.title.box.bottom);
   for (const viz::PlotLayout::LegendEntry& e : L.legend) EXPECT_LE(e.box.bottom, L.area.top);
+}
+
+// the plot keeps the whole history: the wheel zooms the span about the mouse, a drag scrolls back, a cursor
+// outside the span brings the span to it (the plots follow the timeline), a double click follows the newest
+// sample again
+TEST(PlotView, WheelZoomsDragScrollsAndTheSpanFollowsTheCursor) {
+  app::test::application();
+  PlotView view("Lung-cavity volume", "lung-cavity volume [mL]");
+  view.resize(480, 300);
+  fill(view);  // 0-30 s, a 20 s span
+  viz::PlotLayout L = view.layout();
+  EXPECT_DOUBLE_EQ(L.x.lo, 10.0);
+  const QPointF right(L.area.right - 1.0, 0.5 * (L.area.top + L.area.bottom));
+  QWheelEvent in(right, view.mapToGlobal(right.toPoint()), QPoint(), QPoint(0, 120), Qt::NoButton,
+                 Qt::NoModifier, Qt::NoScrollPhase, false);
+  QApplication::sendEvent(&view, &in);
+  EXPECT_DOUBLE_EQ(view.window(), 16.0);
+  L = view.layout();
+  EXPECT_NEAR(L.x.hi, 30.0, 0.1);
+  EXPECT_NEAR(L.x.hi - L.x.lo, 16.0, 1e-9);
+
+  // drag right by half the plot: 8 s earlier, and the series stop at the span's end
+  const double pixels = 0.5 * L.area.width();
+  const QPointF from(L.area.left + 10.0, right.y()), to(from.x() + pixels, right.y());
+  QMouseEvent press(QEvent::MouseButtonPress, from, Qt::LeftButton, Qt::LeftButton, Qt::NoModifier);
+  QMouseEvent move(QEvent::MouseMove, to, Qt::NoButton, Qt::LeftButton, Qt::NoModifier);
+  QApplication::sendEvent(&view, &press);
+  QApplication::sendEvent(&view, &move);
+  L = view.layout();
+  EXPECT_NEAR(L.x.hi, 22.0, 0.2);
+  const viz::Plot shown = view.toPlot(1.0);
+  ASSERT_FALSE(shown.series()[0].x.empty());
+  EXPECT_LE(shown.series()[0].x.back(), L.x.hi + 1e-9);
+  EXPECT_GE(shown.series()[0].x.front(), L.x.lo - 0.05);
+
+  // a scrubbed instant outside the span: the span moves to centre it
+  view.setCursor(3.0);
+  L = view.layout();
+  EXPECT_LE(L.x.lo, 3.0);
+  EXPECT_GE(L.x.hi, 3.0);
+  EXPECT_TRUE(std::isfinite(view.cursorValue(0)));
+
+  // a double click follows the newest sample
+  QMouseEvent twice(QEvent::MouseButtonDblClick, from, Qt::LeftButton, Qt::LeftButton, Qt::NoModifier);
+  QApplication::sendEvent(&view, &twice);
+  EXPECT_TRUE(std::isnan(view.viewEnd()));
+  EXPECT_NEAR(view.layout().x.hi, 30.0, 1e-9);
 }
