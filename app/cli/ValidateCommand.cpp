@@ -359,7 +359,7 @@ void runValidate(const ValidateArgs& args) {
          << silHtml.str() << "</table>\n";
   for (const BreathOutlines& b : outlines)
     html << "<img alt=\"silhouette " << htmlEscape(b.breath.style)
-         << "\" style=\"width:24%\" src=\"data:image/png;base64,"
+         << "\" style=\"width:49%\" src=\"data:image/png;base64,"
          << base64(silhouettePlot(b, sim::SilhouetteView::Lateral).toPng()) << "\">";
   if (!outlines.empty())
     html << "\n<p>Lateral silhouettes of the trunk, to scale (mm): end-expiration blue, end-inspiration red; "
@@ -383,9 +383,12 @@ void runValidate(const ValidateArgs& args) {
     std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("physiology."),
                 c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
                 c.target.c_str());
+  if (!silhouette.empty())
+    std::printf("\n%-36s %-8s %-14s %s\n", "silhouette", "range", "measured", "published");
   for (const sim::Check& c : silhouette)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str(), c.isPassed() ? "within" : "OUTSIDE",
-                (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
+    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("silhouette."),
+                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
+                c.target.c_str());
   if (!silhouetteProblem.empty()) std::printf("silhouette: none (%s)\n", silhouetteProblem.c_str());
   std::printf(
       "%s; physiology: %d of %zu within published ranges; silhouette: %d of %zu; report: %s/report.html "
