@@ -14,6 +14,7 @@
 #include <QElapsedTimer>
 #include <QEventLoop>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -223,6 +224,11 @@ void MainWindow::buildActions() {
   file->addAction("Open &scenario\u2026", this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, "Open scenario", QString(), "Scenario (*.json)");
     if (!path.isEmpty()) openScenario(path);
+  });
+  file->addAction("Open &trace\u2026", this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, "Open volume trace", QString(),
+                                                      "Volume trace (*.csv);;All files (*)");
+    if (!path.isEmpty()) openTrace(path);
   });
   file->addAction(
       "Sa&ve scenario\u2026", this,
@@ -646,6 +652,22 @@ QString MainWindow::openScenario(const QString& path) {
   const QSignalBlocker block(m_styleCombo);
   m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
   showMessage(QString("Scenario '%1' loaded").arg(scenario.name), 5000);
+  return {};
+}
+
+QString MainWindow::openTrace(const QString& path) {
+  if (!m_worker) return "no model is open";
+  std::shared_ptr<const sim::Scenario> drive;
+  try {
+    drive = DocumentController::readTrace(path);
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot open trace '%1': %2").arg(path, e.what());
+    report("Trace not loaded", message);
+    return message;
+  }
+  m_drive = std::move(drive);
+  m_worker->requestScenario(m_drive);
+  showMessage(QString("Following trace '%1'").arg(QFileInfo(path).fileName()), 5000);
   return {};
 }
 

@@ -231,6 +231,7 @@ void SimWorker::collect(const sim::Simulation& simulation) {
     s.transdiaphragmaticPressure = m.gutPressure - simulation.stepWork().outputs.pleuralPressure;
   s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
                              : std::numeric_limits<double>::quiet_NaN();
+  s.trackingRmsPercent = simulation.controller().trackingRmsPercent();
   s.activations = m.activations;
   s.groupMeanTension = m.groupMeanTension;
   s.elementForce.assign(m.elementForce.data(), m.elementForce.data() + m.elementForce.size());

@@ -1,5 +1,6 @@
-// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--magnify N] [--model
-// DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
+// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--trace CSV]
+// [--magnify N]
+// [--model DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -74,6 +75,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption style("style", "Breath style: calm, deep, panting or forced-exhale.", "NAME");
   const QCommandLineOption affect(
       "affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).", "NAME");
+  const QCommandLineOption volumeTrace(
+      "trace", "Follow a measured lung-volume trace (CSV: time [s], volume [L] or [mL]; docs/patterns.md).",
+      "FILE");
   const QCommandLineOption posture(
       "posture",
       QString::fromStdString("Gravity relative to the body: " + pneuma::sim::postureNames() + " (default " +
@@ -110,8 +114,8 @@ int main(int argc, char** argv) {
       "Show the morph playback of the --affect (default neutral) instead of the physics: the skin on its "
       "baked morph targets, no physics (de Melo et al. 2010). With --screenshot, --after is the pattern "
       "time.");
-  parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
-                     screenshot, after, exportGltf, measure, morphPlayback});
+  parser.addOptions({model, style, affect, volumeTrace, posture, camera, labels, skin, magnify, physiology,
+                     speed, screenshot, after, exportGltf, measure, morphPlayback});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -191,6 +195,10 @@ int main(int argc, char** argv) {
   if (hasModel && parser.isSet(affect)) {
     // an unknown name is reported by the window (dialog, or stderr when scripted)
     if (!window.pushAffect(parser.value(affect), true).isEmpty() && isScripted) return 2;
+  }
+  if (hasModel && parser.isSet(volumeTrace)) {
+    // a bad trace is reported by the window (dialog, or stderr when scripted)
+    if (!window.openTrace(parser.value(volumeTrace)).isEmpty() && isScripted) return 2;
   }
   window.scene().setCamera(preset->second);
   {
