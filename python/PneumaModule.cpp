@@ -3,13 +3,17 @@
 /// physics: models are loaded with sim::loadModel(), runs are sim::Simulation, controllers come from
 /// sim::makeController() as in `pneuma-cli simulate`, and parameters change through sim::applyOverride(), the
 /// scenario files' rule. Arrays are SI, as inside the simulator; the state's node and body positions are
-/// numpy views of the simulation's own (3 x N) matrices, without a copy.
+/// numpy views of the simulation's own (3 x N) matrices, without a copy. The output files (summary.json,
+/// timeseries.csv, the plots, a ParaView series) are written by the CLI's own writers (viz::RunRecord,
+/// viz::runSummary(), viz::VtkSeriesWriter), so they are the same files as `pneuma-cli simulate` writes.
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,6 +24,10 @@
 #include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/pattern/PatternController.h"
+#include "viz/AtomicFile.h"
+#include "viz/RunRecord.h"
+#include "viz/RunSummary.h"
+#include "viz/VtkSeriesWriter.h"
 
 namespace py = pybind11;
 namespace sim = pneuma::sim;
@@ -50,8 +58,8 @@ py::array_t<double> viewOf(const Eigen::Matrix3Xd& x, const py::object& owner) {
 /// One simulation run driven from Python.
 class PySimulation {
  public:
-  PySimulation(std::shared_ptr<const sim::Model> model, sim::Scenario scenario)
-      : m_model(std::move(model)), m_scenario(std::move(scenario)) {
+  PySimulation(std::shared_ptr<const sim::Model> model, std::string modelDir, sim::Scenario scenario)
+      : m_model(std::move(model)), m_modelDir(std::move(modelDir)), m_scenario(std::move(scenario)) {
     std::unique_ptr<sim::Controller> controller =
         sim::makeController(m_scenario, m_model, sim::resourceDir());
     // the pattern controller stays reachable for push_affect() and the target/measured series
@@ -105,6 +113,40 @@ class PySimulation {
       throw sim::Error("push_pattern: no pattern plays; start with affect= or pattern=");
     m_pattern->push(sim::pattern::loadPatternFile(path, sim::resourceDir()).layers,
                     immediate ? sim::pattern::SwitchMode::Immediate : sim::pattern::SwitchMode::EndOfCycle);
+  }
+
+  void startOutputs(const std::string& directory, bool csv, bool plots, bool vtk) {
+    if (directory.empty()) throw sim::Error("start_outputs: directory: must not be empty");
+    std::filesystem::create_directories(directory);
+    auto record = std::make_unique<pneuma::viz::RunRecord>(
+        *m_model, m_sim->controller().tracksVolume(), csv ? directory + "/timeseries.csv" : std::string());
+    m_vtk = vtk ? std::make_unique<pneuma::viz::VtkSeriesWriter>(*m_model, m_modelDir, directory, "frames")
+                : nullptr;
+    m_record = std::move(record);
+    m_outDir = directory, m_hasCsv = csv, m_hasPlots = plots;
+  }
+
+  std::vector<std::string> writeOutputs() {
+    if (!m_record) throw sim::Error("write_outputs: no outputs started; call start_outputs(directory) first");
+    std::vector<std::string> files;
+    if (m_hasCsv) {
+      m_record->commitCsv();
+      files.push_back("timeseries.csv");
+    }
+    if (m_hasPlots && m_record->size() > 0)
+      for (const std::string& f : m_record->writePlots(m_outDir, m_scenario.name)) files.push_back(f);
+    if (m_vtk) files.push_back(m_vtk->finish());
+    // the run's duration is what ran after settling
+    sim::Scenario ran = m_scenario;
+    ran.duration = std::max(0.0, m_sim->state().time - m_sim->options().settleTime);
+    const nlohmann::json summary = pneuma::viz::runSummary(
+        *m_model, ran, m_sim.get(),
+        {m_modelDir, m_sim->controller().describe(), false, "", m_record->size(), files});
+    pneuma::viz::writeFileAtomically(m_outDir + "/summary.json", summary.dump(2) + "\n");
+    m_record.reset();
+    m_vtk.reset();
+    files.insert(files.begin(), "summary.json");
+    return files;
   }
 
   py::dict frames() const {
@@ -179,6 +221,13 @@ class PySimulation {
 
  private:
   void record(const sim::Metrics& m) {
+    if (m_record) {
+      if (m_sim->controller().tracksVolume())
+        m_record->append(m, m_sim->controller().targetFraction(), m_sim->controller().measuredFraction());
+      else
+        m_record->append(m);
+    }
+    if (m_vtk) m_vtk->writeFrame(m_sim->state(), m);
     m_frames.time.push_back(m.time);
     m_frames.lungVolume.push_back(m.lungVolume);
     m_frames.abdomenVolume.push_back(m.abdomenVolume);
@@ -192,10 +241,16 @@ class PySimulation {
   }
 
   std::shared_ptr<const sim::Model> m_model;
+  std::string m_modelDir;  // for the ParaView series' body meshes
   sim::Scenario m_scenario;
   std::unique_ptr<sim::Simulation> m_sim;
   sim::pattern::PatternController* m_pattern = nullptr;  // owned by m_sim; null for a breath style
   Frames m_frames;
+  // the output files being recorded (start_outputs() to write_outputs())
+  std::unique_ptr<pneuma::viz::RunRecord> m_record;
+  std::unique_ptr<pneuma::viz::VtkSeriesWriter> m_vtk;
+  std::string m_outDir;
+  bool m_hasCsv = false, m_hasPlots = false;
 };
 
 /// A scenario from keyword arguments (or a file), with `overrides` applied by the scenario files' rule.
@@ -222,6 +277,9 @@ sim::Scenario scenarioFrom(const std::string& file, const std::string& style, co
                                  : py::module_::import("json").attr("dumps")(value).cast<std::string>();
     sim::applyOverride(s.options, key.cast<std::string>(), text, "overrides");
   }
+  // named as pneuma-cli simulate names a run without a scenario name (summary.json's "scenario", plot titles)
+  if (s.name.empty())
+    s.name = s.controllerName.empty() ? "run" : std::filesystem::path(s.controllerName).stem().string();
   s.options.recordSeconds = sim::kTraceOnlyRecordSeconds;
   return s;
 }
@@ -234,8 +292,9 @@ PYBIND11_MODULE(pneuma, m) {
       "Every quantity is SI: volumes in m^3, lengths in m, times in s, forces in N.";
   py::register_exception<sim::Error>(m, "Error", PyExc_ValueError);
 
-  py::class_<sim::Model, std::shared_ptr<sim::Model>>(m, "Model",
-                                                      "An immutable torso model (docs/model-format.md).")
+  py::class_<sim::Model, std::shared_ptr<sim::Model>>(
+      m, "Model", py::dynamic_attr(),
+      "An immutable torso model (docs/model-format.md); `directory` is where load_model() read it.")
       .def_readonly("name", &sim::Model::name, "model name")
       .def_property_readonly(
           "body_count", [](const sim::Model& mo) { return mo.bodies.mass.size(); }, "rigid bodies [-]")
@@ -248,7 +307,10 @@ PYBIND11_MODULE(pneuma, m) {
   m.def(
       "load_model",
       [](const std::string& dir) {
-        return std::make_shared<sim::Model>(sim::loadModel(dir.empty() ? sim::defaultModelDir() : dir));
+        const std::string path = dir.empty() ? sim::defaultModelDir() : dir;
+        py::object model = py::cast(std::make_shared<sim::Model>(sim::loadModel(path)));
+        model.attr("directory") = path;  // for the ParaView series' body meshes (start_outputs(vtk=True))
+        return model;
       },
       py::arg("directory") = "",
       "Loads a model directory (model.json); the default model when `directory` is empty "
@@ -257,26 +319,28 @@ PYBIND11_MODULE(pneuma, m) {
   m.def("override_keys", &sim::overrideKeys, "The keys Simulation.set() and overrides= accept.");
 
   py::class_<PySimulation>(m, "Simulation", "One run: the model, its state, a controller and the options.")
-      .def(py::init([](std::shared_ptr<sim::Model> model, const std::string& scenario,
-                       const std::string& style, const std::string& affect, const std::string& pattern,
-                       std::uint64_t seed, const py::object& dt, const py::object& settleTime,
-                       double outputRate, const py::dict& overrides) {
-             return std::make_unique<PySimulation>(
-                 model,
-                 scenarioFrom(scenario, style, affect, pattern, seed, dt, settleTime, outputRate, overrides));
-           }),
-           py::arg("model"), py::kw_only(), py::arg("scenario") = "", py::arg("style") = "",
-           py::arg("affect") = "", py::arg("pattern") = "", py::arg("seed") = 0, py::arg("dt") = py::none(),
-           py::arg("settle_time") = py::none(), py::arg("output_rate") = 60.0,
-           py::arg("overrides") = py::dict(),
-           "Makes a run from a scenario file (`scenario=`) or from keyword arguments: one of `style` (calm, "
-           "deep, "
-           "panting, forced-exhale), `affect` (de Melo's presets) or `pattern` (a pattern file); `seed`; "
-           "`dt` [s] "
-           "time step (default: the integrator's, 10 ms for patterns); `settle_time` [s] settling before the "
-           "controller starts (default 2); `output_rate` [Hz] frames per simulated second (default 60); "
-           "`overrides`: {key: value} as a scenario's overrides (see override_keys()). An affect or pattern "
-           "calibrates its muscle drive on the model first (a few simulated seconds).")
+      .def(
+          py::init([](const py::object& model, const std::string& scenario, const std::string& style,
+                      const std::string& affect, const std::string& pattern, std::uint64_t seed,
+                      const py::object& dt, const py::object& settleTime, double outputRate,
+                      const py::dict& overrides) {
+            return std::make_unique<PySimulation>(
+                model.cast<std::shared_ptr<sim::Model>>(),
+                py::hasattr(model, "directory") ? model.attr("directory").cast<std::string>() : std::string(),
+                scenarioFrom(scenario, style, affect, pattern, seed, dt, settleTime, outputRate, overrides));
+          }),
+          py::arg("model"), py::kw_only(), py::arg("scenario") = "", py::arg("style") = "",
+          py::arg("affect") = "", py::arg("pattern") = "", py::arg("seed") = 0, py::arg("dt") = py::none(),
+          py::arg("settle_time") = py::none(), py::arg("output_rate") = 60.0,
+          py::arg("overrides") = py::dict(),
+          "Makes a run from a scenario file (`scenario=`) or from keyword arguments: one of `style` (calm, "
+          "deep, "
+          "panting, forced-exhale), `affect` (de Melo's presets) or `pattern` (a pattern file); `seed`; "
+          "`dt` [s] "
+          "time step (default: the integrator's, 10 ms for patterns); `settle_time` [s] settling before the "
+          "controller starts (default 2); `output_rate` [Hz] frames per simulated second (default 60); "
+          "`overrides`: {key: value} as a scenario's overrides (see override_keys()). An affect or pattern "
+          "calibrates its muscle drive on the model first (a few simulated seconds).")
       .def("run", &PySimulation::run, py::arg("seconds"),
            "Advances `seconds` [s] of simulated time, recording every output frame.")
       .def("step", &PySimulation::step, py::arg("count") = 1, "Takes `count` steps of dt.")
@@ -319,6 +383,18 @@ PYBIND11_MODULE(pneuma, m) {
            "and "
            "r [-] (frames x 6 groups: intercostal_external, intercostal_internal, diaphragm, rectus, "
            "transversus_obliques, cartilage).")
+      .def("start_outputs", &PySimulation::startOutputs, py::arg("directory"), py::kw_only(),
+           py::arg("csv") = true, py::arg("plots") = true, py::arg("vtk") = false,
+           "Records every output frame from now on into `directory` (created if missing), as `pneuma-cli "
+           "simulate --out` does: timeseries.csv (`csv`, the CLI's columns and units: mL, mm, %), the PNG "
+           "and SVG "
+           "plots (`plots`) and a ParaView series frames.pvd + frames/ (`vtk`; body meshes from the model's "
+           "directory). Nothing is final until write_outputs().")
+      .def("write_outputs", &PySimulation::writeOutputs,
+           "Writes what start_outputs() recorded and summary.json (the CLI's keys and units; duration_s is "
+           "the "
+           "time run after settling), each through a temporary file and a rename; returns the file names "
+           "written, summary.json first.")
       .def("metrics", &PySimulation::metrics,
            "The latest output frame: volumes [m^3], gut_pressure [Pa], energies [J], element_force [N] (#E), "
            "group_mean_tension [N] (6), landmarks [m] (3, #L).")

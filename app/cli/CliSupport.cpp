@@ -89,13 +89,6 @@ void checkOption(const sim::Range& range, const char* flag, double v) {
   if (!range.contains(v)) fail(kExitBadInput, std::string(flag) + ": " + range.problem(v));
 }
 
-std::string formatNumber(double v) {
-  if (!std::isfinite(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
 void addModelOption(CLI::App& cmd, std::string& model) {
   cmd.add_option(
       "--model", model,
@@ -152,31 +145,6 @@ void addPostureOption(CLI::App& cmd, std::string& name) {
 void applyPosture(const std::string& name, sim::Posture& posture) {
   if (!name.empty() && !sim::postureFromName(name, posture))
     failUnknown("--posture", "posture", name, sim::postureNames());
-}
-
-}  // namespace pneuma::app
-
-namespace pneuma::app {
-
-nlohmann::json jsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-void writeMotion(const sim::Motion& m, nlohmann::json& j) {
-  constexpr double kMm = 1e3, kMl = 1e6;
-  j["dome_descent_mm"] = jsonNumber(m.domeDescent * kMm);
-  j["dome_anterior_mm"] = jsonNumber(m.domeAnterior * kMm);
-  j["sternum_anterior_mm"] = jsonNumber(m.sternumAnterior * kMm);
-  j["sternum_cranial_mm"] = jsonNumber(m.sternumCranial * kMm);
-  j["xiphoid_anterior_mm"] = jsonNumber(m.xiphoidAnterior * kMm);
-  j["xiphoid_cranial_mm"] = jsonNumber(m.xiphoidCranial * kMm);
-  j["lower_rib_expansion_mm"] = jsonNumber(m.lowerRibExpansion * kMm);
-  j["umbilicus_anterior_mm"] = jsonNumber(m.umbilicusAnterior * kMm);
-  j["umbilicus_anterior_min_mm"] = jsonNumber(m.umbilicusAnteriorMin * kMm);
-  j["rib_cage_tidal_ml"] = jsonNumber(m.ribCageTidal * kMl);
-  j["abdomen_tidal_ml"] = jsonNumber(m.abdomenTidal * kMl);
-  j["rib_cage_fraction"] = jsonNumber(m.ribCageShare());
-  j["rc_ab_phase_deg"] = jsonNumber(m.phaseAngle * 180.0 / M_PI);
-  j["flow_sign_changes_per_breath"] = jsonNumber(m.flowSignChanges);
-  j["max_flow_jump_pct"] = jsonNumber(m.maxFlowJump * 100.0);
 }
 
 }  // namespace pneuma::app

@@ -1,7 +1,7 @@
 #pragma once
 /// @file CliSupport.h
 /// Shared plumbing of the pneuma-cli subcommands: exit codes, error reporting, locating the model and
-/// resources, preparing output directories, number formatting for JSON/CSV.
+/// resources, preparing output directories.
 
 #include <cstdint>
 #include <initializer_list>
@@ -11,6 +11,7 @@
 #include "pneuma/sim/Limits.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Step.h"
+#include "viz/RunSummary.h"
 
 namespace CLI {
 class App;
@@ -67,14 +68,9 @@ void checkOption(const sim::Range& range, const char* flag, double v);
 void prepareOutputDir(const std::string& dir, const char* command, std::initializer_list<const char*> own,
                       bool force);
 
-/// Shortest round-trip text of a double for CSV/JSON ("%.9g"); "nan" never appears: non-finite gives "".
-std::string formatNumber(double v);
-
-/// A JSON number, or null when `v` is not finite.
-nlohmann::json jsonNumber(double v);
-
-/// Writes the motion figures into `j` at the edges' units: mm, mL, degrees, % (the keys of docs/cli.md, e.g.
-/// "dome_descent_mm", "rib_cage_fraction", "rc_ab_phase_deg"); a missing figure is null.
-void writeMotion(const sim::Motion& m, nlohmann::json& j);
+// number formatting and the motion figures of summary.json: shared with the Python module (viz/RunSummary.h)
+using viz::formatNumber;
+using viz::jsonNumber;
+using viz::writeMotion;
 
 }  // namespace pneuma::app

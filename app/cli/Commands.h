@@ -13,6 +13,9 @@ namespace pneuma::app {
 void addSimulateCommand(CLI::App& app);
 /// `validate`: rerun the papers' experiments and write report.html, report.md and report.json.
 void addValidateCommand(CLI::App& app);
+/// `silhouette`: the body's silhouettes at end-expiration and end-inspiration per breath style (CSV, SVG,
+/// PNG).
+void addSilhouetteCommand(CLI::App& app);
 /// `bench`: real-time factor per breath style and step time per element count.
 void addBenchCommand(CLI::App& app);
 /// `sweep FILE`: run a sweep file's variants in parallel (or write a Slurm job array); write their table.

@@ -16,7 +16,6 @@
 #include "Commands.h"
 #include "Morphs.h"
 #include "Progress.h"
-#include "RunRecord.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
@@ -25,6 +24,8 @@
 #include "pneuma/sim/pattern/PatternController.h"
 #include "viz/AtomicFile.h"
 #include "viz/GltfWriter.h"
+#include "viz/RunRecord.h"
+#include "viz/RunSummary.h"
 #include "viz/VtkSeriesWriter.h"
 
 namespace pneuma::app {
@@ -187,14 +188,14 @@ void runSimulate(const SimulateArgs& args) {
   // run, recording every output frame; a blow-up or an output that cannot be written (a full disk) ends the
   // run with what was computed so far
   // outputs that cannot even be started are refused before the run
-  std::unique_ptr<RunRecord> recordOwner;
+  std::unique_ptr<viz::RunRecord> recordOwner;
   try {
-    recordOwner = std::make_unique<RunRecord>(
+    recordOwner = std::make_unique<viz::RunRecord>(
         *model, hasTarget, scenario.outputs.csv ? args.out + "/timeseries.csv" : std::string());
   } catch (const std::exception& e) {
     fail(kExitBadInput, std::string("--out: ") + e.what());
   }
-  RunRecord& record = *recordOwner;
+  viz::RunRecord& record = *recordOwner;
   std::unique_ptr<viz::VtkSeriesWriter> vtk;
   if (simulation && scenario.outputs.vtk) {
     try {
@@ -256,55 +257,14 @@ void runSimulate(const SimulateArgs& args) {
   if (failure.empty() && !writeErrors.empty()) failure = writeErrors.front();
 
   const sim::Summary sum = simulation ? simulation->summary() : sim::Summary{};
-  const nlohmann::json none(nullptr);
-  nlohmann::json j;
-  j["pneuma_version"] = PNEUMA_VERSION;
-  j["model"] = modelDir;
-  j["model_name"] = model->name;
-  j["scenario"] = scenario.name;
-  j["controller"] = controllerText;
-  j["controller_kind"] = sim::controllerKindName(scenario.controller);
-  j["integrator"] = sim::integratorName(scenario.options.step.integrator);
-  j["posture"] = sim::postureName(scenario.options.step.posture);
-  j["dt_s"] = simulation ? nlohmann::json(simulation->dt()) : none;
-  j["steps"] = sum.steps;
-  j["seed"] = scenario.seed;
-  j["settle_time_s"] = scenario.options.settleTime;
-  j["duration_s"] = scenario.duration;
-  j["simulated_time_s"] = simulation ? simulation->state().time : 0.0;
-  j["partial"] = isInterrupted || !failure.empty();
-  j["interrupted"] = isInterrupted;
-  j["error"] = failure.empty() ? none : nlohmann::json(failure);
   const bool ran = simulation && record.size() > 0;
-  const bool breathed = ran && sum.cycles > 0;  // the breath figures exist only when a full breath was found
-  j["real_time_factor"] = ran ? jsonNumber(sum.realTimeFactor) : none;
-  j["tidal_volume_ml"] = breathed ? jsonNumber(sum.tidalVolume * 1e6) : none;
-  j["breaths_per_minute"] = breathed ? jsonNumber(sum.breathsPerMinute) : none;
-  j["cycles"] = sum.cycles;
-  j["end_expiratory_volume_ml"] = breathed ? jsonNumber(sum.endExpiratoryVolume * 1e6) : none;
-  j["end_inspiratory_volume_ml"] = breathed ? jsonNumber(sum.endInspiratoryVolume * 1e6) : none;
-  // the lungs' parts at end-expiration: the right/left split of the latest frame, the constant mediastinum
-  const sim::Metrics* latest = ran ? &simulation->latestMetrics() : nullptr;
-  const double rightShare = latest != nullptr ? latest->rightLungVolume / latest->lungVolume : sim::kNaN;
-  j["end_expiratory_right_lung_volume_ml"] =
-      breathed ? jsonNumber(sum.endExpiratoryVolume * rightShare * 1e6) : none;
-  j["end_expiratory_left_lung_volume_ml"] =
-      breathed ? jsonNumber(sum.endExpiratoryVolume * (1.0 - rightShare) * 1e6) : none;
-  j["end_expiratory_thoracic_cavity_volume_ml"] =
-      breathed ? jsonNumber((sum.endExpiratoryVolume + model->lungs.mediastinumVolume) * 1e6) : none;
-  j["max_gut_volume_error_pct"] = ran ? jsonNumber(sum.maxGutVolumeError * 100.0) : none;
-  j["mean_gut_volume_error_pct"] = ran ? jsonNumber(sum.meanGutVolumeError * 100.0) : none;
-  writeMotion(sum.motion, j);
-  j["tracking_rms_pct"] = simulation && simulation->controller().tracksVolume()
-                              ? jsonNumber(simulation->controller().trackingRmsPercent())
-                              : none;
+  const bool breathed = ran && sum.cycles > 0;
   const bool blended = gltf && gltf->frames() > 0;
   const sim::BlendError blend = blended ? gltf->error() : sim::BlendError{};
-  j["morph_blend_rms_mm"] = blended ? jsonNumber(blend.rms * 1e3) : none;
-  j["morph_blend_max_mm"] = blended ? jsonNumber(blend.max * 1e3) : none;
-  j["measured_from_s"] = sum.measuredFrom;
-  j["frames"] = record.size();
-  j["files"] = files;
+  const nlohmann::json j =
+      viz::runSummary(*model, scenario, simulation.get(),
+                      {modelDir, controllerText, isInterrupted, failure, record.size(), files,
+                       blended ? blend.rms : sim::kNaN, blended ? blend.max : sim::kNaN});
   bool hasSummary = false;
   attempt([&] {
     viz::writeFileAtomically(args.out + "/summary.json", j.dump(2) + "\n");

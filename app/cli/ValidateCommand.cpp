@@ -14,6 +14,7 @@
 
 #include "CliSupport.h"
 #include "Commands.h"
+#include "Silhouettes.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Experiments.h"
 #include "pneuma/sim/ModelIO.h"
@@ -91,18 +92,14 @@ viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
   return plot;
 }
 
+constexpr double kSilhouetteSpacing = 0.002;  // [m] outline grid of the report's silhouettes
+
 void runValidate(const ValidateArgs& args) {
   const std::string modelDir = resolveModelDir(args.model);
-  prepareOutputDir(args.out, "validate", {"report.json", "report.md", "report.html", "*.png", "*.svg"},
-                   args.force);
-  sim::ExperimentSettings settings;
-  if (args.isQuick) {
-    settings.simulation.settleTime = 1.0;
-    settings.styleDuration = 10.0;
-    settings.forcedExhaleDuration = 7.0;
-    settings.impactSettle = 1.0;
-    settings.impactDuration = 0.5;
-  }
+  prepareOutputDir(args.out, "validate",
+                   {"report.json", "report.md", "report.html", "*.png", "*.svg", "*.csv"}, args.force);
+  sim::ExperimentSettings settings =
+      args.isQuick ? sim::ExperimentSettings::quick() : sim::ExperimentSettings();
   applyIntegrator(args.integrator, settings.simulation.step.integrator);
   if (args.dt) checkOption(sim::kTimeStepRange, "--dt", *args.dt);
   settings.simulation.dt = args.dt;
@@ -172,6 +169,28 @@ void runValidate(const ValidateArgs& args) {
   int within = 0;
   for (const sim::Check& c : physiology) within += c.isPassed();
 
+  // the silhouette: the skin seen from the side and the front at end-expiration and end-inspiration of each
+  // style, its AP change against published chest-wall motion (reported like the physiology)
+  std::vector<sim::SilhouetteBreath> breaths;
+  std::string silhouetteProblem;
+  if (model->skin.vertexCount() == 0) silhouetteProblem = "the model has no skin";
+  for (const sim::StyleRun& r : runs) {
+    if (!silhouetteProblem.empty()) break;
+    try {
+      breaths.push_back(sim::silhouetteBreath(r));
+    } catch (const sim::Error& e) {
+      silhouetteProblem = e.what();
+    }
+  }
+  const std::vector<sim::Check> silhouette = sim::silhouetteChecks(breaths);
+  int silhouetteWithin = 0;
+  for (const sim::Check& c : silhouette) silhouetteWithin += c.isPassed();
+  std::vector<BreathOutlines> outlines;
+  for (const sim::SilhouetteBreath& b : breaths) {
+    outlines.push_back(traceBreath(b, model->skin.triangles, kSilhouetteSpacing));
+    writeSilhouettes(outlines.back(), args.out, "silhouette_");
+  }
+
   // figures
   std::vector<Figure> figures;
   figures.push_back(
@@ -221,7 +240,8 @@ void runValidate(const ValidateArgs& args) {
   j["passed"] = failed == 0;
   j["failed_count"] = failed;
   using CheckList = std::pair<const char*, const std::vector<sim::Check>*>;
-  for (const auto& [key, list] : {CheckList{"checks", &checks}, CheckList{"physiology", &physiology}})
+  for (const auto& [key, list] : {CheckList{"checks", &checks}, CheckList{"physiology", &physiology},
+                                  CheckList{"silhouette", &silhouette}})
     for (const sim::Check& c : *list)
       j[key].push_back(
           {{"id", c.id},
@@ -234,6 +254,7 @@ void runValidate(const ValidateArgs& args) {
            {"passed", c.isPassed()},
            {"source", c.source}});
   j["physiology_within"] = within;
+  j["silhouette_within"] = silhouetteWithin;
   for (const sim::StyleRun& r : runs) {
     nlohmann::json& style = j["styles"][r.style.name];
     // as in summary.json, the breath figures are null when no full breath was found (a forced exhale)
@@ -246,6 +267,8 @@ void runValidate(const ValidateArgs& args) {
              {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
              {"real_time_factor", r.summary.realTimeFactor}};
     writeMotion(r.summary.motion, style);
+    for (const sim::SilhouetteBreath& b : breaths)
+      if (b.style == r.style.name) style["silhouette"] = silhouetteJson(b);
   }
   for (const Figure& f : figures) j["figures"].push_back(f.stem + ".png");
   viz::writeFileAtomically(args.out + "/report.json", j.dump(2) + "\n");
@@ -269,28 +292,47 @@ void runValidate(const ValidateArgs& args) {
   }
   md << "\n";
 
-  // physiology: the motion next to published ranges
-  std::ostringstream physMd, physHtml;
-  for (const sim::Check& c : physiology) {
-    const std::string verdictText = !std::isfinite(c.measured) ? "n/a"
-                                    : c.isPassed()             ? "within"
-                                                               : "**outside**";
-    physMd << "| " << c.id << " | " << c.what << " | " << number(c.measured) << " " << c.unit << " | "
-           << c.target << " | " << verdictText << " | " << c.source << " |\n";
-    physHtml << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id)
-             << "</td><td>" << htmlEscape(c.what) << "</td><td>" << number(c.measured) << " "
-             << htmlEscape(c.unit) << "</td><td>" << htmlEscape(c.target) << "</td><td>"
-             << (c.isPassed() ? "within" : "outside") << "</td><td>" << htmlEscape(c.source)
-             << "</td></tr>\n";
-  }
+  // physiology and silhouette: the motion next to published ranges
+  const auto rangeRows = [](const std::vector<sim::Check>& list, std::ostringstream& rowsMd,
+                            std::ostringstream& rowsHtml) {
+    for (const sim::Check& c : list) {
+      const std::string verdictText = !std::isfinite(c.measured) ? "n/a"
+                                      : c.isPassed()             ? "within"
+                                                                 : "**outside**";
+      rowsMd << "| " << c.id << " | " << c.what << " | " << number(c.measured) << " " << c.unit << " | "
+             << c.target << " | " << verdictText << " | " << c.source << " |\n";
+      rowsHtml << "<tr class=\"" << (c.isPassed() ? "pass" : "fail") << "\"><td>" << htmlEscape(c.id)
+               << "</td><td>" << htmlEscape(c.what) << "</td><td>" << number(c.measured) << " "
+               << htmlEscape(c.unit) << "</td><td>" << htmlEscape(c.target) << "</td><td>"
+               << (c.isPassed() ? "within" : "outside") << "</td><td>" << htmlEscape(c.source)
+               << "</td></tr>\n";
+    }
+  };
+  std::ostringstream physMd, physHtml, silMd, silHtml;
+  rangeRows(physiology, physMd, physHtml);
+  rangeRows(silhouette, silMd, silHtml);
+  const std::string silIntro =
+      silhouetteProblem.empty()
+          ? "The body's silhouette seen from the side at end-inspiration and end-expiration of each style "
+            "(the last full breath; the forced exhale's one manoeuvre): its anteroposterior depth along the "
+            "chest line (4th intercostal space) and the belly line (umbilicus), held at their end-expiration "
+            "heights. " +
+                std::to_string(silhouetteWithin) + " of " + std::to_string(silhouette.size()) +
+                " within range; not part of the exit status. Outlines: silhouette_<style>_<view>.csv, "
+                "overlays "
+                "silhouette_<style>_<view>.svg and .png."
+          : "No silhouette: " + silhouetteProblem + ".";
   const std::string physIntro =
       "The breath's motion in anatomical axes (summary.json's motion fields) next to published "
       "physiology: " +
       std::to_string(within) + " of " + std::to_string(physiology.size()) +
       " within range. Reported beside the papers' checks; not part of the exit status.";
-  md << "## Physiology\n\n"
-     << physIntro << "\n\n| check | what | measured | published | | source |\n|---|---|---|---|---|---|\n"
-     << physMd.str() << "\n";
+  const char* rangeHeader = "| check | what | measured | published | | source |\n|---|---|---|---|---|---|\n";
+  md << "## Physiology\n\n" << physIntro << "\n\n" << rangeHeader << physMd.str() << "\n";
+  md << "## Silhouette\n\n" << silIntro << "\n\n";
+  if (!silhouette.empty()) md << rangeHeader << silMd.str() << "\n";
+  for (const BreathOutlines& b : outlines)
+    md << "![" << b.breath.style << "](silhouette_" << b.breath.style << "_lateral.png)\n\n";
   for (const Figure& f : figures)
     md << "![" << f.caption << "](" << f.stem << ".png)\n\n" << f.caption << "\n\n";
   html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Pneuma validation "
@@ -309,7 +351,19 @@ void runValidate(const ValidateArgs& args) {
        << "<h2>Physiology</h2>\n<p>" << htmlEscape(physIntro)
        << "</p>\n<table><tr><th>check</th><th>what</th><th>measured</th>"
        << "<th>published</th><th></th><th>source</th></tr>\n"
-       << physHtml.str() << "</table>\n";
+       << physHtml.str() << "</table>\n"
+       << "<h2>Silhouette</h2>\n<p>" << htmlEscape(silIntro) << "</p>\n";
+  if (!silhouette.empty())
+    html << "<table><tr><th>check</th><th>what</th><th>measured</th><th>published</th><th></th><th>source</"
+            "th></tr>\n"
+         << silHtml.str() << "</table>\n";
+  for (const BreathOutlines& b : outlines)
+    html << "<img alt=\"silhouette " << htmlEscape(b.breath.style)
+         << "\" style=\"width:49%\" src=\"data:image/png;base64,"
+         << base64(silhouettePlot(b, sim::SilhouetteView::Lateral).toPng()) << "\">";
+  if (!outlines.empty())
+    html << "\n<p>Lateral silhouettes of the trunk, to scale (mm): end-expiration blue, end-inspiration red; "
+            "dashed, the chest and belly lines.</p>\n";
   for (const Figure& f : figures)
     html << "<figure><img alt=\"" << htmlEscape(f.stem) << "\" src=\"data:image/png;base64,"
          << base64(f.plot.toPng()) << "\"><figcaption>" << htmlEscape(f.caption)
@@ -329,8 +383,19 @@ void runValidate(const ValidateArgs& args) {
     std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("physiology."),
                 c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
                 c.target.c_str());
-  std::printf("%s; physiology: %d of %zu within published ranges; report: %s/report.html (%.0f s)\n",
-              verdict.c_str(), within, physiology.size(), args.out.c_str(), wallSeconds);
+  if (!silhouette.empty())
+    std::printf("\n%-36s %-8s %-14s %s\n", "silhouette", "range", "measured", "published");
+  for (const sim::Check& c : silhouette)
+    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("silhouette."),
+                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
+                c.target.c_str());
+  if (!silhouetteProblem.empty()) std::printf("silhouette: none (%s)\n", silhouetteProblem.c_str());
+  std::printf(
+      "%s; physiology: %d of %zu within published ranges; silhouette: %d of %zu; report: %s/report.html "
+      "(%.0f "
+      "s)\n",
+      verdict.c_str(), within, physiology.size(), silhouetteWithin, silhouette.size(), args.out.c_str(),
+      wallSeconds);
   if (failed > 0) throw CLI::RuntimeError(kExitFailed);
 }
 

@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   pneuma::app::addSweepCommand(app);
   pneuma::app::addScenarioCommand(app);
   pneuma::app::addValidateCommand(app);
+  pneuma::app::addSilhouetteCommand(app);
   pneuma::app::addBenchCommand(app);
   pneuma::app::addModelCommand(app);
   pneuma::app::addBakeCommand(app);

@@ -7,6 +7,7 @@
 #include "pneuma/sim/ModelIO.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Scenario.h"
+#include "pneuma/sim/pattern/VolumeTrace.h"
 #include "viz/AtomicFile.h"
 
 namespace pneuma::app {
@@ -40,6 +41,15 @@ DocumentController::OpenedScenario DocumentController::readScenario(const QStrin
   opened.settings.options.recordSeconds = current.options.recordSeconds;
   opened.modelDir = scenario.model == "default" ? defaultModelDir() : QString::fromStdString(scenario.model);
   return opened;
+}
+
+std::shared_ptr<const sim::Scenario> DocumentController::readTrace(const QString& path) {
+  auto scenario = std::make_shared<sim::Scenario>();
+  scenario->name = QFileInfo(path).completeBaseName().toStdString();
+  scenario->controller = sim::ControllerKind::Trace;
+  scenario->controllerName = QFileInfo(path).absoluteFilePath().toStdString();
+  sim::pattern::loadVolumeTrace(scenario->controllerName);  // its own message: file, line and column
+  return scenario;
 }
 
 void DocumentController::adopt(const OpenedModel& opened) {

@@ -45,6 +45,11 @@ class DocumentController {
   /// An affect or pattern scenario is checked (sim::checkController()) and kept in OpenedScenario::drive.
   /// @throws std::exception naming the problem.
   static OpenedScenario readScenario(const QString& path, const RunSettings& current);
+  /// Reads the measured volume trace at `path` (CSV, sim/pattern/VolumeTrace.h) as the drive of the open
+  /// model's run: a trace scenario (sim::ControllerKind::Trace) named after the file, read and checked before
+  /// anything changes. @throws std::exception naming the file, line and column
+  /// (sim::pattern::parseVolumeTrace()).
+  static std::shared_ptr<const sim::Scenario> readTrace(const QString& path);
 
   /// The adopted model and its directory (null and empty before the first one).
   const std::shared_ptr<const sim::Model>& model() const { return m_model; }

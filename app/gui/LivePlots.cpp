@@ -297,7 +297,7 @@ bool LivePlots::refresh() {
     return PlotView::Series{m_overlay.name + " " + what, kOverlayColour, true, std::move(y), m_overlay.name};
   };
 
-  // lung volume [mL], with the affect pattern's target when one plays
+  // lung volume [mL], with the target of the affect, pattern or trace that plays
   std::vector<PlotView::Series> volume{
       {"lung volume", QColor(20, 90, 190), false, column(kLung, 1e6), QString()}};
   std::vector<double> target = column(kTarget, 1e6);
@@ -310,19 +310,22 @@ bool LivePlots::refresh() {
     volume.push_back(overlaid("lung volume", &PlotSample::lungVolume, 1e6));
   }
   m_plots[0]->setData(time, std::move(volume));
-  // read-out: the two lungs, their split and the tidal volume; at a cursor, the lungs there
+  // read-out: the two lungs, their split and the tidal volume; at a cursor, the lungs there; with a volume
+  // target, its tracking RMS instead of the split (the line keeps its width)
   const bool atCursor = std::isfinite(m_cursor);
+  const bool tracks = std::isfinite(m_latest.trackingRmsPercent);
   QString note;
   if (n > 0 && atCursor) {
     note =
         QString("at %1 s: lungs %2 mL").arg(m_cursor, 0, 'f', 2).arg(m_plots[0]->cursorValue(0), 0, 'f', 0);
   } else if (n > 0) {
     note = QString("lungs %1 mL").arg(1e6 * m_latest.lungVolume, 0, 'f', 0);
-    if (std::isfinite(m_latest.rightLungVolume))
+    if (std::isfinite(m_latest.rightLungVolume) && !tracks)
       note += QString(" (R %1 L %2)")
                   .arg(1e6 * m_latest.rightLungVolume, 0, 'f', 0)
                   .arg(1e6 * m_latest.leftLungVolume, 0, 'f', 0);
     note += QString("  VT %1 mL").arg(1e6 * tidalVolume(), 0, 'f', 0);
+    if (tracks) note += QString("  tracking RMS %1 %").arg(m_latest.trackingRmsPercent, 0, 'f', 2);
   }
   m_plots[0]->setNote(note);
 

@@ -1,7 +1,9 @@
 #pragma once
 /// @file LivePlots.h
 /// The four live plots of the main window over a rolling time window, fed with the worker's samples:
-///  1. lung-cavity volume [mL] with the current tidal volume;
+///  1. lung-cavity volume [mL] with the current tidal volume, and the target volume with the tracking RMS
+///  when
+///     an affect, a pattern or a measured trace drives the run;
 ///  2. gut volume error [%] with the 0.5 % and 2 % bands;
 ///  3. activations r (solid) and alpha (dashed) per muscle group [-];
 ///  4. mean tension per element of each muscle group [N], plus the force trace of each picked element or

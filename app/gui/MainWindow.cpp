@@ -227,6 +227,11 @@ void MainWindow::buildActions() {
     const QString path = QFileDialog::getOpenFileName(this, "Open scenario", QString(), "Scenario (*.json)");
     if (!path.isEmpty()) openScenario(path);
   });
+  file->addAction("Open &trace\u2026", this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, "Open volume trace", QString(),
+                                                      "Volume trace (*.csv);;All files (*)");
+    if (!path.isEmpty()) openTrace(path);
+  });
   file->addAction(
       "Sa&ve scenario\u2026", this,
       [this] {
@@ -755,6 +760,22 @@ QString MainWindow::overlayRecording(const QString& path) {
 }
 
 void MainWindow::clearOverlay() { m_plots->setOverlay({}); }
+
+QString MainWindow::openTrace(const QString& path) {
+  if (!m_worker) return "no model is open";
+  std::shared_ptr<const sim::Scenario> drive;
+  try {
+    drive = DocumentController::readTrace(path);
+  } catch (const std::exception& e) {
+    const QString message = QString("Cannot open trace '%1': %2").arg(path, e.what());
+    report("Trace not loaded", message);
+    return message;
+  }
+  m_drive = std::move(drive);
+  m_worker->requestScenario(m_drive);
+  showMessage(QString("Following trace '%1'").arg(QFileInfo(path).fileName()), 5000);
+  return {};
+}
 
 QString MainWindow::saveScenario(const QString& path) {
   try {

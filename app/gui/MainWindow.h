@@ -68,6 +68,12 @@ class MainWindow : public QMainWindow {
   QString overlayRecording(const QString& path);
   /// Removes the overlaid run.
   void clearOverlay();
+  /// File > Open trace: the open model's run follows the measured lung-volume trace at `path` (CSV,
+  /// docs/patterns.md) from now on, through the pattern controller (its drive is calibrated first, a few
+  /// simulated seconds in the worker); the volume plot draws the trace's target beside the simulated volume
+  /// and its note the tracking RMS. A bad trace changes nothing: the error (file, line, column) is shown and
+  /// returned. @return empty on success, else the error.
+  QString openTrace(const QString& path);
   /// Writes the current model, style and parameters as a scenario file. @return empty or the error.
   QString saveScenario(const QString& path);
   /// Selects a breath style preset by name ("calm", "deep", "panting", "forced-exhale").

@@ -48,6 +48,9 @@ struct PlotSample {
   double transdiaphragmaticPressure = std::numeric_limits<double>::quiet_NaN();
   double targetVolume = std::numeric_limits<double>::quiet_NaN();  ///< [m^3] the affect pattern's target lung
                                                                    ///< volume; NaN without one
+  /// [%] the controller's tracking RMS so far, as a share of its target's peak-to-peak
+  /// (sim::Controller::trackingRmsPercent()); NaN for a controller without a volume target
+  double trackingRmsPercent = std::numeric_limits<double>::quiet_NaN();
   sim::Activations activations{};                                  ///< r and alpha per group
   std::array<double, sim::kElementGroupCount> groupMeanTension{};  ///< [N] sim::Metrics::groupMeanTension
   std::vector<float> elementForce;                                 ///< [N] signed, per element (#E)

@@ -1,5 +1,6 @@
-// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--magnify N] [--model
-// DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
+// pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--trace CSV]
+// [--magnify N]
+// [--model DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -74,6 +75,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption style("style", "Breath style: calm, deep, panting or forced-exhale.", "NAME");
   const QCommandLineOption affect(
       "affect", "Start with an affective state (neutral, panic, relief, ...; de Melo et al. 2010).", "NAME");
+  const QCommandLineOption volumeTrace(
+      "trace", "Follow a measured lung-volume trace (CSV: time [s], volume [L] or [mL]; docs/patterns.md).",
+      "FILE");
   const QCommandLineOption posture(
       "posture",
       QString::fromStdString("Gravity relative to the body: " + pneuma::sim::postureNames() + " (default " +
@@ -118,8 +122,8 @@ int main(int argc, char** argv) {
       "Draw a second run dashed over the plots: a scenario (.json) run on the same model, or a recording "
       "(a pneuma-cli simulate folder or its timeseries.csv).",
       "FILE");
-  parser.addOptions({model, style, affect, posture, camera, labels, skin, magnify, physiology, speed,
-                     screenshot, after, exportGltf, measure, morphPlayback, scenario, compare});
+  parser.addOptions({model, style, affect, volumeTrace, posture, camera, labels, skin, magnify, physiology,
+                     speed, screenshot, after, exportGltf, measure, morphPlayback, scenario, compare});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -208,6 +212,10 @@ int main(int argc, char** argv) {
     const QString error =
         path.endsWith(".json") ? window.overlayScenario(path) : window.overlayRecording(path);
     if (!error.isEmpty() && isScripted) return 2;
+  }
+  if (hasModel && parser.isSet(volumeTrace)) {
+    // a bad trace is reported by the window (dialog, or stderr when scripted)
+    if (!window.openTrace(parser.value(volumeTrace)).isEmpty() && isScripted) return 2;
   }
   window.scene().setCamera(preset->second);
   {

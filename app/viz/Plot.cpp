@@ -322,6 +322,8 @@ void Plot::setXRange(double lo, double hi) {
 
 void Plot::setIncludeZero(bool includeZero) { m_includeZero = includeZero; }
 
+void Plot::setEqualAspect(bool isEqualAspect) { m_equalAspect = isEqualAspect; }
+
 PlotLayout Plot::layout() const {
   TextMetrics m;
   m.lineHeight = lineHeight();

@@ -56,6 +56,9 @@ class Plot {
   void setXRange(double lo, double hi);
   /// Always include 0 in the y range (e.g. tensions).
   void setIncludeZero(bool includeZero);
+  /// Draw to scale: one unit as long on both axes (outlines in mm); the shorter range widens about its
+  /// middle.
+  void setEqualAspect(bool isEqualAspect);
 
   const std::string& title() const { return m_title; }
   const std::string& xLabel() const { return m_xLabel; }
@@ -67,6 +70,7 @@ class Plot {
   bool hasXRange() const { return m_hasXRange; }
   std::pair<double, double> xRange() const { return m_xRange; }
   bool includesZero() const { return m_includeZero; }
+  bool hasEqualAspect() const { return m_equalAspect; }
   int width() const { return m_width; }
   int height() const { return m_height; }
   double textSize() const { return m_textSize; }
@@ -101,6 +105,7 @@ class Plot {
   bool m_hasXRange = false;
   std::pair<double, double> m_xRange{0.0, 1.0};  // x unit
   bool m_includeZero = false;
+  bool m_equalAspect = false;
   int m_width = 960;         // [px]
   int m_height = 540;        // [px]
   double m_textSize = 15.0;  // [px]

@@ -148,6 +148,23 @@ PlotLayout layoutPlot(const Plot& plot, double width, double height, const TextM
   const bool isXLabelOwnRow = xLabelWidth > kMaxMarginLabel * lh;
   if (!isXLabelOwnRow) L.area.left = std::max(L.area.left, pad + xLabelWidth + gap);
   L.area.bottom = height - pad - lh - 0.15 * lh - (isXLabelOwnRow ? lh : 0.0);
+  if (plot.hasEqualAspect() && L.area.width() > 0.0 && L.area.height() > 0.0) {
+    // to scale: the range with fewer units per pixel widens about its middle. The y ticks set the left margin
+    // and so the box's width: redo them until the margin settles (x gets 2 % to spare), then x takes exactly
+    // the y scale
+    const double xm = 0.5 * (xlo + xhi), ym = 0.5 * (ylo + yhi), xSpan = xhi - xlo, ySpan = yhi - ylo;
+    double perPx = 0.0;  // [unit/px]
+    for (int pass = 0; pass < 3; ++pass) {
+      perPx = std::max(1.02 * xSpan / L.area.width(), ySpan / L.area.height());
+      ylo = ym - 0.5 * perPx * L.area.height(), yhi = ym + 0.5 * perPx * L.area.height();
+      L.y = niceTicks(ylo, yhi, yTarget);
+      tickWidth = 0.0;
+      for (const std::string& s : L.y.labels) tickWidth = std::max(tickWidth, m.width(s));
+      L.area.left = pad + lh + gap + tickWidth + gap;
+      if (!isXLabelOwnRow) L.area.left = std::max(L.area.left, pad + xLabelWidth + gap);
+    }
+    xlo = xm - 0.5 * perPx * L.area.width(), xhi = xm + 0.5 * perPx * L.area.width();
+  }
   L.x = niceTicks(xlo, xhi, xTarget);
 
   for (std::size_t i = 0; i < L.y.values.size(); ++i) {

@@ -6,6 +6,8 @@
 #include <map>
 
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Silhouette.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
 
@@ -72,15 +74,37 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
   r.xiphoid = model->landmarks.find("xiphoid");
   const int spine = spineTopBody(*model);
   if (spine >= 0) r.spineBody = model->bodies.name[static_cast<std::size_t>(spine)];
+  r.model = model;
   SimulationOptions o = settings.simulation;
   o.step.jointFrictionScale *= frictionScale;
   Simulation sim(std::move(model), std::make_unique<BreathStyleController>(style), o);
   const double duration = style.cycles > 0 ? settings.forcedExhaleDuration : settings.styleDuration;
+  // the last full cycle after settling, [first, last] [s], whose end-inspiration and end-expiration are kept
+  const double period = 60.0 / style.breathsPerMinute;  // [s]
+  int cycles = static_cast<int>(std::floor(duration / period + 1e-9));
+  if (style.cycles > 0) cycles = std::min(cycles, style.cycles);
+  const double first = o.settleTime + (cycles - 1) * period, last = o.settleTime + cycles * period;
+  double high = -kBig, low = kBig;  // [m^3]
   sim.advance(o.settleTime + duration, [&](const Simulation& s) {
     r.spineTop.push_back(spine >= 0 ? Eigen::Vector3d(s.state().bodyPosition.col(spine))
                                     : Eigen::Vector3d::Zero());
+    const double t = s.state().time, v = s.latestMetrics().lungVolume;
+    if (cycles > 0 && t >= first - 1e-9 && t <= last + 1e-9) {
+      // the largest volume, then the smallest after it
+      if (v > high) {
+        high = v;
+        low = kBig;
+        r.endInspiration = s.state();
+      } else if (v < low) {
+        low = v;
+        r.endExpiration = s.state();
+      }
+    }
     return true;
   });
+  r.hasBreathPoses = high > -kBig && low < kBig;
+  r.endInspirationVolume = high;
+  r.endExpirationVolume = low;
   r.summary = sim.summary();
   r.trace = sim.trace();
   // the trace may hold a frame at t = 0 that precedes the first callback
@@ -339,6 +363,99 @@ std::vector<Check> postureChecks(const StyleRun& upright, const StyleRun& supine
       check("posture.settled_supine", "lung-volume drift in the last 0.5 s of settling, " + name + ", supine",
             "within 2 % of the tidal volume", "pneuma (the settling reaches the posture's rest)", "mL",
             settleDrift(supine) * kMl, -bound * kMl, bound * kMl)};
+}
+
+SilhouetteBreath silhouetteBreath(const StyleRun& run) {
+  if (!run.hasBreathPoses || !run.model)
+    throw Error("silhouette: the '" + run.style.name + "' run holds no end-inspiration and end-expiration");
+  const Model& model = *run.model;
+  if (model.skin.vertexCount() == 0) throw Error("silhouette: the model '" + model.name + "' has no skin");
+  const int jugular = model.landmarks.find("jugular_notch"), xiphoid = model.landmarks.find("xiphoid"),
+            umbilicus = model.landmarks.find("umbilicus"),
+            rib8Right = model.landmarks.find("rib8_lateral_right"),
+            rib8Left = model.landmarks.find("rib8_lateral_left");
+  if (jugular < 0 || xiphoid < 0 || umbilicus < 0 || rib8Right < 0 || rib8Left < 0)
+    throw Error("silhouette: the model '" + model.name +
+                "' lacks one of the landmarks jugular_notch, xiphoid, umbilicus, rib8_lateral_right, "
+                "rib8_lateral_left");
+  SilhouetteBreath b;
+  b.style = run.style.name;
+  PosedGeometry g;
+  poseGeometry(model, run.endExpiration, g);
+  b.skinExpiration = g.skin;
+  // the lines' heights in a pose, from its landmarks
+  const auto chestLine = [&] {
+    return g.landmarks(2, jugular) +
+           kChestLineOnSternum * (g.landmarks(2, xiphoid) - g.landmarks(2, jugular));
+  };
+  b.chestHeight = chestLine();
+  b.bellyHeight = g.landmarks(2, umbilicus);
+  b.trunkBand = 0.5 * std::abs(g.landmarks(0, rib8Right) - g.landmarks(0, rib8Left));
+  poseGeometry(model, run.endInspiration, g);
+  b.skinInspiration = g.skin;
+  b.chestLift = chestLine() - b.chestHeight;
+  b.bellyLift = g.landmarks(2, umbilicus) - b.bellyHeight;
+  const Eigen::Matrix3Xi& t = model.skin.triangles;
+  const auto depth = [&](const Eigen::Matrix3Xd& x, double z) {
+    return silhouetteWidth(x, t, SilhouetteView::Lateral, z, b.trunkBand);
+  };
+  b.chestChange = depth(b.skinInspiration, b.chestHeight) - depth(b.skinExpiration, b.chestHeight);
+  b.bellyChange = depth(b.skinInspiration, b.bellyHeight) - depth(b.skinExpiration, b.bellyHeight);
+  b.lungChange = run.endInspirationVolume - run.endExpirationVolume;
+  return b;
+}
+
+std::vector<Check> silhouetteChecks(const std::vector<SilhouetteBreath>& breaths) {
+  std::map<std::string, const SilhouetteBreath*> byName;
+  for (const SilhouetteBreath& b : breaths) byName[b.style] = &b;
+  auto find = [&](const char* name) { return byName.count(name) ? byName[name] : nullptr; };
+  const SilhouetteBreath* calm = find("calm");
+  const SilhouetteBreath* deep = find("deep");
+  const SilhouetteBreath* panting = find("panting");
+  const SilhouetteBreath* forced = find("forced-exhale");
+  const std::string deGroote =
+      "seated tidal breathing, optoelectronic markers (De Groote et al. 1997, J Appl Physiol 83:1531)";
+  const std::string kaneko =
+      "3D motion capture of 100 adults, sitting and supine (Kaneko & Horie 2012, Respir Care "
+      "57:1442)";
+  const std::string sharp =
+      "fast manoeuvres are mostly rib cage (Sharp et al. 1975, J Appl Physiol 39:608); " + kZordan +
+      ", Sec. 8.1 'panting breathing'";
+  const std::string fig5 = kZordan + ", Sec. 8.1 'forced exhale', Fig. 5";
+  const auto what = [](const SilhouetteBreath& b, const char* line) {
+    return std::string("silhouette AP depth at the ") + line + ", end-inspiration minus end-expiration, " +
+           b.style;
+  };
+  std::vector<Check> out;
+  const auto add = [&](const SilhouetteBreath& b, bool isChest, std::string target, std::string source,
+                       double lower, double upper) {
+    out.push_back(check("silhouette." + b.style + (isChest ? ".chest" : ".belly"),
+                        what(b, isChest ? "chest (4th intercostal space)" : "belly (umbilicus)"),
+                        std::move(target), std::move(source), "mm",
+                        (isChest ? b.chestChange : b.bellyChange) * kMm, lower, upper));
+  };
+  if (calm) {
+    add(*calm, true, "3 - 5 mm published; 1.5 - 10 mm accepted", deGroote, 1.5, 10.0);
+    add(*calm, false, "> 0 mm (the umbilical section moves ventrally)", deGroote + "; Konno & Mead 1967",
+        1e-9, kBig);
+  }
+  if (deep && calm) {
+    // their deep breaths were fuller than the deep style's (about twice calm's volume): the direction only
+    const std::string target = "> calm's (subjects' quiet-breathing motion < 1/3 of their deep breathing's)";
+    add(*deep, true, target, kaneko, calm->chestChange * kMm + 1e-9, kBig);
+    add(*deep, false, target, kaneko, calm->bellyChange * kMm + 1e-9, kBig);
+  }
+  if (panting && calm) {
+    add(*panting, true, "> 0 mm", sharp, 1e-9, kBig);
+    const double calmRatio = calm->bellyChange / std::max(calm->chestChange, 1e-12);
+    add(*panting, false, "< panting chest x calm's belly/chest ratio (chest-dominant)", sharp, -kBig,
+        panting->chestChange * calmRatio * kMm);
+  }
+  if (forced) {
+    add(*forced, true, "> 0 mm (the rib cage falls)", fig5, 1e-9, kBig);
+    add(*forced, false, ">= 10 mm (the rectus pulls the belly in)", fig5, 10.0, kBig);
+  }
+  return out;
 }
 
 ImpactRun runHeavyImpact(std::shared_ptr<const Model> modelPtr, const ExperimentSettings& settings) {

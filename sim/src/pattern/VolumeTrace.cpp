@@ -1,5 +1,6 @@
 #include "pneuma/sim/pattern/VolumeTrace.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -37,27 +38,55 @@ struct Column {
   double toSi = 1.0;
 };
 
-// zero-phase second-order Butterworth low-pass (bilinear transform); each pass starts steady at the mean of
-// its first cut-off period, so one noisy edge sample does not ring into the trace
+// value at x[0] of the least-squares parabola through x[0 .. m-1] (unit spacing): the trace's edge with its
+// noise averaged out and its slope and curvature kept (a Savitzky-Golay end-point estimate)
+double edgeValue(const std::vector<double>& x, std::ptrdiff_t m) {
+  m = std::min<std::ptrdiff_t>(m, static_cast<std::ptrdiff_t>(x.size()));
+  if (m < 3) return x.front();
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  for (std::ptrdiff_t i = 0; i < m; ++i) {
+    const double s = static_cast<double>(i);
+    const Eigen::Vector3d basis(1.0, s, s * s);
+    normal += basis * basis.transpose(), rhs += basis * x[static_cast<std::size_t>(i)];
+  }
+  return normal.ldlt().solve(rhs)(0);
+}
+
+// zero-phase second-order Butterworth low-pass (bilinear transform), run forwards then backwards over the
+// trace padded at each end by its odd reflection about the edge value (2 e - x[k], k = 1 .. pad): a padded
+// trace continues with the edge's value and slope, so the filter's start-up transient falls in the padding
+// and the trace's ends are not pulled toward a mean (scipy.signal.filtfilt's 'odd' padding, with the edge
+// value taken from a parabola over one cut-off period instead of the one edge sample, so that sensor noise
+// on that sample is not mirrored into the whole padding)
 void filtfilt(std::vector<double>& x, double timeStep, double cutoff) {
-  const auto window = static_cast<std::ptrdiff_t>(
-      std::clamp<double>(std::round(1.0 / (cutoff * timeStep)), 1.0, static_cast<double>(x.size())));
+  const auto n = static_cast<std::ptrdiff_t>(x.size());
+  const auto period = static_cast<std::ptrdiff_t>(std::round(1.0 / (cutoff * timeStep)));
+  const std::ptrdiff_t pad = std::min<std::ptrdiff_t>(2 * period, n - 1);
+  const double front = edgeValue(x, period);
+  const double back = edgeValue(std::vector<double>(x.rbegin(), x.rend()), period);
+  std::vector<double> padded;
+  padded.reserve(static_cast<std::size_t>(n + 2 * pad));
+  for (std::ptrdiff_t i = pad; i >= 1; --i) padded.push_back(2.0 * front - x[static_cast<std::size_t>(i)]);
+  padded.insert(padded.end(), x.begin(), x.end());
+  for (std::ptrdiff_t i = 1; i <= pad; ++i)
+    padded.push_back(2.0 * back - x[static_cast<std::size_t>(n - 1 - i)]);
+
   const double k = std::tan(M_PI * cutoff * timeStep), norm = 1.0 / (1.0 + std::sqrt(2.0) * k + k * k);
   const double b0 = k * k * norm, b1 = 2.0 * b0, b2 = b0;
   const double a1 = 2.0 * (k * k - 1.0) * norm, a2 = (1.0 - std::sqrt(2.0) * k + k * k) * norm;
+  // each pass starts steady at its first (padding) sample
   const auto pass = [&](auto begin, auto end) {
-    double start = 0.0;
-    for (auto it = begin; it != begin + window; ++it) start += *it;
-    start /= static_cast<double>(window);
-    double x1 = start, x2 = start, y1 = start, y2 = start;
+    double x1 = *begin, x2 = *begin, y1 = *begin, y2 = *begin;
     for (auto it = begin; it != end; ++it) {
       const double y = b0 * *it + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
       x2 = x1, x1 = *it, y2 = y1, y1 = y;
       *it = y;
     }
   };
-  pass(x.begin(), x.end());
-  pass(x.rbegin(), x.rend());
+  pass(padded.begin(), padded.end());
+  pass(padded.rbegin(), padded.rend());
+  std::copy(padded.begin() + pad, padded.begin() + pad + n, x.begin());
 }
 
 }  // namespace

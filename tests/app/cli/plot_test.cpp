@@ -194,3 +194,27 @@ TEST(PlotLayout, RangesFollowTheDataTheWindowAndZero) {
   EXPECT_NEAR(L.mapX(4.0), L.area.left, 1e-9);
   EXPECT_NEAR(L.mapY(L.y.hi), L.area.top, 1e-9);
 }
+
+// to scale: a 300 x 100 mm outline on a 900 x 600 px canvas keeps one millimetre as long across as up, the
+// data inside the box, and the shorter range widened about its middle
+TEST(PlotLayout, EqualAspectDrawsToScale) {
+  Plot plot("outline", "anterior [mm]", "height [mm]");
+  plot.addSeries("a", {-150.0, 150.0, 150.0, -150.0, -150.0}, {1000.0, 1000.0, 1100.0, 1100.0, 1000.0});
+  const PlotLayout free = plot.layout();
+  plot.setEqualAspect(true);
+  for (const auto& [w, h] : {std::pair{900, 600}, std::pair{400, 900}}) {
+    plot.setSize(w, h);
+    const PlotLayout L = plot.layout();
+    const double perPxX = (L.x.hi - L.x.lo) / L.area.width(), perPxY = (L.y.hi - L.y.lo) / L.area.height();
+    EXPECT_NEAR(perPxX, perPxY, 1e-9 * perPxY) << w << " x " << h;
+    EXPECT_LE(L.x.lo, -150.0);
+    EXPECT_GE(L.x.hi, 150.0);
+    EXPECT_LE(L.y.lo, 1000.0);
+    EXPECT_GE(L.y.hi, 1100.0);
+    EXPECT_NEAR(0.5 * (L.x.lo + L.x.hi), 0.0, 1e-9);
+    EXPECT_NEAR(0.5 * (L.y.lo + L.y.hi), 1050.0, 1e-9);
+  }
+  // without it, the 8 %-padded data fill the box in y
+  EXPECT_GT((free.x.hi - free.x.lo) / free.area.width() / ((free.y.hi - free.y.lo) / free.area.height()),
+            1.2);
+}

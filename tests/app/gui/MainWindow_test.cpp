@@ -589,6 +589,52 @@ TEST_F(DefaultModelWindow, AffectAndPatternScenariosOpenPlayAndSaveWhatDrivesThe
   EXPECT_EQ(sim::loadScenario(saved.toStdString()).controllerName, "deep");
 }
 
+// File > Open trace: the shipped example trace drives the run; the volume plot draws its target beside the
+// simulated volume, the two agree within 5 % of the target's swing, and the note shows the tracking RMS; a
+// bad trace is refused naming its line and column, and the run keeps following the good one
+TEST_F(DefaultModelWindow, OpenedTraceIsDrawnOnTheVolumePlotWithItsTrackingRms) {
+  const QString trace = QString::fromStdString(sim::resourceDir()) + "/traces/calm-sigh.csv";
+  ASSERT_EQ(window.openTrace(trace), QString());
+  ASSERT_TRUE(window.runUntil(14.0, 120000)) << window.lastError().toStdString();
+  window.plots()->refresh();
+  const app::PlotView* plot = window.plots()->volumePlot();
+  ASSERT_EQ(plot->series().size(), 2u) << "simulated and target volume";
+  EXPECT_EQ(plot->series()[0].legend.toStdString(), "simulated");
+  EXPECT_EQ(plot->series()[1].legend.toStdString(), "target");
+  // the plotted curves [mL], once the drive has blended into the trace (after 6 s)
+  const std::vector<double>& t = plot->time();
+  const std::vector<double>& simulated = plot->series()[0].y;
+  const std::vector<double>& target = plot->series()[1].y;
+  double lo = 1e9, hi = -1e9, squares = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] < 6.0 || !std::isfinite(target[k])) continue;
+    lo = std::min(lo, target[k]), hi = std::max(hi, target[k]);
+    squares += (simulated[k] - target[k]) * (simulated[k] - target[k]), ++n;
+  }
+  ASSERT_GT(n, 100);
+  EXPECT_GT(hi - lo, 300.0) << "the trace's breaths (about 0.5 L) are in the target";
+  EXPECT_LT(std::sqrt(squares / n), 0.05 * (hi - lo)) << "the simulated volume follows the drawn target";
+  // the note: "tracking RMS x.x %", under 5 %
+  const QString note = QString::fromStdString(plot->toPlot().note());
+  const QRegularExpressionMatch rms = QRegularExpression("tracking RMS ([0-9.]+) %").match(note);
+  ASSERT_TRUE(rms.hasMatch()) << note.toStdString();
+  EXPECT_LT(rms.captured(1).toDouble(), 5.0) << note.toStdString();
+
+  // a bad trace: the error names the file, line and column; the good trace still drives the run
+  QTemporaryDir dir;
+  const QString bad = dir.filePath("bad.csv");
+  QFile file(bad);
+  ASSERT_TRUE(file.open(QIODevice::WriteOnly));
+  file.write("time [s],volume [L]\n0,2.4\n0.5,2.6\n0.4,2.5\n");
+  file.close();
+  const QString error = window.openTrace(bad);
+  EXPECT_TRUE(error.contains(bad + ":4: column 1 'time [s]': time must increase")) << error.toStdString();
+  ASSERT_TRUE(window.runUntil(15.0, 60000));
+  window.plots()->refresh();
+  EXPECT_TRUE(QString::fromStdString(plot->toPlot().note()).contains("tracking RMS"));
+}
+
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(5.0));

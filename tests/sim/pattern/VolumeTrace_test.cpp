@@ -50,21 +50,55 @@ TEST(VolumeTrace, KeepsTheBreathRemovesNoiseAndOffsetsToTheMinimum) {
       parseVolumeTrace(csv("mL", 200.0, 20.0, [&](double t) { return 1e3 * noisy(t); }), "t.csv", kStep);
   ASSERT_EQ(litres.volume.size(), 2001u);
   EXPECT_NEAR(litres.duration(), 20.0, 1e-9);
-  double lo = 1.0, hi = -1.0, worst = 0.0;
+  double lo = 1.0, hi = -1.0, worst = 0.0, worstEnd = 0.0;
   for (std::size_t k = 0; k < litres.volume.size(); ++k) {
     const double t = kStep * static_cast<double>(k);
     lo = std::min(lo, litres.volume[k]), hi = std::max(hi, litres.volume[k]);
     // the clean breath above its minimum (2.4 L), in m^3
-    // within 0.5 s of either end the filter's steady start (the mean of its first 0.25 s) leaves up to 2 %
     const double error = std::abs(litres.volume[k] - (breath(t) - 2.4) * 1e-3);
-    if (t > 0.5 && t < 19.5) worst = std::max(worst, error);
-    EXPECT_LT(error, 0.012e-3) << t;
+    (t > 0.5 && t < 19.5 ? worst : worstEnd) = std::max(t > 0.5 && t < 19.5 ? worst : worstEnd, error);
     EXPECT_NEAR(ml.volume[k], litres.volume[k], 1e-12);
   }
   EXPECT_DOUBLE_EQ(lo, 0.0);
   EXPECT_NEAR(hi, 0.5e-3, 0.005e-3);  // the 0.5 L swing within 1 %
-  EXPECT_LT(worst, 0.005e-3);         // 50 mL of noise down below 5 mL, edges included
+  EXPECT_LT(worst, 0.005e-3);         // 50 mL of noise down below 5 mL
+  // within 0.5 s of either end the edge value comes from a parabola over 0.25 s of noisy samples, which keeps
+  // some of the noise (14.5 mL, 2.9 % of the swing; a sine on a slope is in the test below)
+  RecordProperty("worst_end_error_ml", std::to_string(worstEnd * 1e6));
+  EXPECT_LT(worstEnd, 0.015e-3);
   EXPECT_NEAR(litres.sample(2.0), (breath(2.0) - 2.4) * 1e-3, 0.005e-3);
+}
+
+// the filter's ends (reflection padding about a parabola's edge value): a sine cut at any phase, so that the
+// trace starts and ends on a slope, keeps its value at both ends; largest error within 0.5 s of either end,
+// as a share of the peak-to-peak, under 0.1 % at 0.25 Hz (15 b/m) and 1.5 % at 1 Hz (60 b/m; the
+// forward-backward filter itself keeps 99.6 % of 1 Hz). A filter started at the mean of its first samples
+// is off by 13 % and 49 % there.
+TEST(VolumeTrace, FilteredEndsFollowASineCutOnASlope) {
+  const double pi = std::acos(-1.0);
+  for (const auto& [frequency, limit] : {std::pair{0.25, 0.001}, std::pair{1.0, 0.015}}) {
+    for (int eighth = 0; eighth < 8; ++eighth) {
+      const double phase = 2.0 * pi * eighth / 8.0;
+      const auto sine = [&](double t) {
+        return 2.5 + 0.25 * std::sin(2.0 * pi * frequency * t + phase);
+      };  // [L]
+      const VolumeTrace trace = parseVolumeTrace(csv("L", 100.0, 10.3, sine), "t.csv", kStep);
+      ASSERT_EQ(trace.volume.size(), 1031u);
+      // the offset to the minimum, from the middle of the trace, where no end reaches
+      double offset = 0.0;
+      int middle = 0;
+      for (std::size_t k = 300; k <= 730; ++k, ++middle)
+        offset += trace.volume[k] - sine(kStep * static_cast<double>(k)) * 1e-3;
+      offset /= middle;
+      double worst = 0.0;
+      for (std::size_t k = 0; k < trace.volume.size(); ++k) {
+        const double t = kStep * static_cast<double>(k);
+        if (t > 0.5 && t < 9.8) continue;
+        worst = std::max(worst, std::abs(trace.volume[k] - sine(t) * 1e-3 - offset));
+      }
+      EXPECT_LT(worst / 0.5e-3, limit) << frequency << " Hz, phase " << eighth << "/8 of a cycle";
+    }
+  }
 }
 
 TEST(VolumeTrace, RejectsBadInputNamingTheLineAndColumn) {

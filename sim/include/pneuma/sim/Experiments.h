@@ -52,6 +52,17 @@ struct ExperimentSettings {
     simulation.outputRate = 30.0;
     simulation.recordSeconds = kTraceOnlyRecordSeconds;
   }
+  /// Shorter runs for the same checks (`--quick` of validate and silhouette): 1 s settling, 10 s of a
+  /// periodic style, 7 s of the forced exhale, 1 s + 0.5 s around the impact.
+  static ExperimentSettings quick() {
+    ExperimentSettings s;
+    s.simulation.settleTime = 1.0;
+    s.styleDuration = 10.0;
+    s.forcedExhaleDuration = 7.0;
+    s.impactSettle = 1.0;
+    s.impactDuration = 0.5;
+    return s;
+  }
 };
 
 /// A breath-style run.
@@ -65,6 +76,15 @@ struct StyleRun {
   std::vector<Eigen::Vector3d> spineTop;  ///< [m] its com at every frame of `trace`
   int umbilicus = -1;  ///< column of the "umbilicus" landmark in trace.landmarks, -1 if missing
   int xiphoid = -1;    ///< column of the "xiphoid" landmark in trace.landmarks, -1 if missing
+  std::shared_ptr<const Model> model;  ///< the model it ran on
+  /// The poses of the last full cycle after settling (the single manoeuvre of a forced exhale): the frame of
+  /// largest lung volume, and the frame of smallest volume after it in the same cycle. Valid when
+  /// hasBreathPoses.
+  State endInspiration;
+  State endExpiration;  ///< see endInspiration
+  bool hasBreathPoses = false;
+  double endInspirationVolume = 0.0;  ///< [m^3] lung volume at endInspiration
+  double endExpirationVolume = 0.0;   ///< [m^3] lung volume at endExpiration
 };
 
 /// Plays `style` on `model` for settings.styleDuration after settling (forcedExhaleDuration when the style
@@ -120,6 +140,57 @@ double settleDrift(const StyleRun& run, double window = 0.5);
 /// volume) at least 1 percentage point lower supine; end-expiratory volume at least 1 % lower supine; the
 /// supine run settled (|settleDrift()| under 2 % of its tidal volume in the last 0.5 s of settling).
 std::vector<Check> postureChecks(const StyleRun& upright, const StyleRun& supine);
+
+/// [-] Where the chest line of the silhouette figures meets the sternum: this fraction of the way from the
+/// jugular notch to the xiphoid tip, the 4th intercostal space (the nipple line). On the model's sternum the
+/// 4th space lies midway between costal notches 4 and 5, manubrium + half the body down: (52 + 55) / 202 mm
+/// male, (48 + 46) / 175 mm female (resources/anatomy, Gray's Anatomy: costal cartilages 3-6 evenly on the
+/// body).
+constexpr double kChestLineOnSternum = 0.53;
+
+/// The body's silhouette in one breath of a style run: the posed skin at end-expiration and end-inspiration
+/// (StyleRun::endExpiration, endInspiration) and the change of its anteroposterior depth, seen from the side
+/// (silhouetteWidth(), SilhouetteView::Lateral), along two horizontal lines held at their end-expiration
+/// heights, as a camera or a laser line sees the silhouette move: the chest line (kChestLineOnSternum of the
+/// way down the sternum) and the belly line (the umbilicus). On the sloping upper chest the silhouette's
+/// forward motion at a fixed height includes the skin's rise (chestLift, bellyLift give the landmarks'). Seen
+/// from the side, the trunk only: the skin within trunkBand of the midsagittal plane, so that the arms (held
+/// forward of the belly in the skin's pose) do not hide it.
+struct SilhouetteBreath {
+  std::string style;                 ///< the run's style name
+  Eigen::Matrix3Xd skinExpiration;   ///< [m] posed skin at end-expiration (3 x #V)
+  Eigen::Matrix3Xd skinInspiration;  ///< [m] posed skin at end-inspiration (3 x #V)
+  double chestHeight = 0.0;          ///< [m] z of the chest line at end-expiration
+  double bellyHeight = 0.0;          ///< [m] z of the belly line at end-expiration
+  double chestLift = 0.0;  ///< [m] rise of the chest line's landmarks from end-expiration to end-inspiration
+  double bellyLift = 0.0;  ///< [m] rise of the umbilicus
+  double trunkBand = 0.0;  ///< [m] half-width of the trunk seen from the side: rib 8's lateral half-distance
+  double chestChange = 0.0;  ///< [m] AP depth along the chest line, end-inspiration minus end-expiration
+  double bellyChange = 0.0;  ///< [m] the same along the belly line
+  double lungChange = 0.0;   ///< [m^3] lung volume, end-inspiration minus end-expiration
+};
+
+/// The silhouette breath of `run`. @throws Error when the run has no breath poses, its model no skin or no
+/// "jugular_notch", "xiphoid" and "umbilicus" landmarks.
+SilhouetteBreath silhouetteBreath(const StyleRun& run);
+
+/// The silhouette's anteroposterior change per style against published chest-wall motion (ids
+/// "silhouette.<style>.chest" and ".belly", in mm; checks whose styles are missing are left out):
+///  - calm chest 1.5 - 10 mm: seated tidal breathing moves the chest wall at the 3rd and 5th costal
+///  cartilages
+///    3-5 mm, mostly ventrally and cranially (De Groote et al. 1997, J Appl Physiol 83:1531, optoelectronic
+///    markers); the band is half the lower and twice the upper figure, for the spread between people;
+///  - calm belly > 0: at the umbilicus the wall moves almost only ventrally (De Groote et al. 1997; Konno &
+///    Mead 1967, J Appl Physiol 22:407);
+///  - deep chest and belly above calm's: quiet-breathing movements are less than a third of deep-breathing
+///    ones, sitting and supine (Kaneko & Horie 2012, Respir Care 57:1442, 100 subjects); their deep breaths
+///    were fuller than the deep style's (about twice calm's volume), so only the direction is checked;
+///  - panting chest > 0 and belly below calm's belly/chest proportion of the chest: fast manoeuvres are
+///  mostly
+///    rib cage (Sharp et al. 1975, J Appl Physiol 39:608; Zordan et al. 2004 Sec. 8.1);
+///  - forced exhale chest > 0 (the rib cage falls) and belly >= 10 mm (the rectus pulls the abdomen in by
+///    more than a centimetre, Zordan et al. 2004 Sec. 8.1, Fig. 5).
+std::vector<Check> silhouetteChecks(const std::vector<SilhouetteBreath>& breaths);
 
 /// The heavy-impact run (Figure 4).
 struct ImpactRun {

@@ -1,14 +1,14 @@
-#include "RunRecord.h"
+#include "viz/RunRecord.h"
 
 #include <cmath>
 #include <sstream>
 
-#include "CliSupport.h"
 #include "viz/AtomicFile.h"
 #include "viz/ModelScene.h"
 #include "viz/Plot.h"
+#include "viz/RunSummary.h"
 
-namespace pneuma::app {
+namespace pneuma::viz {
 
 namespace {
 
@@ -19,9 +19,9 @@ constexpr double kPct = 1e2;  // [%]
 sim::ElementGroup group(int i) { return static_cast<sim::ElementGroup>(i); }
 
 // the 3D view's group colour (Figure 2 of Zordan et al. 2004), so plots and scene agree
-viz::Color groupPlotColour(int g) {
-  const std::array<double, 3> c = viz::groupColour(group(g));
-  return viz::Color{c[0], c[1], c[2]};
+Color groupPlotColour(int g) {
+  const std::array<double, 3> c = groupColour(group(g));
+  return Color{c[0], c[1], c[2]};
 }
 
 }  // namespace
@@ -29,11 +29,11 @@ viz::Color groupPlotColour(int g) {
 RunRecord::RunRecord(const sim::Model& model, bool hasVolumeTarget, const std::string& csvPath)
     : m_model(model),
       m_hasVolumeTarget(hasVolumeTarget),
-      m_r(sim::kElementGroupCount, viz::MinMaxSeries(kPlotBuckets)),
-      m_alpha(sim::kElementGroupCount, viz::MinMaxSeries(kPlotBuckets)),
-      m_tension(sim::kElementGroupCount, viz::MinMaxSeries(kPlotBuckets)) {
+      m_r(sim::kElementGroupCount, MinMaxSeries(kPlotBuckets)),
+      m_alpha(sim::kElementGroupCount, MinMaxSeries(kPlotBuckets)),
+      m_tension(sim::kElementGroupCount, MinMaxSeries(kPlotBuckets)) {
   if (csvPath.empty()) return;
-  m_csv = std::make_unique<viz::AtomicFileWriter>(csvPath);
+  m_csv = std::make_unique<AtomicFileWriter>(csvPath);
   writeCsvHeader();
 }
 
@@ -92,58 +92,57 @@ void RunRecord::commitCsv() {
 
 std::vector<std::string> RunRecord::writePlots(const std::string& dir, const std::string& runLabel) const {
   std::vector<std::string> written;
-  auto save = [&](const viz::Plot& plot, const std::string& stem) {
+  auto save = [&](const Plot& plot, const std::string& stem) {
     plot.writePng(dir + "/" + stem + ".png");
     plot.writeSvg(dir + "/" + stem + ".svg");
     written.push_back(stem + ".png");
     written.push_back(stem + ".svg");
   };
   // the thinned curve of `s`, values times k
-  auto curve = [](const viz::MinMaxSeries& s, double k, std::vector<double>& t, std::vector<double>& v) {
+  auto curve = [](const MinMaxSeries& s, double k, std::vector<double>& t, std::vector<double>& v) {
     s.points(t, v);
     for (double& x : v) x *= k;
   };
   std::vector<double> t, v;
 
-  viz::Plot lung("Lung volume (" + runLabel + ")", "time [s]", "lung volume [mL]");
+  Plot lung("Lung volume (" + runLabel + ")", "time [s]", "lung volume [mL]");
   curve(m_lungVolume, kMl, t, v);
   lung.addSeries("lung volume", t, v);
   save(lung, "lung_volume");
 
-  viz::Plot gut("Gut volume error (" + runLabel + ")", "time [s]", "gut volume error (V - V0)/V0 [%]");
+  Plot gut("Gut volume error (" + runLabel + ")", "time [s]", "gut volume error (V - V0)/V0 [%]");
   curve(m_gutVolumeError, kPct, t, v);
   gut.addSeries("gut volume error", t, v);
   save(gut, "gut_volume_error");
 
-  viz::Plot act("Muscle activations (" + runLabel + ")", "time [s]", "r, alpha [-]");
-  viz::Plot ten("Mean element tension per group (" + runLabel + ")", "time [s]",
-                "mean tension per element [N]");
+  Plot act("Muscle activations (" + runLabel + ")", "time [s]", "r, alpha [-]");
+  Plot ten("Mean element tension per group (" + runLabel + ")", "time [s]", "mean tension per element [N]");
   for (int g = 0; g < sim::kElementGroupCount; ++g) {
     const std::size_t i = static_cast<std::size_t>(g);
     const std::string name = sim::groupName(group(g));
-    const viz::Color c = groupPlotColour(g);
+    const Color c = groupPlotColour(g);
     if (sim::isMuscleGroup(group(g))) {
       curve(m_r[i], 1.0, t, v);
-      act.addSeries(viz::Plot::Series{name + " r", t, v, c, false});
+      act.addSeries(Plot::Series{name + " r", t, v, c, false});
       curve(m_alpha[i], 1.0, t, v);
-      act.addSeries(viz::Plot::Series{name + " alpha", t, v, c, true});
+      act.addSeries(Plot::Series{name + " alpha", t, v, c, true});
     }
     curve(m_tension[i], 1.0, t, v);
-    ten.addSeries(viz::Plot::Series{name, t, v, c, false});
+    ten.addSeries(Plot::Series{name, t, v, c, false});
   }
   save(act, "activations");
   save(ten, "tensions");
 
   if (m_hasVolumeTarget) {
-    viz::Plot vf("Volume fraction: pattern target vs measured (" + runLabel + ")", "time [s]",
-                 "volume fraction [-]");
+    Plot vf("Volume fraction: pattern target vs measured (" + runLabel + ")", "time [s]",
+            "volume fraction [-]");
     curve(m_target, 1.0, t, v);
-    vf.addSeries(viz::Plot::Series{"target", t, v, {0.84, 0.15, 0.16}, true});
+    vf.addSeries(Plot::Series{"target", t, v, {0.84, 0.15, 0.16}, true});
     curve(m_measured, 1.0, t, v);
-    vf.addSeries(viz::Plot::Series{"measured", t, v, {0.0, 0.0, 0.0}, false});
+    vf.addSeries(Plot::Series{"measured", t, v, {0.0, 0.0, 0.0}, false});
     save(vf, "volume_fraction");
   }
   return written;
 }
 
-}  // namespace pneuma::app
+}  // namespace pneuma::viz

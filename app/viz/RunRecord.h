@@ -1,11 +1,11 @@
 #pragma once
 /// @file RunRecord.h
-/// The per-frame record of one pneuma-cli run and its exports: timeseries.csv (one header row of
-/// "name [unit]" columns) and the plots (lung-cavity volume, gut volume error, activations, group
-/// tensions, and the volume fraction target vs measured when a pattern drives the breathing).
-/// Memory stays bounded however long the run: the CSV is written row by row as frames arrive (to a temporary
-/// file, renamed by commitCsv()), and the plots keep each series thinned to the minima and maxima of at most
-/// kPlotBuckets buckets (viz::MinMaxSeries), so an hour's plot is as small as a minute's.
+/// The per-frame record of one run (pneuma-cli simulate, the Python module's outputs) and its exports:
+/// timeseries.csv (one header row of "name [unit]" columns) and the plots (lung-cavity volume, gut volume
+/// error, activations, group tensions, and the volume fraction target vs measured when a pattern drives the
+/// breathing). Memory stays bounded however long the run: the CSV is written row by row as frames arrive (to
+/// a temporary file, renamed by commitCsv()), and the plots keep each series thinned to the minima and maxima
+/// of at most kPlotBuckets buckets (MinMaxSeries), so an hour's plot is as small as a minute's.
 
 #include <memory>
 #include <string>
@@ -16,7 +16,7 @@
 #include "viz/AtomicFile.h"
 #include "viz/MinMaxSeries.h"
 
-namespace pneuma::app {
+namespace pneuma::viz {
 
 /// Buckets per plotted series (each keeps a minimum and a maximum): about two per pixel of a 960 px plot.
 inline constexpr std::size_t kPlotBuckets = 1024;
@@ -43,14 +43,14 @@ class RunRecord {
   void writeCsvHeader();
   const sim::Model& m_model;
   bool m_hasVolumeTarget;
-  std::unique_ptr<viz::AtomicFileWriter> m_csv;  // null without a CSV
+  std::unique_ptr<AtomicFileWriter> m_csv;  // null without a CSV
   std::size_t m_frames = 0;
-  viz::MinMaxSeries m_lungVolume{kPlotBuckets};      // [m^3]
-  viz::MinMaxSeries m_gutVolumeError{kPlotBuckets};  // [-]
-  std::vector<viz::MinMaxSeries> m_r, m_alpha;       // [-] per ElementGroup
-  std::vector<viz::MinMaxSeries> m_tension;          // [N] per ElementGroup
-  viz::MinMaxSeries m_target{kPlotBuckets};          // [-]
-  viz::MinMaxSeries m_measured{kPlotBuckets};        // [-]
+  MinMaxSeries m_lungVolume{kPlotBuckets};      // [m^3]
+  MinMaxSeries m_gutVolumeError{kPlotBuckets};  // [-]
+  std::vector<MinMaxSeries> m_r, m_alpha;       // [-] per ElementGroup
+  std::vector<MinMaxSeries> m_tension;          // [N] per ElementGroup
+  MinMaxSeries m_target{kPlotBuckets};          // [-]
+  MinMaxSeries m_measured{kPlotBuckets};        // [-]
 };
 
-}  // namespace pneuma::app
+}  // namespace pneuma::viz
