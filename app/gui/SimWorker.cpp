@@ -227,8 +227,6 @@ PlotSample plotSample(const sim::Simulation& simulation, double previousTime, do
   s.gutPressure = m.gutPressure;
   if (simulation.model().cavity.compliance > 0.0)
     s.transdiaphragmaticPressure = m.gutPressure - simulation.stepWork().outputs.pleuralPressure;
-  s.targetVolume = m_pattern ? m_pattern->fractionToVolume(m_pattern->targetFraction())
-                             : std::numeric_limits<double>::quiet_NaN();
   s.trackingRmsPercent = simulation.controller().trackingRmsPercent();
   s.activations = m.activations;
   s.groupMeanTension = m.groupMeanTension;
