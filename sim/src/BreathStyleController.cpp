@@ -31,9 +31,6 @@ void requireRange(const std::string& field, double v, double lo, double hi, bool
 
 GroupActivation& slot(Activations& a, ElementGroup g) { return a[static_cast<std::size_t>(g)]; }
 
-constexpr double kExpiratoryRise = 0.3;   // [-] part of the exhale over which the expiratory drive rises
-constexpr double kExpiratoryFall = 0.15;  // [-] part at the exhale's end over which it falls back to 0
-
 // [-] 0 -> 1 as u goes from 0 to `width` (> 0): s(x) = 3x^2 - 2x^3, x = u / width clamped to [0, 1]
 double smoothRise(double u, double width) {
   const double x = std::clamp(u / width, 0.0, 1.0);
@@ -49,6 +46,10 @@ void validateBreathStyle(const BreathStyle& s) {
   requireRange(p + "diaphragm_r", s.diaphragmR, 0.0, 1.5, true);
   requireRange(p + "diaphragm_alpha", s.diaphragmAlpha, 0.0, 1.0, true);
   requireRange(p + "drive_decay_fraction", s.driveDecayFraction, 0.0, 1.0, true);
+  requireRange(p + "expiratory_rise_fraction", s.expiratoryRiseFraction, 0.0, 1.0, true);
+  requireRange(p + "expiratory_fall_fraction", s.expiratoryFallFraction, 0.0, 1.0, true);
+  requireRange(p + "expiratory_rise_fraction + expiratory_fall_fraction",
+               s.expiratoryRiseFraction + s.expiratoryFallFraction, 0.0, 1.0, true);
   requireRange(p + "internal_intercostal_alpha", s.internalIntercostalAlpha, 0.0, 1.0, false);
   requireRange(p + "intercostal_alpha", s.intercostalAlpha, 0.0, 1.0, true);
   requireRange(p + "intercostal_amplitude", s.intercostalAmplitude, 0.0, 1.5, false);
@@ -65,8 +66,9 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   const JsonDocument doc = JsonDocument::parse(jsonText, source);
   const JsonReader j = doc.root();
   j.allowKeys({"name", "note", "breaths_per_minute", "inhale_fraction", "diaphragm_r", "diaphragm_alpha",
-               "drive_decay_fraction", "intercostal_mean", "intercostal_amplitude", "intercostal_alpha",
-               "internal_intercostal_alpha", "intercostal_lead_s", "rectus_r", "rectus_active", "cycles"});
+               "drive_decay_fraction", "expiratory_rise_fraction", "expiratory_fall_fraction",
+               "intercostal_mean", "intercostal_amplitude", "intercostal_alpha", "internal_intercostal_alpha",
+               "intercostal_lead_s", "rectus_r", "rectus_active", "cycles"});
   BreathStyle s;
   // required fields, then optional ones that keep their defaults when absent
   s.name = j.at("name").string();
@@ -78,6 +80,8 @@ BreathStyle parseBreathStyle(const std::string& jsonText, const std::string& sou
   s.inhaleFraction = j.numberOr("inhale_fraction", s.inhaleFraction);
   s.diaphragmAlpha = j.numberOr("diaphragm_alpha", s.diaphragmAlpha);
   s.driveDecayFraction = j.numberOr("drive_decay_fraction", s.driveDecayFraction);
+  s.expiratoryRiseFraction = j.numberOr("expiratory_rise_fraction", s.expiratoryRiseFraction);
+  s.expiratoryFallFraction = j.numberOr("expiratory_fall_fraction", s.expiratoryFallFraction);
   s.intercostalAlpha = j.numberOr("intercostal_alpha", s.intercostalAlpha);
   s.internalIntercostalAlpha = j.numberOr("internal_intercostal_alpha", s.internalIntercostalAlpha);
   s.intercostalLead = j.numberOr("intercostal_lead_s", s.intercostalLead);
@@ -101,6 +105,8 @@ std::string serializeBreathStyle(const BreathStyle& s) {
                             {"diaphragm_r", s.diaphragmR},
                             {"diaphragm_alpha", s.diaphragmAlpha},
                             {"drive_decay_fraction", s.driveDecayFraction},
+                            {"expiratory_rise_fraction", s.expiratoryRiseFraction},
+                            {"expiratory_fall_fraction", s.expiratoryFallFraction},
                             {"intercostal_mean", s.intercostalMean},
                             {"intercostal_amplitude", s.intercostalAmplitude},
                             {"intercostal_alpha", s.intercostalAlpha},
@@ -150,7 +156,8 @@ double inspiratoryDrive(const BreathStyle& s, double phase) {
 double expiratoryDrive(const BreathStyle& s, double phase) {
   if (phase < s.inhaleFraction) return 0.0;
   const double x = (phase - s.inhaleFraction) / (1.0 - s.inhaleFraction);  // [-] 0 to 1 over the exhale
-  return smoothRise(x, kExpiratoryRise) * (1.0 - smoothRise(x - 1.0 + kExpiratoryFall, kExpiratoryFall));
+  const double fall = s.expiratoryFallFraction;
+  return smoothRise(x, s.expiratoryRiseFraction) * (1.0 - smoothRise(x - 1.0 + fall, fall));
 }
 
 Activations BreathStyleController::activations(double t, const Metrics& /*latest*/) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <sstream>
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
@@ -251,6 +252,26 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
                         "<= 20 % of peak flow",
                         "smooth tidal airflow profiles (Benchetrit 2000, Respir Physiol 122:123)",
                         "% of peak", m.maxFlowJump * kPct, 0.0, 20.0));
+  }
+  // the other periodic styles' flow: smooth and near-sinusoidal (panting at about 1 Hz too). A pure sinusoid
+  // of frequency f sampled at fs changes by up to 2 pi f / fs of its peak from one frame to the next (at 60
+  // b/m and validate's 30 frames/s: 21 %), so the bound is twice that or calm's 20 %, whichever is larger
+  for (const StyleRun& r : runs) {
+    if (r.frictionScale != 1.0 || r.style.cycles > 0 || &r == calm || r.trace.size() < 2) continue;
+    const Motion& m = r.summary.motion;
+    const std::string& n = r.style.name;
+    const double fs = static_cast<double>(r.trace.size() - 1) /
+                      (r.trace.time.back() - r.trace.time.front());  // [1/s] frame rate
+    const double bound = std::max(20.0, 2.0 * kPct * 2.0 * M_PI * r.style.breathsPerMinute / 60.0 / fs);
+    std::ostringstream target;
+    target << "<= " << std::lround(bound) << " % of peak flow (2 x a sinusoid's, at least 20 %)";
+    out.push_back(check("physiology." + n + ".flow_reversals", "flow (dV/dt) sign changes per breath, " + n,
+                        "2", "a spirogram: one inspiration, one expiration", "-", m.flowSignChanges, 2.0,
+                        2.0));
+    out.push_back(check("physiology." + n + ".flow_jump", "largest frame-to-frame flow change, " + n,
+                        target.str(),
+                        "smooth tidal airflow profiles (Benchetrit 2000, Respir Physiol 122:123)",
+                        "% of peak", m.maxFlowJump * kPct, 0.0, bound));
   }
   if (deep) {
     const Motion& m = deep->summary.motion;

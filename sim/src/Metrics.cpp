@@ -153,14 +153,22 @@ Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNa
   s.meanGutVolumeError = sumError / static_cast<double>(trace.size() - i0);
 
   // cycles: upward crossings of the mean volume, re-armed only after dropping 25 % of the range below it
-  // (so ringing smaller than a quarter of the breath is not counted as breaths)
-  const auto begin = trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(i0);
-  const double lo = *std::min_element(begin, trace.lungVolume.end());
-  const double hi = *std::max_element(begin, trace.lungVolume.end());
+  // (so ringing smaller than a quarter of the breath is not counted as breaths); the range is taken from the
+  // first upward crossing on, so the first breath's climb from the settled volume (a style whose
+  // end-expiratory volume settles higher, as panting's does) does not widen it
   double mean = 0.0;
   for (std::size_t i = i0; i < trace.size(); ++i) mean += trace.lungVolume[i];
   mean /= static_cast<double>(trace.size() - i0);
-  const double hysteresis = 0.25 * (hi - lo);
+  std::size_t first = i0 + 1;
+  while (first < trace.size() && !(trace.lungVolume[first - 1] < mean && trace.lungVolume[first] >= mean))
+    ++first;
+  const auto begin = trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(i0);
+  const auto from1 =
+      trace.lungVolume.begin() + static_cast<std::ptrdiff_t>(std::min(first, trace.size() - 1));
+  const double lo = *std::min_element(begin, trace.lungVolume.end());
+  const double hi = *std::max_element(begin, trace.lungVolume.end());
+  const double hysteresis = 0.25 * (*std::max_element(from1, trace.lungVolume.end()) -
+                                    *std::min_element(from1, trace.lungVolume.end()));
   std::vector<std::size_t> up;  // frame index of each upward crossing
   std::vector<double> upTime;   // [s] interpolated crossing time
   bool armed = false;

@@ -218,6 +218,31 @@ TEST(BreathStyle, ActivationLevelsApplyAndRoundTrip) {
   EXPECT_THROW(validateBreathStyle(bad), Error);
 }
 
+// the expiratory drive's rise and fall windows shape one smooth bump over the exhale: e rises over the first
+// `rise` of it and returns to 0 over the last `fall`, with zero slope at both ends (panting: 0.5 / 0.5, so
+// the expiratory muscles let go gradually instead of in the exhale's last 75 ms)
+TEST(BreathStyle, ExpiratoryDriveIsASmoothBumpOverTheExhale) {
+  BreathStyle s = loadBreathStyle("calm");
+  s.inhaleFraction = 0.5;
+  s.expiratoryRiseFraction = 0.5;
+  s.expiratoryFallFraction = 0.5;
+  EXPECT_EQ(expiratoryDrive(s, 0.25), 0.0);            // inhale
+  EXPECT_NEAR(expiratoryDrive(s, 0.75), 1.0, 1e-12);   // the exhale's middle
+  EXPECT_NEAR(expiratoryDrive(s, 0.625), 0.5, 1e-12);  // half way up
+  EXPECT_NEAR(expiratoryDrive(s, 0.875), 0.5, 1e-12);  // and half way down
+  EXPECT_LT(expiratoryDrive(s, 0.995), 2e-3);          // near 0, flat, just before the next inhale
+  s.expiratoryFallFraction = 0.15;  // the default: still at full drive at 80 % of the exhale
+  EXPECT_NEAR(expiratoryDrive(s, 0.9), 1.0, 1e-12);
+  s.expiratoryRiseFraction = 0.9;  // the two windows may not overlap
+  EXPECT_THROW(validateBreathStyle(s), Error);
+  s.expiratoryRiseFraction = 0.0;
+  EXPECT_THROW(validateBreathStyle(s), Error);
+  EXPECT_THROW(parseBreathStyle(R"({"name": "x", "breaths_per_minute": 60, "diaphragm_r": 0.8,
+      "intercostal_mean": 0.9, "intercostal_amplitude": 0.1, "expiratory_fall_fraction": 1.2})",
+                                "x.json"),
+               Error);
+}
+
 // the drive's decay window must be a fraction of the exhale, the internal layer's level in [0, 1]
 TEST(BreathStyle, DriveFieldsAreRangeChecked) {
   BreathStyle bad = loadBreathStyle("calm");

@@ -18,10 +18,13 @@
 ///    contraction, with their drive taken intercostalLead seconds ahead (d(x + lead / T)): the rib friction
 ///    (Eq. 3) makes the rib cage lag its muscles by about 0.18 s, so without the lead it moved 40 deg behind
 ///    the belly in a calm breath (healthy adults: 12-23 deg, Chen et al. 2015); 0.15 s gives 16 deg;
-///  - expiratory drive e(x) (expiratoryDrive()): 0 during the inhale; over the exhale s(x' / 0.3) (1 - s((x'
-///  - 0.85)
-///    / 0.15)). The internal intercostals get alpha = e internalIntercostalAlpha (0 in quiet breathing, where
-///    expiration is passive recoil), the rectus alpha = e at r = rectusR when rectusActive (forced exhale).
+///  - expiratory drive e(x) (expiratoryDrive()): 0 during the inhale; over the exhale
+///    e = s(x' / a) (1 - s((x' - 1 + b) / b)), a = expiratoryRiseFraction (default 0.3), b =
+///    expiratoryFallFraction (default 0.15). Panting uses a = b = 0.5, a smooth bump over the exhale: with
+///    the defaults the expiratory muscles let go in the last 75 ms of its 0.5 s exhale, the rib cage sprang
+///    back and the flow reversed twice more per breath. The internal intercostals get alpha = e
+///    internalIntercostalAlpha (0 in quiet breathing, where expiration is passive recoil), the rectus alpha =
+///    e at r = rectusR when rectusActive (forced exhale).
 /// This replaces the paper's control (Section 7, Table 2: a diaphragm step and out-of-phase intercostal
 /// sinusoids of r at alpha 1): with both intercostal layers always at full activation the antagonists
 /// co-contracted at kilonewtons, and the diaphragm's step moved the abdomen a fraction of a second before the
@@ -45,8 +48,12 @@ struct BreathStyle {
   double diaphragmR = 0.85;        ///< [-] diaphragm contraction ratio during inhale, (0, 1.5]
   double diaphragmAlpha = 1.0;     ///< [-] diaphragm activation level during inhale, (0, 1]
   double driveDecayFraction =
-      1.0;                        ///< [-] part of the exhale over which the inspiratory drive decays, (0, 1]
-  double intercostalMean = 0.92;  ///< [-] mean r of the intercostal sinusoids
+      1.0;  ///< [-] part of the exhale over which the inspiratory drive decays, (0, 1]
+  double expiratoryRiseFraction =
+      0.3;  ///< [-] part of the exhale over which the expiratory drive rises to 1, (0, 1]
+  double expiratoryFallFraction =
+      0.15;  ///< [-] part at the exhale's end over which it falls back to 0, (0, 1], rise + fall <= 1
+  double intercostalMean = 0.92;       ///< [-] mean r of the intercostal sinusoids
   double intercostalAmplitude = 0.08;  ///< [-] amplitude of the intercostal sinusoids (Table 2 "±")
   double intercostalAlpha = 1.0;  ///< [-] external intercostal activation at full inspiratory drive, (0, 1]
   double internalIntercostalAlpha =
@@ -58,12 +65,14 @@ struct BreathStyle {
 };
 
 /// Checks ranges: rate > 0, inhaleFraction in (0, 1), every resulting r in (0, 1.5], driveDecayFraction in
-/// (0, 1], internalIntercostalAlpha in [0, 1], intercostalLead in [0, T / 2], cycles >= 0.
+/// (0, 1], expiratoryRiseFraction and expiratoryFallFraction in (0, 1] with a sum <= 1,
+/// internalIntercostalAlpha in [0, 1], intercostalLead in [0, T / 2], cycles >= 0.
 /// @throws Error naming the field and value.
 void validateBreathStyle(const BreathStyle& s);
 
 /// Parses a preset from JSON text (fields: name, note, breaths_per_minute, inhale_fraction,
 /// diaphragm_r, diaphragm_alpha (optional, default 1), drive_decay_fraction (optional, default 1),
+/// expiratory_rise_fraction (optional, default 0.3), expiratory_fall_fraction (optional, default 0.15),
 /// intercostal_mean, intercostal_alpha (optional, default 1), internal_intercostal_alpha (optional, default
 /// 0), intercostal_lead_s (optional, default 0), intercostal_amplitude, rectus_active, rectus_r, cycles).
 /// @throws Error naming `source` and the field.

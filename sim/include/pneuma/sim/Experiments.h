@@ -108,7 +108,10 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 /// >= 2 x calm and 20-35 mm per litre inspired; the umbilicus forward on every calm inhale; rib 8's lateral
 /// distance growing
 /// >= 2 mm calm and >= 10 mm deep; the calm rib-cage share 55-85 % upright; calm rib-cage / abdomen phase
-/// < 30 deg; two flow reversals per calm breath and no frame-to-frame flow jump above 20 % of peak flow.
+/// < 30 deg; two flow reversals per calm breath and no frame-to-frame flow jump above 20 % of peak flow;
+/// for every other periodic style among `runs` (deep, panting, ...) two flow reversals per breath and no jump
+/// above max(20 %, 2 x 2 pi f / fs) of peak flow, f the breathing frequency and fs the trace's frame rate
+/// (a pure sinusoid changes by up to 2 pi f / fs of its peak per frame: 21 % at 60 b/m and 30 frames/s).
 std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs);
 
 /// [m] backward sway of the spine top during inhales (Section 5: "during a deep inhale, as the ribs are

@@ -110,11 +110,10 @@ struct Summary {
 };
 
 /// Analyses `trace` from time `from` [s] on: cycles are delimited by successive upward crossings of
-/// the mean lung volume (with a hysteresis of 25 % of the range); tidal volume is the mean
-/// per-cycle peak-to-peak, the rate is 60 / mean period.
-/// Motion (see Motion) uses the landmarks "diaphragm_apex", "jugular_notch", "xiphoid", "rib8_lateral_left",
-/// "rib8_lateral_right" and "umbilicus".
-/// Fills the volume, rate, gut-error and motion fields; the caller sets rtf, steps and dt.
+/// the mean lung volume (with a hysteresis of 25 % of the range from the first upward crossing on); tidal
+/// volume is the mean per-cycle peak-to-peak, the rate is 60 / mean period. Motion (see Motion) uses the
+/// landmarks "diaphragm_apex", "jugular_notch", "xiphoid", "rib8_lateral_left", "rib8_lateral_right" and
+/// "umbilicus". Fills the volume, rate, gut-error and motion fields; the caller sets rtf, steps and dt.
 Summary summarize(const Trace& trace, const std::vector<std::string>& landmarkNames, double from);
 
 }  // namespace pneuma::sim
