@@ -91,7 +91,8 @@ void runPlay(const PlayArgs& a) {
   InterruptGuard guard;
   const sim::MorphTargets m = morphTargetsFor(model, a.morphs);
 
-  // the playback: pattern volume and balance -> weights, per frame (sim::MorphPlayer)
+  // the playback: pattern volume and balance -> weights, per frame (sim::MorphPlayer), and the bones posed by
+  // the same weights (sim::blendBones)
   const std::clock_t start = std::clock();
   sim::MorphPlayer player(pattern, a.seed);
   const long long frames = static_cast<long long>(std::floor(a.duration * a.outputRate)) + 1;
@@ -102,6 +103,7 @@ void runPlay(const PlayArgs& a) {
     const double t = static_cast<double>(f) / a.outputRate;  // [s]
     animation.time.push_back(t);
     animation.weights.col(f) = player.weightsAt(m, t);
+    if (!m.bones.empty()) animation.bodies.push_back(sim::blendBones(m, animation.weights.col(f)));
   }
   const double cpu = static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;  // [s]
   writeGltfOrFail("--gltf", a.gltf, *model, resolveModelDir(a.model), m, {animation});

@@ -27,6 +27,9 @@ sim::MorphTargets morphTargetsFor(const std::shared_ptr<const sim::Model>& model
         fail(kExitBadInput, "--morphs: " + morphsFile + " has " + std::to_string(m.vertexCount()) +
                                 " skin vertices, model '" + model->name + "' " +
                                 std::to_string(model->skin.vertexCount()));
+      if (!m.bones.empty() && m.bones != model->bodies.name)
+        fail(kExitBadInput, "--morphs: " + morphsFile + " has the bones of another model than '" +
+                                model->name + "' (bake it again)");
       return m;
     } catch (const sim::Error& e) {
       fail(kExitBadInput, std::string("--morphs: ") + e.what());

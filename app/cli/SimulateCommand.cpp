@@ -284,6 +284,13 @@ void runSimulate(const SimulateArgs& args) {
   if (blended)
     std::printf("  morph blend error over the skin: RMS %.2f mm, max %.2f mm (%zu frames)\n", blend.rms * 1e3,
                 blend.max * 1e3, gltf->frames());
+  if (blended && !morphs->bones.empty()) {
+    const sim::BoneBlendError bone = gltf->boneError();
+    std::printf(
+        "  morph blend error of the bones: rib tips RMS %.2f mm, max %.2f mm; rotations RMS %.2f deg, "
+        "max %.2f deg\n",
+        bone.tipRms * 1e3, bone.tipMax * 1e3, bone.angleRms * 180.0 / M_PI, bone.angleMax * 180.0 / M_PI);
+  }
   std::printf("  wrote %s%zu files in %s\n", hasSummary ? "summary.json and " : "", files.size(),
               args.out.c_str());
   if (!failure.empty() || !writeErrors.empty()) {

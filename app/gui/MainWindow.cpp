@@ -52,7 +52,10 @@ namespace pneuma::app {
 
 namespace {
 
-constexpr int kRefreshMs = 33;           // [ms] display refresh: 30 Hz
+constexpr int kRefreshMs = 33;  // [ms] display refresh: 30 Hz
+// [ms] a 3D render at most this long is drawn at every refresh: with the plots' few milliseconds both stay
+// above 20 Hz (50 ms per refresh); a slower one waits its turn so that it cannot starve the plots
+constexpr double kRenderEveryRefreshMs = 36.0;
 constexpr double kRecordSeconds = 60.0;  // [s] recorded for the timeline
 
 const std::vector<std::pair<QString, double>> kSpeeds{
@@ -68,7 +71,8 @@ const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructur
     {"Lung cavity", &viz::DisplayOptions::showCavity},
     {"Lungs", &viz::DisplayOptions::showLungs},
     {"Landmarks", &viz::DisplayOptions::showLandmarks},
-    {"Anatomical labels", &viz::DisplayOptions::showLabels}};
+    {"Anatomical labels", &viz::DisplayOptions::showLabels},
+    {"Ghost of the compared run", &viz::DisplayOptions::showGhost}};
 const std::vector<std::pair<const char*, viz::MuscleColouring>> kMuscleColourings{
     {"Tension [N]", viz::MuscleColouring::Force},
     {"Activation \u03b1 [0-1]", viz::MuscleColouring::Activation},
@@ -589,8 +593,17 @@ void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
   m_scene->setOptions(options);
   m_params->setMagnification(options.magnification);
   syncDisplayWidgets();
-  if (m_shown) m_scene->update(m_shown->state, m_shown->metrics, m_shown->endExpiration.get());
+  if (m_shown) poseScene(*m_shown);
   m_view->renderWindow()->Render();
+}
+
+void MainWindow::poseScene(const Snapshot& s) {
+  if (s.model != m_document.model()) return;
+  m_scene->update(s.state, s.metrics, s.endExpiration.get());
+  // the compared run's ghost at the same instant, magnified about its own breath's end-expiration
+  const RunGhost& ghost = m_plots->overlay().ghost;
+  const sim::State* at = ghost.at(s.state.time);
+  m_scene->setGhost(at, at ? ghost.endExpirationAt(s.state.time) : nullptr);
 }
 
 QString MainWindow::modelStatus() const {
@@ -740,7 +753,8 @@ QString MainWindow::overlayScenario(const QString& path) {
   if (overlay.samples.empty()) return "cancelled";
   const QString name = overlay.name;
   m_plots->setOverlay(std::move(overlay));
-  showMessage(QString("Comparing with '%1' (dashed)").arg(name), 5000);
+  setDisplayOptions(m_scene->options());  // the ghost
+  showMessage(QString("Comparing with '%1' (dashed, and its ghost in the 3D view)").arg(name), 5000);
   return {};
 }
 
@@ -759,7 +773,10 @@ QString MainWindow::overlayRecording(const QString& path) {
   return {};
 }
 
-void MainWindow::clearOverlay() { m_plots->setOverlay({}); }
+void MainWindow::clearOverlay() {
+  m_plots->setOverlay({});
+  setDisplayOptions(m_scene->options());  // no ghost
+}
 
 QString MainWindow::openTrace(const QString& path) {
   if (!m_worker) return "no model is open";
@@ -928,8 +945,7 @@ void MainWindow::showMorphPlaybackAt(double t) {
     displacement += w(static_cast<Eigen::Index>(k)) * m_morphs->targets[k].displacement;
   m_scene->updateMorphPlayback(m_morphs->base, displacement);
   m_view->renderWindow()->Render();
-  m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
-  ++m_framesRendered;
+  countRender(clock.nsecsElapsed());
   m_playbackTime = t;
   m_playbackFrom = t;
   m_playbackClock.restart();
@@ -998,9 +1014,13 @@ void MainWindow::refresh() {
     }
     m_plots->append(std::move(frame.samples));
     // a slow 3D render (software GL) waits its turn so that the plots keep the refresh rate
-    const bool isDue = !frame.snapshot->isRunning || m_sinceRender.elapsed() >= 1.5 * m_renderMs;
+    const bool isDue = !frame.snapshot->isRunning || m_renderMs <= kRenderEveryRefreshMs ||
+                       m_sinceRender.elapsed() >= 1.5 * m_renderMs;
     if (isNew && isDue) showSnapshot(frame.snapshot);
-    if (m_plots->refresh()) ++m_plotFrames;
+    if (m_plots->refresh()) {
+      ++m_plotFrames;
+      ++m_totalPlotFrames;
+    }
   }
 
   // rates over one-second windows
@@ -1016,6 +1036,30 @@ void MainWindow::refresh() {
   }
 }
 
+QSize MainWindow::viewSize() const { return m_view->size(); }
+
+void MainWindow::countRender(qint64 nanoseconds) {
+  const double ms = static_cast<double>(nanoseconds) * 1e-6;
+  m_renderMs = 0.9 * m_renderMs + 0.1 * ms;
+  ++m_framesRendered;
+  ++m_totalFrames;
+  m_totalRenderMs += ms;
+}
+
+void MainWindow::restartRates() {
+  m_ratesClock.start();
+  m_totalFrames = m_totalPlotFrames = 0;
+  m_totalRenderMs = 0.0;
+}
+
+MainWindow::Rates MainWindow::rates() const {
+  const double seconds =
+      m_ratesClock.isValid() ? static_cast<double>(m_ratesClock.nsecsElapsed()) * 1e-9 : 0.0;
+  if (!(seconds > 0.0)) return {};
+  return {m_totalFrames / seconds, m_totalPlotFrames / seconds,
+          m_totalFrames > 0 ? m_totalRenderMs / m_totalFrames : 0.0};
+}
+
 QString MainWindow::breathingReadout() const { return m_breathing->text(); }
 
 void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
@@ -1023,11 +1067,10 @@ void MainWindow::showSnapshot(std::shared_ptr<const Snapshot> snapshot) {
   const Snapshot& s = *m_shown;
   QElapsedTimer clock;
   clock.start();
-  if (s.model == m_document.model()) m_scene->update(s.state, s.metrics, s.endExpiration.get());
+  poseScene(s);
   m_view->renderWindow()->Render();
-  m_renderMs = 0.9 * m_renderMs + 0.1 * static_cast<double>(clock.nsecsElapsed()) * 1e-6;
+  countRender(clock.nsecsElapsed());
   m_sinceRender.restart();
-  ++m_framesRendered;
 
   m_plots->setBreaths(s.endExpirationTimes);
   m_plots->setCursor(s.isScrubbed ? s.metrics.time : std::numeric_limits<double>::quiet_NaN());

@@ -151,6 +151,15 @@ class MainWindow : public QMainWindow {
   double plotRate() const { return m_plotHz; }
   /// Wall time [ms] of one scene update and render, smoothed.
   double renderMilliseconds() const { return m_renderMs; }
+  /// The 3D view's size in pixels.
+  QSize viewSize() const;
+  /// The rates averaged since restartRates() (pneuma --measure): 3D frames and plot refreshes per second, and
+  /// the mean wall time of one scene update and render [ms].
+  struct Rates {
+    double fps = 0.0, plotHz = 0.0, renderMs = 0.0;
+  };
+  void restartRates();
+  Rates rates() const;
   /// Sets the simulation speed: simulated seconds per wall second, 0 = as fast as possible.
   void setSpeed(double speed);
   /// The last error reported to the user (model, scenario, export or simulation).
@@ -238,6 +247,13 @@ class MainWindow : public QMainWindow {
   double m_renderMs = 0.0;  // [ms]
   double m_plotHz = 0.0;    // [1/s] plot refreshes
   int m_plotFrames = 0;
+  // since restartRates(): frames, plot refreshes, render time [ms]
+  QElapsedTimer m_ratesClock;
+  int m_totalFrames = 0, m_totalPlotFrames = 0;
+  double m_totalRenderMs = 0.0;
+  void countRender(qint64 nanoseconds);
+  /// Moves the 3D scene to `s` (when it is of the open model), with the compared run's ghost at its time.
+  void poseScene(const Snapshot& s);
   QElapsedTimer m_sinceRender;
   qint64 m_fpsWindowStart = 0;  // [ms]
   QString m_lastError;

@@ -47,15 +47,35 @@ RunOverlay runScenarioOverlay(const QString& path, std::shared_ptr<const sim::Mo
   const double end = options.settleTime + scenario.duration;  // [s]
   double previousTime = kNaN, previousVolume = kNaN;
   bool isStopped = false;
+  EndExpirationFinder endExpirations;
+  double nextGhost = 0.0;  // [s] the next state kept for the ghost
   simulation.advance(end, [&](const sim::Simulation& s) {
     overlay.samples.push_back(plotSample(s, previousTime, previousVolume));
+    if (auto found = endExpirations.add(s)) overlay.ghost.endExpirations.push_back(std::move(found));
+    if (s.state().time >= nextGhost - 1e-9) {
+      overlay.ghost.states.push_back(s.state());
+      nextGhost = s.state().time + 1.0 / kGhostRate;
+    }
     previousTime = s.latestMetrics().time;
     previousVolume = s.latestMetrics().lungVolume;
     isStopped = progress && !progress(std::min(1.0, s.state().time / end));
     return !isStopped;
   });
-  if (isStopped) overlay.samples.clear();
+  if (isStopped) overlay = RunOverlay{};
   return overlay;
+}
+
+const sim::State* RunGhost::at(double t) const {
+  const auto after = std::upper_bound(states.begin(), states.end(), t,
+                                      [](double time, const sim::State& s) { return time < s.time; });
+  return after == states.begin() ? nullptr : &*(after - 1);
+}
+
+const sim::State* RunGhost::endExpirationAt(double t) const {
+  const sim::State* found = nullptr;
+  for (const auto& e : endExpirations)
+    if (e->time <= t) found = e.get();
+  return found;
 }
 
 RunOverlay readRecordingOverlay(const QString& path, const sim::Model& model) {

@@ -14,9 +14,25 @@
 
 namespace pneuma::app {
 
+/// [1/s] states kept per simulated second for the ghost of a compared scenario: a smooth ghost at the 3D
+/// view's frame rate, about 1 MB per simulated second on the default model
+constexpr double kGhostRate = 30.0;
+
+/// The poses of a compared run for its ghost in the 3D view (viz::ModelScene::setGhost()). A scenario run has
+/// them; a recording (timeseries.csv) has none.
+struct RunGhost {
+  std::vector<sim::State> states;  ///< kGhostRate per simulated second, oldest first
+  std::vector<std::shared_ptr<const sim::State>> endExpirations;  ///< each breath's (EndExpirationFinder)
+  /// The state to show at simulated time `t` [s]: the last one at or before it (null when none).
+  const sim::State* at(double t) const;
+  /// The end-expiratory state of the breath in progress at `t` [s] (null before the first).
+  const sim::State* endExpirationAt(double t) const;
+};
+
 struct RunOverlay {
   QString name;                     ///< shown in the legends: the scenario's name or the recording's folder
   std::vector<PlotSample> samples;  ///< one per output frame, oldest first (no element forces)
+  RunGhost ghost;                   ///< empty for a recording
 };
 
 /// Runs the scenario at `path` on `model` (the window's, read from `modelDir`) for its duration after its

@@ -248,25 +248,32 @@ void SimWorker::collect(const sim::Simulation& simulation) {
 void SimWorker::clearEndExpirations() {
   m_endExpirations.clear();
   m_previousTime = std::numeric_limits<double>::quiet_NaN();
-  m_isSeekingMinimum = true;
-  m_extremeVolume = std::numeric_limits<double>::quiet_NaN();
+  m_endExpirationFinder.clear();
 }
 
 void SimWorker::findEndExpiration(const sim::Simulation& simulation) {
+  auto found = m_endExpirationFinder.add(simulation);
+  if (!found) return;
+  // that breath's end-expiration; forget those older than the recording
+  m_endExpirations.push_back(std::move(found));
+  const sim::Recorder& rec = simulation.recorder();
+  const double oldest = rec.empty() ? 0.0 : rec.frame(0).time;
+  while (m_endExpirations.size() > 1 && m_endExpirations[1]->time <= oldest)
+    m_endExpirations.erase(m_endExpirations.begin());
+}
+
+std::shared_ptr<const sim::State> EndExpirationFinder::add(const sim::Simulation& simulation) {
   const double v = simulation.latestMetrics().lungVolume;
-  if (simulation.state().time < simulation.options().settleTime || !std::isfinite(v)) return;
+  if (simulation.state().time < simulation.options().settleTime || !std::isfinite(v)) return nullptr;
   const double rise = kEndExpirationRise * v;
+  std::shared_ptr<const sim::State> found;
   if (m_isSeekingMinimum) {
     if (!(v >= m_extremeVolume)) {
       m_extremeVolume = v;
       m_atMinimum = simulation.state();
     } else if (v > m_extremeVolume + rise) {
-      // the minimum is past: that breath's end-expiration; forget those older than the recording
-      m_endExpirations.push_back(std::make_shared<const sim::State>(m_atMinimum));
-      const sim::Recorder& rec = simulation.recorder();
-      const double oldest = rec.empty() ? 0.0 : rec.frame(0).time;
-      while (m_endExpirations.size() > 1 && m_endExpirations[1]->time <= oldest)
-        m_endExpirations.erase(m_endExpirations.begin());
+      // the minimum is past: that breath's end-expiration
+      found = std::make_shared<const sim::State>(m_atMinimum);
       m_isSeekingMinimum = false;
       m_extremeVolume = v;
     }
@@ -277,6 +284,12 @@ void SimWorker::findEndExpiration(const sim::Simulation& simulation) {
     m_extremeVolume = v;
     m_atMinimum = simulation.state();
   }
+  return found;
+}
+
+void EndExpirationFinder::clear() {
+  m_isSeekingMinimum = true;
+  m_extremeVolume = std::numeric_limits<double>::quiet_NaN();
 }
 
 void SimWorker::pushAffect(const std::string& name, sim::pattern::SwitchMode mode) {

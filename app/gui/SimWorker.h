@@ -62,6 +62,23 @@ struct PlotSample {
 /// elementForce empty.
 PlotSample plotSample(const sim::Simulation& simulation, double previousTime, double previousVolume);
 
+/// Follows the lung volume of a run's output frames and finds each breath's end-expiratory state: a volume
+/// minimum after settling, confirmed once the volume has risen kEndExpirationRise (0.5 %) of itself above it.
+/// The motion magnification draws the motion from it (viz::DisplayOptions::magnification).
+class EndExpirationFinder {
+ public:
+  /// Feeds the simulation's latest output frame; returns the end-expiratory state of the breath whose
+  /// minimum this frame confirms, else null.
+  std::shared_ptr<const sim::State> add(const sim::Simulation& simulation);
+  /// Starts again (reset, new model, new posture).
+  void clear();
+
+ private:
+  bool m_isSeekingMinimum = true;
+  double m_extremeVolume = std::numeric_limits<double>::quiet_NaN();  // [m^3] running minimum or maximum
+  sim::State m_atMinimum;                                             // the state at the running minimum
+};
+
 /// What the GUI draws at one instant, copied out of the simulation.
 struct Snapshot {
   std::shared_ptr<const sim::Model> model;  ///< the model the state belongs to
@@ -198,8 +215,7 @@ class SimWorker : public QObject {
   void publish(bool isScrubbed);
   /// Forgets the end-expirations found (reset, new model, new posture).
   void clearEndExpirations();
-  /// Follows the lung volume of each output frame and keeps the state at each end-expiration: a volume
-  /// minimum confirmed once the volume has risen kEndExpirationRise of itself above it.
+  /// Keeps the state at each end-expiration (EndExpirationFinder) within the recording.
   void findEndExpiration(const sim::Simulation& simulation);
 
   std::shared_ptr<const sim::Model> m_model;
@@ -228,9 +244,7 @@ class SimWorker : public QObject {
   std::vector<PlotSample> m_samples;  // collected since the last publish
   // end-expirations: the confirmed ones within the recording (oldest first), and the search for the next
   std::vector<std::shared_ptr<const sim::State>> m_endExpirations;
-  bool m_isSeekingMinimum = true;
-  double m_extremeVolume = std::numeric_limits<double>::quiet_NaN();  // [m^3] running minimum or maximum
-  sim::State m_atMinimum;                                             // the state at the running minimum
+  EndExpirationFinder m_endExpirationFinder;
   double m_previousTime =
       std::numeric_limits<double>::quiet_NaN();  // [s] the last output frame, for the flow
   double m_previousVolume = 0.0;                 // [m^3] its lung volume

@@ -266,18 +266,25 @@ int main(int argc, char** argv) {
   }
   if (hasModel && !isPlayback) window.play();
   if (parser.isSet(measure)) {
-    // report what the status bar shows after the given wall time
+    // the rates averaged over the given wall time after a warm-up (the first quarter, at most 2 s: the first
+    // renders compile the shaders)
+    const double warmUp = std::min(2.0, 0.25 * measureSeconds);  // [s]
+    QTimer::singleShot(static_cast<int>(1000.0 * warmUp), &window, [&window] { window.restartRates(); });
     QTimer::singleShot(static_cast<int>(1000.0 * measureSeconds), &window, [&window] {
       const auto* shown = window.shown();
+      const pneuma::app::MainWindow::Rates rates = window.rates();
+      const QSize view = window.viewSize();
       if (window.isMorphPlayback()) {
-        std::printf("morph playback: 3D view %.1f fps (%.1f ms per render), no physics\n", window.renderFps(),
-                    window.renderMilliseconds());
+        std::printf("morph playback: 3D view %.1f fps (%.1f ms per render, %dx%d px), no physics\n",
+                    rates.fps, rates.renderMs, view.width(), view.height());
         QApplication::exit(0);
         return;
       }
       std::printf(
-          "3D view %.1f fps (%.1f ms per render), plots %.1f Hz, real-time factor %.2f, simulated %.2f s\n",
-          window.renderFps(), window.renderMilliseconds(), window.plotRate(),
+          "3D view %.1f fps (%.1f ms per render, %dx%d px), plots %.1f Hz, real-time factor %.2f, simulated "
+          "%.2f "
+          "s\n",
+          rates.fps, rates.renderMs, view.width(), view.height(), rates.plotHz,
           shown ? shown->realTimeFactor : 0.0, shown ? shown->state.time : 0.0);
       QApplication::exit(shown ? 0 : 1);
     });

@@ -116,6 +116,38 @@ Eigen::Matrix3Xf vertexNormals(const Eigen::Matrix3Xf& x, const Triangles& trian
 /// Model-frame points [m] to glTF floats.
 Eigen::Matrix3Xf toGltf(const Eigen::Matrix3Xd& x) { return (modelToGltf() * x).cast<float>(); }
 
+/// Bone poses (or their displacements) as 7 numbers per bone in the glTF frame: the translation C t and the
+/// quaternion of C R C^T, which is (C v, w) for q = (v, w) since C is a proper rotation; linear in both, so
+/// displacements convert alike.
+tinygltf::Value bonesToGltf(const sim::BonePoses& p) {
+  const Eigen::Matrix3d& c = modelToGltf();
+  std::vector<tinygltf::Value> flat;
+  for (Eigen::Index b = 0; b < p.size(); ++b) {
+    const Eigen::Vector3d t = c * p.translation.col(b), v = c * p.rotation.col(b).head<3>();
+    for (double x : {t.x(), t.y(), t.z(), v.x(), v.y(), v.z(), p.rotation(3, b)}) flat.emplace_back(x);
+  }
+  return tinygltf::Value(flat);
+}
+
+/// The inverse of bonesToGltf() for `count` bones; false when `value` is not 7 numbers per bone.
+bool bonesFromGltf(const tinygltf::Value& value, std::size_t count, sim::BonePoses& p) {
+  if (!value.IsArray() || value.ArrayLen() != 7 * count) return false;
+  const Eigen::Matrix3d& c = modelToGltf();
+  const auto n = static_cast<Eigen::Index>(count);
+  p = {Eigen::Matrix3Xd(3, n), Eigen::Matrix4Xd(4, n)};
+  for (Eigen::Index b = 0; b < n; ++b) {
+    double x[7];
+    for (int i = 0; i < 7; ++i) {
+      const tinygltf::Value& number = value.Get(static_cast<int>(7 * b + i));
+      if (!number.IsNumber()) return false;
+      x[i] = number.GetNumberAsDouble();
+    }
+    p.translation.col(b) = c.transpose() * Eigen::Vector3d(x[0], x[1], x[2]);
+    p.rotation.col(b) << c.transpose() * Eigen::Vector3d(x[3], x[4], x[5]), x[6];
+  }
+  return true;
+}
+
 int addMaterial(tinygltf::Model& gltf, const std::string& name, std::vector<double> colour,
                 double roughness) {
   tinygltf::Material m;
@@ -151,12 +183,20 @@ void boneMesh(const std::string& path, const std::string& name, Eigen::Matrix3Xf
 }  // namespace
 
 GltfAnimationBuilder::GltfAnimationBuilder(const sim::Model& model, const sim::MorphTargets& targets)
-    : m_model(model), m_fit(targets) {}
+    : m_model(model), m_targets(targets), m_fit(targets), m_tips(sim::boneTips(model)) {}
 
 void GltfAnimationBuilder::add(double time, const sim::State& state) {
   if (!m_time.empty() && !(time > m_time.back())) return;
   sim::poseGeometry(m_model, state, m_posed);
   m_weights.push_back(m_fit.weights(m_posed.skin));
+  if (!m_targets.bones.empty()) {
+    const sim::BoneBlendError b =
+        sim::boneBlendError(m_model, m_tips, sim::blendBones(m_targets, m_weights.back()), m_posed.body);
+    m_bone.tipRms += b.tipRms * b.tipRms;
+    m_bone.angleRms += b.angleRms * b.angleRms;
+    m_bone.tipMax = std::max(m_bone.tipMax, b.tipMax);
+    m_bone.angleMax = std::max(m_bone.angleMax, b.angleMax);
+  }
   const sim::BlendError e = m_fit.error(m_posed.skin);
   m_squares += e.rms * e.rms;
   m_max = std::max(m_max, e.max);
@@ -181,12 +221,24 @@ sim::BlendError GltfAnimationBuilder::error() const {
   return {std::sqrt(m_squares / static_cast<double>(m_time.size())), m_max};
 }
 
+sim::BoneBlendError GltfAnimationBuilder::boneError() const {
+  if (m_time.empty()) return {};
+  const double frames = static_cast<double>(m_time.size());
+  sim::BoneBlendError e = m_bone;
+  e.tipRms = std::sqrt(m_bone.tipRms / frames);
+  e.angleRms = std::sqrt(m_bone.angleRms / frames);
+  return e;
+}
+
 GltfAnimation breathingDemo(const sim::MorphTargets& targets) {
   GltfAnimation a;
   a.name = "breathing";
   a.time = {0.0, 2.0, 5.0};
   a.weights = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(targets.targets.size()), 3);
   if (a.weights.rows() > 0) a.weights(0, 1) = 1.0;
+  if (!targets.bones.empty())
+    for (Eigen::Index f = 0; f < a.weights.cols(); ++f)
+      a.bodies.push_back(sim::blendBones(targets, a.weights.col(f)));
   return a;
 }
 
@@ -198,6 +250,9 @@ void writeGltf(const std::string& path, const sim::Model& model, const std::stri
   if (targets.vertexCount() != skin.vertexCount())
     throw sim::Error("morph targets have " + std::to_string(targets.vertexCount()) + " vertices, the skin " +
                      std::to_string(skin.vertexCount()));
+  if (!targets.bones.empty() && targets.bones != model.bodies.name)
+    throw sim::Error("the morph targets' bones are not model '" + model.name +
+                     "''s bodies (bake them again)");
   const Eigen::Matrix3d& c = modelToGltf();
 
   tinygltf::Model gltf;
@@ -226,13 +281,21 @@ void writeGltf(const std::string& path, const sim::Model& model, const std::stri
   skinMesh.primitives.push_back(skinPrimitive);
   std::vector<tinygltf::Value> shares;
   for (const sim::MorphTarget& t : targets.targets) shares.emplace_back(t.ribCageShare);
-  const tinygltf::Value::Object calibration{
-      {"rest_volume_m3", tinygltf::Value(targets.restVolume)},
-      {"base_volume_m3", tinygltf::Value(targets.baseVolume)},
-      {"target_volume_m3", tinygltf::Value(targets.targetVolume)},
-      {"volume_per_fraction_m3", tinygltf::Value(targets.volumePerFraction)},
-      {"weight_per_volume_per_m3", tinygltf::Value(targets.weightPerVolume)},
-      {"rib_cage_share", tinygltf::Value(shares)}};
+  tinygltf::Value::Object calibration{{"rest_volume_m3", tinygltf::Value(targets.restVolume)},
+                                      {"base_volume_m3", tinygltf::Value(targets.baseVolume)},
+                                      {"target_volume_m3", tinygltf::Value(targets.targetVolume)},
+                                      {"volume_per_fraction_m3", tinygltf::Value(targets.volumePerFraction)},
+                                      {"weight_per_volume_per_m3", tinygltf::Value(targets.weightPerVolume)},
+                                      {"rib_cage_share", tinygltf::Value(shares)}};
+  if (!targets.bones.empty()) {
+    std::vector<tinygltf::Value> names(targets.bones.begin(), targets.bones.end()), displacements;
+    for (const sim::MorphTarget& t : targets.targets)
+      displacements.push_back(bonesToGltf(t.boneDisplacement));
+    calibration["bones"] =
+        tinygltf::Value(tinygltf::Value::Object{{"names", tinygltf::Value(names)},
+                                                {"base", bonesToGltf(targets.boneBase)},
+                                                {"targets", tinygltf::Value(displacements)}});
+  }
   skinMesh.extras = tinygltf::Value(tinygltf::Value::Object{{"targetNames", tinygltf::Value(targetNames)},
                                                             {"pneuma", tinygltf::Value(calibration)}});
   gltf.meshes.push_back(skinMesh);
@@ -281,6 +344,9 @@ void writeGltf(const std::string& path, const sim::Model& model, const std::stri
     if (frames < 2 || a.weights.cols() != frames ||
         a.weights.rows() != static_cast<Eigen::Index>(targets.targets.size()))
       throw sim::Error("animation '" + a.name + "': needs at least two frames and one weight per target");
+    for (const std::vector<Eigen::Isometry3d>& poses : a.bodies)
+      if (poses.size() != model.bodies.name.size())
+        throw sim::Error("animation '" + a.name + "': bone poses are not one per body of the model");
     tinygltf::Animation animation;
     animation.name = a.name;
     const Eigen::MatrixXf time =
@@ -375,7 +441,8 @@ sim::MorphTargets readGltfMorphTargets(const std::string& path) {
     const auto position = p.targets[k].find("POSITION");
     m.targets.push_back({names.Get(static_cast<int>(k)).Get<std::string>(),
                          points(position != p.targets[k].end() ? position->second : -1),
-                         number(shares.Get(static_cast<int>(k)), "rib_cage_share")});
+                         number(shares.Get(static_cast<int>(k)), "rib_cage_share"),
+                         {}});
     if (m.targets.back().displacement.cols() != m.base.cols())
       throw fail("a target's size differs from the skin's");
   }
@@ -384,6 +451,25 @@ sim::MorphTargets readGltfMorphTargets(const std::string& path) {
   m.targetVolume = number(c.Get("target_volume_m3"), "target_volume_m3");
   m.volumePerFraction = number(c.Get("volume_per_fraction_m3"), "volume_per_fraction_m3");
   m.weightPerVolume = number(c.Get("weight_per_volume_per_m3"), "weight_per_volume_per_m3");
+
+  // the bones, when baked with them
+  if (c.Has("bones")) {
+    const tinygltf::Value& bones = c.Get("bones");
+    const tinygltf::Value& boneNames = bones.Get("names");
+    const tinygltf::Value& displacements = bones.Get("targets");
+    if (!boneNames.IsArray() || !displacements.IsArray() || displacements.ArrayLen() != m.targets.size())
+      throw fail("extras.pneuma.bones: names or targets missing");
+    for (std::size_t b = 0; b < boneNames.ArrayLen(); ++b) {
+      const tinygltf::Value& name = boneNames.Get(static_cast<int>(b));
+      if (!name.IsString()) throw fail("extras.pneuma.bones.names: not a string");
+      m.bones.push_back(name.Get<std::string>());
+    }
+    bool isValid = bonesFromGltf(bones.Get("base"), m.bones.size(), m.boneBase);
+    for (std::size_t k = 0; k < m.targets.size(); ++k)
+      isValid = isValid && bonesFromGltf(displacements.Get(static_cast<int>(k)), m.bones.size(),
+                                         m.targets[k].boneDisplacement);
+    if (!isValid) throw fail("extras.pneuma.bones: not 7 numbers per bone");
+  }
   return m;
 }
 

@@ -22,6 +22,8 @@
 #include <vtkPropCollection.h>
 #include <vtkProperty.h>
 #include <vtkProperty2D.h>
+#include <vtkQuadricDecimation.h>
+#include <vtkRenderStepsPass.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
@@ -164,6 +166,26 @@ vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
   return label;
 }
 
+// display only: a bone mesh with kBoneDisplayKeep of its triangles (quadric decimation, volume kept), shaded
+// with normals split at 60 degrees as readBodyMesh() does. Under software OpenGL the bones' 41 000 triangles
+// cost a third of a frame whatever the window size. The exports (ParaView series, glTF) read the full mesh.
+constexpr double kBoneDisplayKeep = 0.3;         // [-] share of the triangles drawn
+constexpr vtkIdType kBoneDecimationFloor = 400;  // [-] meshes with fewer triangles are drawn as they are
+
+vtkSmartPointer<vtkPolyData> decimateForDisplay(vtkPolyData* mesh) {
+  if (mesh->GetNumberOfPolys() < kBoneDecimationFloor) return mesh;
+  vtkNew<vtkQuadricDecimation> decimate;
+  decimate->SetInputData(mesh);
+  decimate->SetTargetReduction(1.0 - kBoneDisplayKeep);
+  decimate->VolumePreservationOn();
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputConnection(decimate->GetOutputPort());
+  normals->SetFeatureAngle(60.0);
+  normals->Update();
+  if (normals->GetOutput()->GetNumberOfPolys() == 0) return mesh;
+  return normals->GetOutput();
+}
+
 }  // namespace
 
 vtkSmartPointer<vtkPolyData> readBodyMesh(const std::string& path, const std::string& bodyName) {
@@ -271,8 +293,9 @@ struct ModelScene::Impl {
   // the end-expiratory pose the displacements are measured from, posed (rest pose until there is one)
   double referenceTime = std::numeric_limits<double>::quiet_NaN();  // [s] its State::time
   sim::PosedGeometry reference;
-  sim::PosedGeometry real;     // the state posed as it is, when the drawn pose is magnified
-  std::vector<double> values;  // scratch for the auto range
+  sim::PosedGeometry real;         // the state posed as it is, when the drawn pose is magnified
+  std::vector<double> values;      // scratch for the auto range
+  Eigen::Matrix3Xf normalScratch;  // scratch for setNormals()
 
   // muscle elements, one actor per group (points 2k, 2k+1 are the ends of the group's k-th element)
   struct Group {
@@ -305,6 +328,11 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkFloatArray> skinScalar;  // [mm] displacement from end-expiration
   vtkSmartPointer<vtkActor> skinActor;
 
+  // the ghost of a compared run: its gut and lungs, light grey and translucent
+  std::vector<std::pair<vtkSmartPointer<vtkPolyData>, vtkSmartPointer<vtkActor>>> ghost;  // gut, right, left
+  sim::PosedGeometry ghostPosed;
+  bool hasGhost = false;
+
   // teaching labels: landmarks, group centres, and a few named bones
   struct Label {
     vtkSmartPointer<vtkCaptionActor2D> actor;
@@ -323,6 +351,8 @@ struct ModelScene::Impl {
     bodyPose.clear();
     labels.clear();
     gutActor = cavityActor = landmarkActor = highlightActor = skinActor = nullptr;
+    ghost.clear();
+    hasGhost = false;
     lungs = {};
     lungActors = {};
     highlight = Pick{};
@@ -339,9 +369,10 @@ struct ModelScene::Impl {
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
                        static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
-                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor),
-                       static_cast<vtkProp*>(skinActor)})
+                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
       if (p) props.push_back(p);
+    for (const auto& g : ghost) props.push_back(g.second);
+    if (skinActor) props.push_back(skinActor);
     return props;
   }
 
@@ -354,26 +385,46 @@ struct ModelScene::Impl {
   }
 
   // a smooth-shaded surface of `data` coloured through `table` by one float scalar per point (`scalar`, zero
-  // at first); `isOriented` keeps the triangles' own orientation for the normals
+  // at first); its point normals are computed from its triangles at every setPoints() (setNormals())
   static vtkSmartPointer<vtkActor> scalarSurfaceActor(vtkPolyData* data,
                                                       vtkSmartPointer<vtkFloatArray>& scalar,
-                                                      vtkLookupTable* table, bool isOriented) {
+                                                      vtkLookupTable* table) {
     scalar = vtkSmartPointer<vtkFloatArray>::New();
     scalar->SetNumberOfValues(data->GetNumberOfPoints());
     scalar->Fill(0.0f);
     data->GetPointData()->SetScalars(scalar);
-    vtkNew<vtkPolyDataNormals> normals;
-    normals->SetInputData(data);
-    normals->SplittingOff();
-    if (isOriented) normals->ConsistencyOff();
-    vtkNew<vtkPolyDataMapper> mapper;
-    mapper->SetInputConnection(normals->GetOutputPort());
-    mapper->SetLookupTable(table);
-    mapper->UseLookupTableScalarRangeOn();
-    auto actor = vtkSmartPointer<vtkActor>::New();
-    actor->SetMapper(mapper);
+    vtkNew<vtkFloatArray> normals;
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(data->GetNumberOfPoints());
+    normals->Fill(0.0f);
+    data->GetPointData()->SetNormals(normals);
+    auto actor = actorFor(data);
+    actor->GetMapper()->SetLookupTable(table);
+    actor->GetMapper()->UseLookupTableScalarRangeOn();
     actor->PickableOff();
     return actor;
+  }
+
+  // the area-weighted vertex normals of a triangle surface posed at `x` (3 x #V [m]) into `data`'s point
+  // normals: a few hundred microseconds for the skin's 20 000 triangles, where vtkPolyDataNormals rebuilt its
+  // cell links on every frame
+  static void setNormals(vtkPolyData* data, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xi& triangles,
+                         Eigen::Matrix3Xf& scratch) {
+    scratch.setZero(3, x.cols());
+    for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
+      const Eigen::Vector3d a = x.col(triangles(0, t)), b = x.col(triangles(1, t)),
+                            c = x.col(triangles(2, t));
+      const Eigen::Vector3f n = (b - a).cross(c - a).cast<float>();  // twice the area, outward for CCW
+      for (int k = 0; k < 3; ++k) scratch.col(triangles(k, t)) += n;
+    }
+    auto* normals = vtkFloatArray::SafeDownCast(data->GetPointData()->GetNormals());
+    for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      const float length = scratch.col(i).norm();
+      const Eigen::Vector3f n =
+          length > 0.0f ? Eigen::Vector3f(scratch.col(i) / length) : Eigen::Vector3f::UnitZ();
+      normals->SetTypedTuple(i, n.data());
+    }
+    normals->Modified();
   }
 
   static vtkSmartPointer<vtkPolyData> surface(int nPoints, const Eigen::Matrix3Xi& triangles) {
@@ -408,8 +459,8 @@ struct ModelScene::Impl {
         sphere->Update();
         meshes.emplace_back(sphere->GetOutput());
       } else {
-        meshes.push_back(readBodyMesh((std::filesystem::path(modelDir) / file).string(),
-                                      model.bodies.name[static_cast<std::size_t>(b)]));
+        meshes.push_back(decimateForDisplay(readBodyMesh((std::filesystem::path(modelDir) / file).string(),
+                                                         model.bodies.name[static_cast<std::size_t>(b)])));
       }
     }
     return meshes;
@@ -466,7 +517,7 @@ struct ModelScene::Impl {
 
     // gut, cavity, landmarks
     gut = surface(model.nodes.size(), model.gut.triangles);
-    gutActor = scalarSurfaceActor(gut, gutScalar, gutTable, false);
+    gutActor = scalarSurfaceActor(gut, gutScalar, gutTable);
 
     cavity = surface(model.cavity.vertices.size(), model.cavity.triangles);
     cavityActor = actorFor(cavity);
@@ -481,14 +532,14 @@ struct ModelScene::Impl {
       lungs[i] = surface(lungSurfaces[i]->vertexCount(), lungSurfaces[i]->triangles);
       lungActors[i] = actorFor(lungs[i]);
       lungActors[i]->GetProperty()->SetColor(0.96, 0.62, 0.66);
-      lungActors[i]->GetProperty()->SetOpacity(0.3);
+      lungActors[i]->GetProperty()->SetOpacity(0.5);  // one layer (front faces): as dense as two at 0.3
       lungActors[i]->PickableOff();
     }
 
     // the skin: smooth-shaded, drawn last among the surfaces so the translucent body wraps the rest
     if (model.skin.vertexCount() > 0) {
       skin = surface(model.skin.vertexCount(), model.skin.triangles);
-      skinActor = scalarSurfaceActor(skin, skinScalar, skinTable, true);
+      skinActor = scalarSurfaceActor(skin, skinScalar, skinTable);
       skinActor->GetProperty()->SetSpecular(0.15);
       skinActor->GetProperty()->SetSpecularPower(12.0);
     }
@@ -546,6 +597,26 @@ struct ModelScene::Impl {
     highlightActor->PickableOff();
     highlightActor->VisibilityOff();
 
+    // the ghost: the compared run's gut and lungs, drawn before the skin
+    const auto addGhost = [&](int nPoints, const Eigen::Matrix3Xi& triangles) {
+      auto data = surface(nPoints, triangles);
+      auto actor = actorFor(data);
+      actor->GetProperty()->SetColor(0.86, 0.88, 0.92);
+      actor->GetProperty()->SetOpacity(0.4);
+      actor->GetProperty()->BackfaceCullingOn();
+      actor->PickableOff();
+      ghost.emplace_back(data, actor);
+    };
+    addGhost(model.nodes.size(), model.gut.triangles);
+    for (const sim::LungSurface* lung : lungSurfaces)
+      if (lung->vertexCount() > 0) addGhost(lung->vertexCount(), lung->triangles);
+
+    // the closed surfaces (outward triangles, sim/Model.h) draw their front faces only: a translucent one
+    // blends one layer instead of two, which halves its fragments under software OpenGL
+    for (vtkActor* a : {gutActor.GetPointer(), cavityActor.GetPointer(), lungActors[0].GetPointer(),
+                        lungActors[1].GetPointer(), skinActor.GetPointer()})
+      if (a) a->GetProperty()->BackfaceCullingOn();
+
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
   }
 
@@ -583,7 +654,7 @@ struct ModelScene::Impl {
     for (const auto& b : bodies) b->SetVisibility(options.showBones);
     if (gutActor) {
       gutActor->SetVisibility(options.showGut);
-      gutActor->GetProperty()->SetOpacity(options.isGutTranslucent ? 0.35 : 1.0);
+      gutActor->GetProperty()->SetOpacity(options.isGutTranslucent ? 0.55 : 1.0);  // one layer (front faces)
       const bool coloured = options.gutColouring != GutColouring::Plain;
       gutActor->GetMapper()->SetScalarVisibility(coloured);
       gutActor->GetProperty()->SetColor(0.72, 0.58, 0.82);
@@ -605,6 +676,7 @@ struct ModelScene::Impl {
       skinActor->GetMapper()->SetScalarVisibility(isSkinColoured);
     }
     skinBar->SetVisibility(isSkinShown && isSkinColoured);
+    for (const auto& g : ghost) g.second->SetVisibility(hasGhost && options.showGhost);
     motionText->SetInput(motionCaption().c_str());
     motionText->SetVisibility(!motionCaption().empty());
     // morph playback: the skin alone, opaque and plain; everything the physics moves is hidden
@@ -628,6 +700,11 @@ struct ModelScene::Impl {
 
 ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
   vtkRenderer* r = m_impl->renderer;
+  // translucent surfaces blended in the order drawn (gut, cavity, lungs, skin: inside out) instead of VTK's
+  // default order-independent pass, whose two floating-point targets and final pass cost a fifth of a frame
+  // under software OpenGL
+  vtkNew<vtkRenderStepsPass> steps;
+  r->SetPass(steps);
   // paraview-like blue-grey gradient
   r->GradientBackgroundOn();
   r->SetBackground(0.11, 0.12, 0.16);
@@ -761,6 +838,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
   // gut surface, coloured by its real displacement from end-expiration [mm] or its pressure [cmH2O]
   if (s.gut) {
     Impl::setPoints(s.gut, s.posed.gut);
+    Impl::setNormals(s.gut, s.posed.gut, model.gut.triangles, s.normalScratch);
     const bool byPressure = s.options.gutColouring == GutColouring::Pressure;
     const double pressure = metrics.gutPressure / kPascalPerCmH2O;
     s.values.clear();
@@ -793,6 +871,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
   // skin and its real displacement from end-expiration [mm]
   if (s.skin) {
     Impl::setPoints(s.skin, s.posed.skin);
+    Impl::setNormals(s.skin, s.posed.skin, model.skin.triangles, s.normalScratch);
     s.values.clear();
     for (Eigen::Index v = 0; v < s.posed.skin.cols(); ++v) {
       const double d = 1000.0 * (real.skin.col(v) - s.reference.skin.col(v)).norm();
@@ -836,6 +915,30 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
   }
 }
 
+void ModelScene::setGhost(const sim::State* state, const sim::State* endExpiration) {
+  Impl& s = *m_impl;
+  s.hasGhost = state && state->nodePosition.cols() == s.model.nodes.size() && !s.ghost.empty();
+  if (s.hasGhost) {
+    // the same magnification as this run's (update())
+    if (endExpiration && s.options.magnification != 1.0)
+      sim::poseGeometry(s.model, sim::magnifyMotion(*endExpiration, *state, s.options.magnification),
+                        s.ghostPosed);
+    else
+      sim::poseGeometry(s.model, *state, s.ghostPosed);
+    Impl::setPoints(s.ghost[0].first, s.ghostPosed.gut);
+    std::size_t k = 1;
+    for (const Eigen::Matrix3Xd* lung : {&s.ghostPosed.lungRight, &s.ghostPosed.lungLeft})
+      if (k < s.ghost.size() && lung->cols() == s.ghost[k].first->GetNumberOfPoints())
+        Impl::setPoints(s.ghost[k++].first, *lung);
+  }
+  for (const auto& g : s.ghost)
+    g.second->SetVisibility(s.hasGhost && s.options.showGhost && s.playback.empty());
+}
+
+bool ModelScene::isGhostShown() const {
+  return m_impl->hasGhost && m_impl->options.showGhost && m_impl->playback.empty();
+}
+
 const sim::PosedGeometry& ModelScene::posed() const { return m_impl->posed; }
 
 std::string ModelScene::motionCaption() const { return m_impl->motionCaption(); }
@@ -849,7 +952,9 @@ const std::string& ModelScene::morphPlayback() const { return m_impl->playback; 
 
 void ModelScene::updateMorphPlayback(const Eigen::Matrix3Xd& base, const Eigen::Matrix3Xd& displacement) {
   if (!m_impl->skin || base.cols() != m_impl->skin->GetNumberOfPoints()) return;
-  Impl::setPoints(m_impl->skin, base + m_impl->options.magnification * displacement);
+  const Eigen::Matrix3Xd x = base + m_impl->options.magnification * displacement;
+  Impl::setPoints(m_impl->skin, x);
+  Impl::setNormals(m_impl->skin, x, m_impl->model.skin.triangles, m_impl->normalScratch);
 }
 
 void ModelScene::setOptions(const DisplayOptions& options) {

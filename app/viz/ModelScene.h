@@ -100,6 +100,8 @@ struct DisplayOptions {
   bool isAutoRange = false;
   double magnification = kDefaultMagnification;  ///< [-] motion magnification, in [kMinMagnification,
                                                  ///< kMaxMagnification]
+  /// the ghost of a compared run (ModelScene::setGhost()), when there is one
+  bool showGhost = true;
 };
 
 /// What a pick in the view hit.
@@ -134,6 +136,14 @@ class ModelScene {
   /// DisplayOptions::magnification times; without it the state is drawn as it is.
   void update(const sim::State& state, const sim::Metrics& metrics,
               const sim::State* endExpiration = nullptr);
+
+  /// The ghost of a second run (runs side by side, e.g. calm breathing beside a paralysed hemidiaphragm): its
+  /// gut and lungs drawn light grey and translucent over this run, posed from `state` (a state of the same
+  /// model) with the motion from `endExpiration` magnified as update() magnifies this run's. A null `state`
+  /// removes it; DisplayOptions::showGhost hides it.
+  void setGhost(const sim::State* state, const sim::State* endExpiration = nullptr);
+  /// Whether a ghost is drawn now.
+  bool isGhostShown() const;
 
   /// The geometry as drawn by the last update() (magnified) [m].
   const sim::PosedGeometry& posed() const;

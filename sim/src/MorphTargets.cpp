@@ -24,6 +24,7 @@ constexpr int kCalibrationStride = 6;  // keep every 6th deep-run frame (10 Hz) 
 /// The skins at the smallest and largest lung volume of one run, from `skip` seconds after settling on.
 struct RunExtremes {
   Eigen::Matrix3Xd minSkin, maxSkin;                            // [m] (3 x #V)
+  std::vector<Eigen::Isometry3d> minBones, maxBones;            // body -> world (#B)
   double minVolume = std::numeric_limits<double>::infinity();   // [m^3]
   double maxVolume = -std::numeric_limits<double>::infinity();  // [m^3]
   double restVolume = 0.0;                                      // [m^3] lung volume at the end of settling
@@ -58,8 +59,8 @@ RunExtremes runStyle(const std::shared_ptr<const Model>& model, const std::strin
       const bool isMin = volume<run.minVolume, isMax = volume> run.maxVolume;
       const bool isSample = keepSamples && frame % kCalibrationStride == 0;
       if (isMin || isMax || isSample) poseGeometry(*model, s.state(), posed);
-      if (isMin) run.minVolume = volume, run.minSkin = posed.skin;
-      if (isMax) run.maxVolume = volume, run.maxSkin = posed.skin;
+      if (isMin) run.minVolume = volume, run.minSkin = posed.skin, run.minBones = posed.body;
+      if (isMax) run.maxVolume = volume, run.maxSkin = posed.skin, run.maxBones = posed.body;
       if (isSample) run.sampleVolume.push_back(volume), run.sampleSkin.push_back(posed.skin);
       ++frame;
     }
@@ -71,6 +72,32 @@ RunExtremes runStyle(const std::shared_ptr<const Model>& model, const std::strin
   if (!(run.maxVolume > run.minVolume) || !std::isfinite(run.ribCageShare))
     throw Error("bake: the " + stage + " run did not breathe (no tidal volume)");
   return run;
+}
+
+/// The quaternion of a pose, on the side of `reference` (q . reference >= 0).
+Eigen::Quaterniond rotationOf(const Eigen::Isometry3d& pose, const Eigen::Quaterniond& reference) {
+  Eigen::Quaterniond q(pose.linear());
+  q.normalize();
+  if (q.dot(reference) < 0.0) q.coeffs() = -q.coeffs();
+  return q;
+}
+
+/// The bones of a target: the run's motion from its minimum to its maximum, `scale` times, added to `base`:
+/// translations scaled linearly, rotations in angle about the same axis (r^scale, r = q_max q_min^-1).
+BonePoses boneDisplacement(const BonePoses& base, const RunExtremes& r, double scale) {
+  const Eigen::Index n = base.size();
+  BonePoses d{Eigen::Matrix3Xd(3, n), Eigen::Matrix4Xd(4, n)};
+  for (Eigen::Index b = 0; b < n; ++b) {
+    const auto i = static_cast<std::size_t>(b);
+    const Eigen::Quaterniond q0(base.rotation.col(b));
+    d.translation.col(b) = (r.maxBones[i].translation() - r.minBones[i].translation()) * scale;
+    const Eigen::AngleAxisd turn(rotationOf(r.maxBones[i], Eigen::Quaterniond::Identity()) *
+                                 rotationOf(r.minBones[i], Eigen::Quaterniond::Identity()).conjugate());
+    Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(scale * turn.angle(), turn.axis())) * q0;
+    if (q.dot(q0) < 0.0) q.coeffs() = -q.coeffs();
+    d.rotation.col(b) = q.coeffs() - q0.coeffs();
+  }
+  return d;
 }
 
 }  // namespace
@@ -97,12 +124,21 @@ MorphTargets bakeMorphTargets(std::shared_ptr<const Model> model, const std::str
   m.baseVolume = deep.minVolume;
   m.targetVolume = deep.maxVolume;
   const double tidal = deep.maxVolume - deep.minVolume;  // [m^3]
+  // the bones at the base: the deep run's at its smallest volume
+  m.bones = model->bodies.name;
+  const Eigen::Index bodies = model->bodies.size();
+  m.boneBase = {Eigen::Matrix3Xd(3, bodies), Eigen::Matrix4Xd(4, bodies)};
+  for (Eigen::Index b = 0; b < bodies; ++b) {
+    const Eigen::Isometry3d& pose = deep.minBones[static_cast<std::size_t>(b)];
+    m.boneBase.translation.col(b) = pose.translation();
+    m.boneBase.rotation.col(b) = rotationOf(pose, Eigen::Quaterniond::Identity()).coeffs();
+  }
   auto target = [&](const std::string& name, const RunExtremes& r) {
     const double scale = tidal / (r.maxVolume - r.minVolume);
-    return MorphTarget{name, (r.maxSkin - r.minSkin) * scale, std::clamp(r.ribCageShare, 0.0, 1.0)};
+    return MorphTarget{name, (r.maxSkin - r.minSkin) * scale, std::clamp(r.ribCageShare, 0.0, 1.0),
+                       boneDisplacement(m.boneBase, r, scale)};
   };
-  m.targets.push_back(
-      MorphTarget{"breathing", deep.maxSkin - deep.minSkin, std::clamp(deep.ribCageShare, 0.0, 1.0)});
+  m.targets.push_back(target("breathing", deep));  // scale 1: the deep breath itself
   m.targets.push_back(target("chest", pant));
   m.targets.push_back(target("belly", supine));
 
@@ -141,6 +177,78 @@ BlendError MorphFit::error(const Eigen::Matrix3Xd& skin) const {
   const Eigen::VectorXd distance = (skin - blend(weights(skin))).colwise().norm().transpose();
   if (distance.size() == 0) return {};
   return {std::sqrt(distance.squaredNorm() / static_cast<double>(distance.size())), distance.maxCoeff()};
+}
+
+std::vector<Eigen::Isometry3d> blendBones(const MorphTargets& targets, const Eigen::VectorXd& weights) {
+  if (targets.bones.empty()) return {};
+  Eigen::Matrix3Xd t = targets.boneBase.translation;  // [m]
+  Eigen::Matrix4Xd q = targets.boneBase.rotation;     // [-]
+  for (std::size_t k = 0; k < targets.targets.size(); ++k) {
+    const double w = weights(static_cast<Eigen::Index>(k));
+    t += w * targets.targets[k].boneDisplacement.translation;
+    q += w * targets.targets[k].boneDisplacement.rotation;
+  }
+  std::vector<Eigen::Isometry3d> poses(targets.bones.size(), Eigen::Isometry3d::Identity());
+  for (std::size_t b = 0; b < poses.size(); ++b) {
+    const auto i = static_cast<Eigen::Index>(b);
+    poses[b].linear() = Eigen::Quaterniond(q.col(i)).normalized().toRotationMatrix();
+    poses[b].translation() = t.col(i);
+  }
+  return poses;
+}
+
+Eigen::Matrix3Xd boneTips(const Model& model) {
+  const int n = model.bodies.size();
+  // the joint to each body's parent, in the body's frame (its com when it has none)
+  Eigen::Matrix3Xd root = Eigen::Matrix3Xd::Zero(3, n);
+  for (int j = 0; j < model.joints.size(); ++j) {
+    const int c = model.joints.child[static_cast<std::size_t>(j)];
+    root.col(c) = model.joints.anchor.col(j) - model.bodies.com.col(c);
+  }
+  Eigen::Matrix3Xd tip = Eigen::Matrix3Xd::Zero(3, n);
+  Eigen::VectorXd reach = Eigen::VectorXd::Zero(n);  // [m] the tip's distance from the root
+  auto consider = [&](int b, const Eigen::Vector3d& p) {
+    if (b < 0) return;
+    const double d = (p - root.col(b)).norm();
+    if (d > reach(b)) reach(b) = d, tip.col(b) = p;
+  };
+  const Elements& e = model.elements;
+  for (int i = 0; i < e.size(); ++i) {
+    if (isApposition(e, i)) continue;
+    const auto k = static_cast<std::size_t>(i);
+    consider(e.endA.body[k], e.endA.local.col(i));
+    consider(e.endB.body[k], e.endB.local.col(i));
+  }
+  for (int j = 0; j < model.joints.size(); ++j) {
+    const int p = model.joints.parent[static_cast<std::size_t>(j)];
+    consider(p, model.joints.anchor.col(j) - model.bodies.com.col(p));
+  }
+  return tip;
+}
+
+BoneBlendError boneBlendError(const Model& model, const Eigen::Matrix3Xd& tips,
+                              const std::vector<Eigen::Isometry3d>& blend,
+                              const std::vector<Eigen::Isometry3d>& posed) {
+  BoneBlendError e;
+  double tipSquares = 0.0, angleSquares = 0.0;  // [m^2], [rad^2]
+  int ribs = 0, moving = 0;
+  const std::size_t n = std::min({blend.size(), posed.size(), model.bodies.name.size()});
+  for (std::size_t b = 0; b < n; ++b) {
+    if (model.bodies.isFixed[b] != 0) continue;
+    const double angle = Eigen::AngleAxisd(blend[b].linear() * posed[b].linear().transpose()).angle();
+    angleSquares += angle * angle;
+    e.angleMax = std::max(e.angleMax, angle);
+    ++moving;
+    if (model.bodies.name[b].rfind("rib", 0) != 0) continue;
+    const Eigen::Vector3d p = tips.col(static_cast<Eigen::Index>(b));
+    const double d = (blend[b] * p - posed[b] * p).norm();
+    tipSquares += d * d;
+    e.tipMax = std::max(e.tipMax, d);
+    ++ribs;
+  }
+  if (ribs > 0) e.tipRms = std::sqrt(tipSquares / ribs);
+  if (moving > 0) e.angleRms = std::sqrt(angleSquares / moving);
+  return e;
 }
 
 Eigen::VectorXd patternWeights(const MorphTargets& targets, double fraction, double balance) {

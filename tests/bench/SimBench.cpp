@@ -1,6 +1,7 @@
 // Speed of the simulation core (Google Benchmark): the real-time factor per breath style on the
-// default model (simulated seconds per wall-clock second, one thread), and the cost of one step as the
-// gut mesh is refined 4x per level (synthetic toy torso, 162 -> 642 -> 2562 gut nodes).
+// default model (simulated seconds per wall-clock second, one thread), the cost of one step as the
+// gut mesh is refined 4x per level (synthetic toy torso, 162 -> 642 -> 2562 gut nodes), and de Melo's
+// morph playback of every affect (no physics: `pneuma-cli play` and the app's morph playback).
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -13,7 +14,10 @@
 #include "ToyTorso.h"
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/MorphTargets.h"
+#include "pneuma/sim/Resources.h"
 #include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/pattern/Pattern.h"
 
 namespace pneuma::sim {
 namespace {
@@ -81,6 +85,44 @@ void stepTime(benchmark::State& state) {
   state.counters["gut_faces"] = static_cast<double>(model.gut.triangles.cols());
 }
 
+// 60 s of an affect at 30 frames/s played on morph targets the size of the default model's (its skin and its
+// bodies, random shapes: the cost does not depend on them) as `pneuma-cli play` and the app do it: each
+// frame's weights (sim::MorphPlayer), bone poses (sim::blendBones) and skin (MorphFit::blend, what a renderer
+// draws). One iteration is the 60 s; the bound is 1 s of CPU (the counter cpu_s_per_60s).
+void morphPlay(benchmark::State& state, const std::string& affect) {
+  const auto model = defaultModel();
+  if (!model || model->skin.vertexCount() == 0) {
+    state.SkipWithError("default model missing: build it with 'pneuma-cli model build'");
+    return;
+  }
+  const int nV = model->skin.vertexCount(), nB = model->bodies.size();
+  MorphTargets m;
+  m.base = Eigen::Matrix3Xd::Random(3, nV);
+  m.bones = model->bodies.name;
+  m.boneBase = {Eigen::Matrix3Xd::Random(3, nB), Eigen::Matrix4Xd::Random(4, nB)};
+  for (const char* name : {"breathing", "chest", "belly"})
+    m.targets.push_back({name,
+                         Eigen::Matrix3Xd::Random(3, nV) * 0.01,
+                         m.targets.size() * 0.4,
+                         {Eigen::Matrix3Xd::Random(3, nB) * 0.01, Eigen::Matrix4Xd::Random(4, nB) * 0.01}});
+  m.restVolume = 3.0e-3;
+  m.baseVolume = 2.9e-3;
+  m.targetVolume = 4.0e-3;
+  m.weightPerVolume = 1.0 / 1.1e-3;
+  const MorphFit fit(m);
+  const pattern::Pattern p = pattern::loadAffect(affect, resourceDir());
+  for (auto _ : state) {
+    MorphPlayer player(p, 0);
+    for (int f = 0; f <= 1800; ++f) {
+      const Eigen::VectorXd w = player.weightsAt(m, f / 30.0);
+      benchmark::DoNotOptimize(blendBones(m, w).data());
+      benchmark::DoNotOptimize(fit.blend(w).data());
+    }
+  }
+  state.counters["cpu_s_per_60s"] = benchmark::Counter(
+      static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 const bool kRegistered = [] {
   // every breath style with the default integrator at its default dt (1/60 s) and at 10 ms; calm with
   // symplectic Euler
@@ -106,6 +148,10 @@ const bool kRegistered = [] {
   benchmark::RegisterBenchmark("StepTime/gut_subdivisions", stepTime)
       ->DenseRange(2, 4)
       ->Unit(benchmark::kMicrosecond);
+  for (const std::string& affect : pattern::listAffects(resourceDir()))
+    benchmark::RegisterBenchmark(("MorphPlay/" + affect).c_str(), [affect](benchmark::State& st) {
+      morphPlay(st, affect);
+    })->Unit(benchmark::kMillisecond);
   return true;
 }();
 

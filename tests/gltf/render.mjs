@@ -1,7 +1,8 @@
 // Loads a .glb in three.js inside headless Chromium (Debian's /usr/bin/chromium, driven by playwright-core),
 // renders the animation at its deepest inspiration and half a breath earlier, writes both frames as PNG and
 // checks that the body is drawn and that the two frames differ at the chest and at the belly.
-// Usage: node render.mjs FILE.glb HALF_BREATH_S OUT_PREFIX
+// Usage: node render.mjs FILE.glb HALF_BREATH_S OUT_PREFIX [translucent]
+// (translucent: the skin drawn at 30 % opacity over the bones, for pictures of the skeleton breathing)
 import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
@@ -9,7 +10,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
-const [glb, halfBreath, outPrefix] = process.argv.slice(2);
+const [glb, halfBreath, outPrefix, mode] = process.argv.slice(2);
 if (!glb || !halfBreath || !outPrefix) {
   console.error('usage: node render.mjs FILE.glb HALF_BREATH_S OUT_PREFIX');
   process.exit(2);
@@ -50,7 +51,7 @@ try {
   page.on('pageerror', (e) => console.error('page error:', e.message));
   await page.goto(`http://127.0.0.1:${port}/`);
   await page.waitForFunction(() => window.ready === true);
-  const info = await page.evaluate(() => window.load('/model.glb'));
+  const info = await page.evaluate((translucent) => window.load('/model.glb', translucent), mode === 'translucent');
   const t1 = info.peak, t0 = t1 - Number(halfBreath) >= 0 ? t1 - Number(halfBreath) : t1 + Number(halfBreath);
   const r = await page.evaluate(([a, b]) => window.compare(a, b, 30), [t0, t1]);
   for (const [name, png] of [['a', r.png0], ['b', r.png1]])

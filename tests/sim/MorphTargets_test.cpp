@@ -18,9 +18,9 @@ MorphTargets randomTargets() {
   std::srand(7);
   MorphTargets m;
   m.base = Eigen::Matrix3Xd::Random(3, 50);
-  m.targets = {{"breathing", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.5},
-               {"chest", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.9},
-               {"belly", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.2}};
+  m.targets = {{"breathing", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.5, {}},
+               {"chest", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.9, {}},
+               {"belly", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.2, {}}};
   m.restVolume = 3.0e-3;
   m.baseVolume = 2.9e-3;
   m.targetVolume = 4.0e-3;
@@ -75,6 +75,56 @@ TEST(PatternWeights, VolumeSetsTheAmplitudeAndBalanceTheSplit) {
   EXPECT_EQ(w(2), 0.0);
 }
 
+// two bones: the second turns 10 degrees about z and moves 4 mm in the breathing target, and back 6 degrees
+// about x in the chest target; the blend follows the weights linearly in translation and, by nlerp, in angle
+TEST(BlendBones, TranslationsBlendLinearlyAndRotationsByNormalisedLerp) {
+  MorphTargets m = randomTargets();
+  m.bones = {"fixed", "rib1_left"};
+  const Eigen::Quaterniond q0(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  m.boneBase = {Eigen::Matrix3Xd::Zero(3, 2), Eigen::Matrix4Xd(4, 2)};
+  m.boneBase.rotation << Eigen::Vector4d(0, 0, 0, 1), q0.coeffs();
+  const double ten = 10.0 * M_PI / 180.0, six = 6.0 * M_PI / 180.0;  // [rad]
+  auto displacement = [&](const Eigen::Vector3d& move, const Eigen::AngleAxisd& turn) {
+    BonePoses d{Eigen::Matrix3Xd::Zero(3, 2), Eigen::Matrix4Xd::Zero(4, 2)};
+    d.translation.col(1) = move;
+    d.rotation.col(1) = (Eigen::Quaterniond(turn) * q0).coeffs() - q0.coeffs();
+    return d;
+  };
+  m.targets[0].boneDisplacement =
+      displacement({0.0, 0.004, 0.0}, Eigen::AngleAxisd(ten, Eigen::Vector3d::UnitZ()));
+  m.targets[1].boneDisplacement =
+      displacement({0.0, 0.0, -0.002}, Eigen::AngleAxisd(six, Eigen::Vector3d::UnitX()));
+  m.targets[2].boneDisplacement = {Eigen::Matrix3Xd::Zero(3, 2), Eigen::Matrix4Xd::Zero(4, 2)};
+
+  // the angle of bone 1 from its base, and its translation
+  auto turned = [&](const Eigen::VectorXd& w) {
+    const std::vector<Eigen::Isometry3d> p = blendBones(m, w);
+    EXPECT_EQ(p.size(), 2u);
+    EXPECT_TRUE(p[0].isApprox(Eigen::Isometry3d::Identity()));
+    return std::make_pair(Eigen::AngleAxisd(p[1].linear() * q0.toRotationMatrix().transpose()),
+                          p[1].translation());
+  };
+  const auto [rest, x0] = turned(Eigen::Vector3d::Zero());
+  EXPECT_LT(rest.angle(), 1e-12);
+  const auto [full, x1] = turned(Eigen::Vector3d(1, 0, 0));
+  EXPECT_NEAR(full.angle(), ten, 1e-12);
+  EXPECT_NEAR(std::abs(full.axis().z()), 1.0, 1e-12);
+  EXPECT_LT((x1 - Eigen::Vector3d(0, 0.004, 0)).norm(), 1e-15);
+  // half the weight: nlerp between two rotations is exactly half the angle
+  const auto [half, xHalf] = turned(Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_NEAR(half.angle(), 0.5 * ten, 1e-12);
+  EXPECT_LT((xHalf - Eigen::Vector3d(0, 0.002, 0)).norm(), 1e-15);
+  // two targets: translations add, the rotation is a unit quaternion between both turns
+  const auto [both, x2] = turned(Eigen::Vector3d(1, 1, 0));
+  EXPECT_LT((x2 - Eigen::Vector3d(0, 0.004, -0.002)).norm(), 1e-15);
+  EXPECT_GT(both.angle(), ten);
+  EXPECT_LT(both.angle(), ten + six);
+
+  // targets without bones pose none
+  m.bones.clear();
+  EXPECT_TRUE(blendBones(m, Eigen::Vector3d(1, 0, 0)).empty());
+}
+
 TEST(BakeMorphTargets, ModelWithoutSkinIsRefused) {
   REQUIRE_DEFAULT_MODEL();
   auto bare = std::make_shared<Model>(*test::defaultModel());
@@ -124,6 +174,32 @@ TEST(BakeMorphTargets, DefaultModelTargetsMoveTheChestOrTheBellyAsTheirBreaths) 
   // belly, than the belly target does
   EXPECT_GT(anteriorMotion(m, breathing, bellyLow, chestLow - 0.03, yFront - 0.05), 0.0);
   EXPECT_GT(ratio(chest), 2.0 * ratio(belly)) << ratio(chest) << " vs " << ratio(belly);
+
+  // the bones were baked with the skin: at the breathing target's weight 1 every rib's anterior end (its tip)
+  // is forward of and above where it is at the base: the pump-handle motion of inspiration
+  ASSERT_EQ(m.bones, model->bodies.name);
+  const Eigen::Matrix3Xd tips = boneTips(*model);
+  const std::vector<Eigen::Isometry3d> base = blendBones(m, Eigen::Vector3d(0, 0, 0));
+  const std::vector<Eigen::Isometry3d> in = blendBones(m, Eigen::Vector3d(1, 0, 0));
+  int ribs = 0;
+  double forward = 0.0;  // [m] mean anterior motion of the rib tips
+  for (int b = 0; b < model->bodies.size(); ++b) {
+    const auto i = static_cast<std::size_t>(b);
+    if (model->bodies.name[i].rfind("rib", 0) != 0) continue;
+    // the tip is the rib's anterior end: in front of the rib's centre of mass
+    EXPECT_GT(tips(1, b), 0.0) << model->bodies.name[i];
+    forward += (in[i] * tips.col(b) - base[i] * tips.col(b)).y();
+    ++ribs;
+  }
+  ASSERT_GT(ribs, 10);
+  EXPECT_GT(forward / ribs, 1e-3) << "the rib tips move forward by more than 1 mm in a deep breath";
+  // the bones of a weight-0 blend are the base's, and a blend's error against itself is zero
+  const BoneBlendError none = boneBlendError(*model, tips, in, in);
+  EXPECT_EQ(none.tipMax, 0.0);
+  EXPECT_LT(none.angleMax, 1e-7);
+  const BoneBlendError deep = boneBlendError(*model, tips, in, base);
+  EXPECT_GT(deep.tipMax, 1e-3);
+  EXPECT_GT(deep.angleMax, deep.angleRms);
 
   // the shape grows linearly with the volume: the calibrated slope puts the deep breath's peak at weight ~1
   EXPECT_NEAR(m.weightPerVolume * (m.targetVolume - m.baseVolume), 1.0, 0.1);

@@ -21,6 +21,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QProgressDialog>
+#include <QPushButton>
 #include <QRegularExpression>
 #include <QStatusBar>
 #include <QSvgRenderer>
@@ -204,6 +205,34 @@ TEST_F(DefaultModelWindow, SkinShowsTheBodyAndTheRibCageThroughIt) {
   const int area = opaque.width() * opaque.height();
   EXPECT_GT(differing(opaque, hidden), area / 10) << "the opaque body covers the view's middle";
   EXPECT_GT(differing(translucent, opaque), area / 50) << "the inside shows through the translucent skin";
+}
+
+// the cheaper render (docs/app.md, "Measured under Xvfb"): the closed surfaces draw their front faces only
+// and the translucent ones blend in drawing order. The opaque skin still hides everything inside it (no back
+// face culled away opens a hole: hiding the bones changes no pixel), and through the translucent skin the
+// bones still show (hiding them changes a good part of the body)
+TEST_F(DefaultModelWindow, OpaqueSkinHidesTheInsideAndTheTranslucentOneShowsIt) {
+  viz::DisplayOptions o = window.scene().options();
+  o.showGut = o.showLungs = o.showLandmarks = false;
+  o.showGroup.fill(false);
+  o.skin = viz::SkinDisplay::Opaque;
+  const auto grab = [&](bool bones) {
+    o.showBones = bones;
+    window.setDisplayOptions(o);
+    return window.grabView();
+  };
+  const QImage opaqueBones = grab(true), opaqueNoBones = grab(false);
+  o.skin = viz::SkinDisplay::Translucent;
+  const QImage translucentBones = grab(true), translucentNoBones = grab(false);
+  o.skin = viz::SkinDisplay::Hidden;
+  const QImage bonesAlone = grab(true), nothing = grab(false);
+  const int bonePixels = differing(bonesAlone, nothing);
+  EXPECT_GT(bonePixels, opaqueBones.width() * opaqueBones.height() / 40)
+      << "the skeleton fills the view's middle";
+  EXPECT_LT(differing(opaqueBones, opaqueNoBones), bonePixels / 200)
+      << "nothing shows through the opaque skin";
+  EXPECT_GT(differing(translucentBones, translucentNoBones), bonePixels / 2)
+      << "the bones show through the translucent skin";
 }
 
 TEST(MainWindow, ExportedPlotFilesHoldThePlottedData) {
@@ -1122,6 +1151,100 @@ TEST_F(DefaultModelWindow, TeachingPresetShowsItsExplanationAndTheNormalRunDashe
 
 // a run of another model is not drawn: a scenario of the default model or a recording of it, over the toy
 // torso, each gives a message naming both models
+// the ghost of the compared run: its gut and lungs drawn light grey where that run has them at the shown
+// instant (magnified as the run is). Calm compared with calm, the ghost lies on the run's own gut and lungs;
+// a paralysed left hemidiaphragm compared with calm, it does not. Its check box hides it, and removing the
+// comparison removes it.
+TEST_F(DefaultModelWindow, GhostOfTheComparedRunIsDrawnWhereThatRunIs) {
+  QTemporaryDir dir;
+  const QString calm = shortCalm(dir, 10.0);
+  const QString left =
+      QString::fromStdString(sim::resourceDir()) + "/scenarios/teaching/paralysed-left-hemidiaphragm.json";
+  const viz::DisplayOptions defaults = window.scene().options();  // opening a model frames what is shown
+  viz::DisplayOptions o = defaults;
+  o.showBones = o.showLandmarks = o.showCavity = false;
+  o.skin = viz::SkinDisplay::Hidden;
+  o.showGroup.fill(false);
+  o.gutColouring = viz::GutColouring::Plain;  // no legend
+  o.magnification = viz::kMaxMagnification;
+  // seen from the side at the second end-inspiration (8 s): the chest and belly forward, the dome down
+  const auto runToEndInspiration = [&] {
+    if (!window.runUntil(8.0, 180000)) return false;
+    for (QPushButton* b : window.findChildren<QPushButton*>())
+      if (b->text() == "Lateral") b->click();
+    QApplication::processEvents();
+    return true;
+  };
+  // the pixels where a grab differs from the empty view
+  const auto mask = [](const QImage& a, const QImage& empty) {
+    std::vector<char> m(static_cast<std::size_t>(a.width() * a.height()));
+    for (int y = 0; y < a.height(); ++y)
+      for (int x = 0; x < a.width(); ++x) {
+        const QColor p = a.pixelColor(x, y), q = empty.pixelColor(x, y);
+        m[static_cast<std::size_t>(y * a.width() + x)] =
+            std::abs(p.red() - q.red()) + std::abs(p.green() - q.green()) + std::abs(p.blue() - q.blue()) >
+            30;
+      }
+    return m;
+  };
+  // the share of the run's gut-and-lung pixels that the ghost alone does not cover, or covers where the run
+  // has none
+  const auto ghostMismatch = [&] {
+    o.showGut = o.showLungs = true;
+    o.showGhost = false;
+    window.setDisplayOptions(o);
+    const QImage run = window.grabView();
+    o.showGut = o.showLungs = false;
+    o.showGhost = true;
+    window.setDisplayOptions(o);
+    EXPECT_TRUE(window.scene().isGhostShown());
+    const QImage ghost = window.grabView();
+    o.showGhost = false;
+    window.setDisplayOptions(o);
+    const QImage empty = window.grabView();
+    const std::vector<char> a = mask(run, empty), b = mask(ghost, empty);
+    int covered = 0, differ = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      covered += a[k];
+      differ += a[k] != b[k];
+    }
+    EXPECT_GT(covered, static_cast<int>(a.size()) / 40) << "the gut and lungs fill the view's middle";
+    return static_cast<double>(differ) / std::max(covered, 1);
+  };
+
+  ASSERT_EQ(window.openScenario(calm), QString());
+  ASSERT_EQ(window.overlayScenario(calm), QString());
+  ASSERT_TRUE(runToEndInspiration()) << window.lastError().toStdString();
+  const double same = ghostMismatch();
+  // (the translucent edges of the differently coloured surfaces cross the mask's threshold at different
+  // pixels: a few per cent)
+  EXPECT_LT(same, 0.08) << "calm against calm: the ghost lies on the run";
+
+  window.setDisplayOptions(defaults);
+  ASSERT_EQ(window.openScenario(left), QString());
+  ASSERT_EQ(window.overlayScenario(calm), QString());
+  ASSERT_TRUE(runToEndInspiration()) << window.lastError().toStdString();
+  const double paralysed = ghostMismatch();
+  EXPECT_GT(paralysed, 3.0 * same) << "paralysed against calm: the ghost is elsewhere";
+
+  // the check box hides it; removing the comparison removes it
+  QCheckBox* box = nullptr;
+  for (QCheckBox* c : window.findChildren<QCheckBox*>())
+    if (c->text() == "Ghost of the compared run") box = c;
+  ASSERT_NE(box, nullptr);
+  o.showGhost = true;
+  window.setDisplayOptions(o);
+  EXPECT_TRUE(window.scene().isGhostShown());
+  box->click();
+  QApplication::processEvents();
+  EXPECT_FALSE(window.scene().isGhostShown());
+  box->click();
+  QApplication::processEvents();
+  EXPECT_TRUE(window.scene().isGhostShown());
+  window.clearOverlay();
+  EXPECT_FALSE(window.scene().isGhostShown());
+}
+
 TEST(MainWindow, ComparisonWithAnotherModelIsRefusedWithAMessage) {
   ToyWindow w;
   const QString calm = QString::fromStdString(sim::resourceDir()) + "/scenarios/calm.json";

@@ -12,8 +12,9 @@
 ///   - chest:     the tidal displacement of panting (rib-cage dominant), scaled to the deep breath's volume,
 ///   - belly:     the tidal displacement of a supine deep breath (abdomen dominant), scaled likewise.
 /// A skin x is then approximated by the linear blend  x ~ base + sum_k w_k D_k.
+/// The bones are baked at the same extremes, so that the same weights pose the skeleton too (blendBones()).
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -26,11 +27,24 @@
 
 namespace pneuma::sim {
 
-/// One morph target: a displacement of every skin vertex from the base.
+/// Poses of every body (MorphTargets::bones), or their displacements: a translation of the body's centre of
+/// mass and the coefficients of its body -> world rotation quaternion, in the model frame.
+struct BonePoses {
+  Eigen::Matrix3Xd translation;  ///< [m] centre of mass, world (3 x #B)
+  Eigen::Matrix4Xd rotation;     ///< [-] quaternion coefficients x, y, z, w (Eigen's order) (4 x #B)
+
+  int size() const { return static_cast<int>(translation.cols()); }
+};
+
+/// One morph target: a displacement of every skin vertex from the base, and of every bone's pose.
 struct MorphTarget {
   std::string name;               ///< "breathing", "chest" or "belly"
   Eigen::Matrix3Xd displacement;  ///< [m] D_k, per skin vertex (3 x #V)
   double ribCageShare = 0.0;      ///< [-] rib cage's share of the tidal volume of the run it came from
+  /// the bones at this target minus the base bones: translations [m] and quaternion coefficients [-], the
+  /// latter q_k - q_base with q_k the bone's rotation at weight 1 on the base's side (q_k . q_base >= 0);
+  /// empty when the targets were baked without bones
+  BonePoses boneDisplacement;
 };
 
 /// The baked shapes and the volume-to-shape calibration of one model.
@@ -44,6 +58,8 @@ struct MorphTargets {
   /// [1/m^3] calibrated volume-to-shape slope: the least-squares line, through the origin, of the summed
   /// fitted weights of the deep run's frames against their lung volume above baseVolume.
   double weightPerVolume = 0.0;
+  std::vector<std::string> bones;  ///< body names (Bodies::name) the bone poses belong to; empty: none (#B)
+  BonePoses boneBase;              ///< the bones at the base shape (#B)
 
   int vertexCount() const { return static_cast<int>(base.cols()); }
 };
@@ -54,11 +70,38 @@ struct BlendError {
   double max = 0.0;  ///< [m] max_v |x_v - blend_v|
 };
 
+/// The bones posed by morph weights w, with the skin's blend: translations linearly, rotations by normalised
+/// linear interpolation of the baked quaternions (nlerp), the same weights as the skin:
+///   t_b = t_base,b + sum_k w_k dt_k,b,   q_b = normalise(q_base,b + sum_k w_k dq_k,b).
+/// @return body frame -> world per bone of `targets.bones` (#B); empty when the targets have no bones.
+std::vector<Eigen::Isometry3d> blendBones(const MorphTargets& targets, const Eigen::VectorXd& weights);
+
+/// How far blended bones are from posed ones.
+struct BoneBlendError {
+  double tipRms = 0.0;    ///< [m] RMS over the ribs' tips (boneTips()) of |x_blend - x_posed|
+  double tipMax = 0.0;    ///< [m] the largest of those distances
+  double angleRms = 0.0;  ///< [rad] RMS over the moving bones of the angle of R_blend R_posed^T
+  double angleMax = 0.0;  ///< [rad] the largest of those angles
+};
+
+/// [m] the tip of every body in its own frame (3 x #B): of the points the body holds (its element endpoints,
+/// apposition springs left out, and the anchors of its joints), the one farthest from the joint to its
+/// parent; for a rib, the anterior end where its costal cartilage starts. The com when it holds no point.
+Eigen::Matrix3Xd boneTips(const Model& model);
+
+/// The error of blended bone poses `blend` against posed ones `posed` (both body -> world, #B) of `model`:
+/// tip distances over the bodies whose name starts with "rib", angles over every moving body.
+BoneBlendError boneBlendError(const Model& model, const Eigen::Matrix3Xd& tips,
+                              const std::vector<Eigen::Isometry3d>& blend,
+                              const std::vector<Eigen::Isometry3d>& posed);
+
 /// Called during a bake with the stage ("deep", "panting", "supine deep") and its progress in [0, 1].
 using BakeProgress = std::function<void(const std::string& stage, double fraction)>;
 
 /// Runs the three breath-style presets (`resourceDir`/presets: deep upright, panting upright, deep supine;
-/// 2 s settling and two breaths each, about 30 simulated seconds) on `model` and extracts the shapes.
+/// 2 s settling and two breaths each, about 30 simulated seconds) on `model` and extracts the shapes, of the
+/// skin and of every bone at the same instants (a chest or belly target's rotation is its run's rotation
+/// between the extremes, scaled in angle like the displacements and applied to the base).
 /// @throws Error when the model has no skin, a preset cannot be loaded or a run fails; Interrupted when
 ///         `stop` (may be null) is set.
 MorphTargets bakeMorphTargets(std::shared_ptr<const Model> model, const std::string& resourceDir,
