@@ -370,17 +370,17 @@ double buildCavity(const Skeleton& sk, const GutSurface& gut, sim::Model& model)
   // comes within kFaceClearance of grazes the dome: drop the bone point of that face nearest the vertex and
   // build again.
   TriangleMesh cavity;
-  std::map<std::array<long long, 3>, int> hullVertex;
+  std::vector<int> bonePoint;  // per cavity vertex: its hull point in pts, -1 for a floor vertex
   for (int round = 0;; ++round) {
     Eigen::Matrix3Xd hullInput(3, static_cast<Eigen::Index>(pts.size()));
     for (std::size_t i = 0; i < pts.size(); ++i) hullInput.col(static_cast<Eigen::Index>(i)) = pts[i].world;
     std::vector<int> source;
     const TriangleMesh hull = convexHull(hullInput, source);
-    hullVertex.clear();
+    std::map<std::array<long long, 3>, int> hullVertex;
     for (int v = 0; v < hull.vertexCount(); ++v)
       hullVertex.emplace(gridKey(hull.vertices.col(v)), source[static_cast<std::size_t>(v)]);
     cavity = subtract(hull, gutMesh, kGrid, "lung cavity");
-    std::vector<int> bonePoint(static_cast<std::size_t>(cavity.vertexCount()), -1);
+    bonePoint.assign(static_cast<std::size_t>(cavity.vertexCount()), -1);
     for (int v = 0; v < cavity.vertexCount(); ++v)
       if (auto it = hullVertex.find(gridKey(cavity.vertices.col(v))); it != hullVertex.end())
         bonePoint[static_cast<std::size_t>(v)] = it->second;
@@ -398,9 +398,8 @@ double buildCavity(const Skeleton& sk, const GutSurface& gut, sim::Model& model)
   c = sim::Cavity{};
   for (int v = 0; v < cavity.vertexCount(); ++v) {
     const Eigen::Vector3d p = cavity.vertices.col(v);
-    auto it = hullVertex.find(gridKey(p));
-    if (it != hullVertex.end()) {
-      addEndpoint(c.vertices, pts[static_cast<std::size_t>(it->second)], model.bodies);
+    if (const int b = bonePoint[static_cast<std::size_t>(v)]; b >= 0) {
+      addEndpoint(c.vertices, pts[static_cast<std::size_t>(b)], model.bodies);
       continue;
     }
     double best = 1e9;
