@@ -1,8 +1,8 @@
 #include "viz/OffscreenView.h"
 
+#include <vtkImageData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
-#include <vtkImageData.h>
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
@@ -14,8 +14,8 @@ namespace pneuma::viz {
 OffscreenView::OffscreenView(vtkRenderer* renderer, int width, int height)
     : m_renderer(renderer), m_width(width), m_height(height) {
   if (width < 1 || height < 1)
-    throw std::runtime_error("an off-screen view of " + std::to_string(width) + " x " + std::to_string(height) +
-                             " pixels");
+    throw std::runtime_error("an off-screen view of " + std::to_string(width) + " x " +
+                             std::to_string(height) + " pixels");
   m_home = renderer->GetRenderWindow();
   if (m_home) m_home->RemoveRenderer(renderer);
   m_window = vtkSmartPointer<vtkRenderWindow>::New();
@@ -43,8 +43,8 @@ std::vector<unsigned char> OffscreenView::render() {
   image->GetDimensions(dims);
   if (dims[0] != m_width || dims[1] != m_height || image->GetNumberOfScalarComponents() != 3)
     throw std::runtime_error("the off-screen view returned " + std::to_string(dims[0]) + " x " +
-                             std::to_string(dims[1]) + " pixels instead of " + std::to_string(m_width) + " x " +
-                             std::to_string(m_height));
+                             std::to_string(dims[1]) + " pixels instead of " + std::to_string(m_width) +
+                             " x " + std::to_string(m_height));
   // VTK's rows run bottom-up
   const std::size_t row = static_cast<std::size_t>(3 * m_width);
   std::vector<unsigned char> rgb(row * static_cast<std::size_t>(m_height));

@@ -3,9 +3,9 @@
 // frames it decodes and the duration. Shared by the movie tests of viz, the app and its command line.
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace pneuma::test {
