@@ -3,6 +3,7 @@
 /// report.html (self-contained, plots embedded), report.md and report.json. Exit 0 iff every check passes.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -401,23 +402,20 @@ void runValidate(const ValidateArgs& args) {
     std::printf("%-32s %-8s %-14s %s\n", c.id.c_str(), c.isPassed() ? "pass" : "FAIL",
                 (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
   for (const sim::Check& c : blowUps) std::printf("  %s: %s\n", c.id.c_str(), c.what.c_str());
-  std::printf("\n%-36s %-8s %-14s %s\n", "physiology", "range", "measured", "published");
-  for (const sim::Check& c : physiology)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("physiology."),
-                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
-                c.target.c_str());
-  if (!silhouette.empty())
-    std::printf("\n%-36s %-8s %-14s %s\n", "silhouette", "range", "measured", "published");
-  for (const sim::Check& c : silhouette)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("silhouette."),
-                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
-                c.target.c_str());
+  // a table of checks against published ranges, the ids without their section prefix, padded to the longest
+  const auto rangeTable = [](const char* section, const std::vector<sim::Check>& list) {
+    const std::size_t prefix = std::strlen(section) + 1;
+    int width = 36;
+    for (const sim::Check& c : list) width = std::max(width, static_cast<int>(c.id.size() - prefix));
+    std::printf("\n%-*s %-8s %-14s %s\n", width, section, "range", "measured", "published");
+    for (const sim::Check& c : list)
+      std::printf("%-*s %-8s %-14s %s\n", width, c.id.c_str() + prefix, c.isPassed() ? "within" : "OUTSIDE",
+                  (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
+  };
+  rangeTable("physiology", physiology);
+  if (!silhouette.empty()) rangeTable("silhouette", silhouette);
   if (!silhouetteProblem.empty()) std::printf("silhouette: none (%s)\n", silhouetteProblem.c_str());
-  std::printf("\n%-36s %-8s %-14s %s\n", "teaching", "range", "measured", "published");
-  for (const sim::Check& c : teaching)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("teaching."),
-                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
-                c.target.c_str());
+  rangeTable("teaching", teaching);
   std::printf(
       "%s; physiology: %d of %zu within published ranges; silhouette: %d of %zu; teaching: %d of %zu; "
       "report: "
