@@ -78,6 +78,7 @@ set(pneuma_deb_depends
     "libqt5core5a (>= 5.15)" "libqt5gui5 (>= 5.15)" "libqt5widgets5 (>= 5.15)" "libqt5svg5 (>= 5.15)"
     "libvtk9.1" "libvtk9.1-qt" "libtet1.5" "libassimp5" "libgmp10" "libmpfr6")
 list(JOIN pneuma_deb_depends ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
-# the plots' font (viz::Plot falls back to VTK's Arial without it)
-set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "fonts-dejavu-core")
+# the plots' font (viz::Plot falls back to VTK's Arial without it); ffmpeg for MP4 movies (viz::MovieWriter:
+# without it the app refuses .mp4 with the reason, and Ogg and PNG exports still work)
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "fonts-dejavu-core, ffmpeg")
 include(CPack)

@@ -15,7 +15,7 @@ PNEUMA_PACKAGES=(
   libvtk9-dev libvtk9-qt-dev libtinygltf-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth chromium nodejs
-  help2man clang-format
+  help2man clang-format ffmpeg
   slurm-wlm munge
   pybind11-dev python3-dev python3-numpy python3-matplotlib
 )

@@ -8,13 +8,17 @@
 #include <QPdfWriter>
 #include <QProgressDialog>
 #include <QSvgRenderer>
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include "gui/PlotView.h"
 #include "gui/SimWorker.h"
 #include "viz/AtomicFile.h"
 #include "viz/MovieWriter.h"
+#include "viz/OffscreenView.h"
 
 namespace pneuma::app {
 
@@ -82,29 +86,109 @@ QString ExportController::exportViewImage(const QString& path) {
   return {};
 }
 
-QString ExportController::exportAnimation(const QString& path, double from, double to, double fps,
+int ExportController::frameCount(const MovieOptions& options) {
+  if (!(options.to > options.from) || !(options.fps > 0.0)) return 0;
+  return static_cast<int>(std::floor((options.to - options.from) * options.fps + 1e-6)) + 1;
+}
+
+namespace {
+
+// what is drawn over each frame of a movie: the time stamp (top centre) and the volume panel (bottom left)
+// (the volume plot over the exported span, its cursor at the frame's instant), sized for the frame
+class MovieOverlay {
+ public:
+  MovieOverlay(const ExportController::MovieOptions& options, const PlotView* volume) : m_options(options) {
+    if (!options.hasVolumePanel || !volume || volume->series().empty()) return;
+    // the lung volume over the exported span (the panel keeps the plot's title, unit and colour)
+    const std::vector<double>& t = volume->time();
+    const PlotView::Series& lung = volume->series().front();
+    std::vector<double> time, y;
+    for (std::size_t k = 0; k < t.size(); ++k)
+      if (t[k] >= options.from - 1e-9 && t[k] <= options.to + 1e-9)
+        time.push_back(t[k]), y.push_back(lung.y[k]);
+    m_panel = std::make_unique<PlotView>(volume->title(), volume->yLabel());
+    m_panel->setWindow(options.to - options.from);
+    m_panel->setViewEnd(options.to);
+    m_panel->setData(std::move(time), {{lung.name, lung.colour, false, std::move(y), QString()}});
+  }
+
+  // draws the overlays for the instant `t` [s] onto `frame`
+  void paint(QImage& frame, double t) const {
+    if (!m_options.hasTimeStamp && !m_panel) return;
+    QPainter painter(&frame);
+    painter.setRenderHint(QPainter::Antialiasing);
+    const int h = frame.height(), w = frame.width();
+    if (m_options.hasTimeStamp) {
+      QFont font = painter.font();
+      font.setPixelSize(std::max(12, h / 24));
+      font.setBold(true);
+      painter.setFont(font);
+      const QString text = QString("t = %1 s").arg(t, 0, 'f', 2);
+      // at the top centre: the view's own caption ("motion x5") keeps the top left
+      const QRect box = painter.fontMetrics().boundingRect(text).adjusted(-8, -4, 8, 4);
+      const QRect placed = box.translated(QPoint((w - box.width()) / 2, h / 40) - box.topLeft());
+      painter.fillRect(placed, QColor(0, 0, 0, 150));
+      painter.setPen(Qt::white);
+      painter.drawText(placed, Qt::AlignCenter, text);
+    }
+    if (m_panel) {
+      m_panel->setCursor(t);
+      const QSize size(std::max(200, static_cast<int>(0.42 * w)), std::max(120, static_cast<int>(0.3 * h)));
+      m_panel->resize(size);
+      painter.setOpacity(0.92);
+      m_panel->render(&painter, QPoint(h / 40, h - size.height() - h / 40));
+    }
+  }
+
+ private:
+  ExportController::MovieOptions m_options;
+  std::unique_ptr<PlotView> m_panel;
+};
+
+}  // namespace
+
+QString ExportController::exportAnimation(const QString& path, const MovieOptions& options,
                                           QWidget* dialogParent) {
   try {
-    if (!(to > from) || !(fps > 0.0)) throw std::runtime_error("nothing recorded to export");
-    viz::MovieWriter writer(path.toStdString(), fps);
-    const int frames = static_cast<int>(std::floor((to - from) * fps + 1e-6)) + 1;
+    const int frames = frameCount(options);
+    if (frames == 0) throw std::runtime_error("nothing recorded to export");
+    if (options.size.isValid() && (options.size.width() < 16 || options.size.height() < 16))
+      throw std::runtime_error("a frame of " + std::to_string(options.size.width()) + " x " +
+                               std::to_string(options.size.height()) + " pixels is too small");
+    viz::MovieWriter writer(path.toStdString(), options.fps);
+    const MovieOverlay overlay(options, m_view.volumePlot ? m_view.volumePlot() : nullptr);
+    // a chosen size is rendered off screen (the view on screen stays blank meanwhile)
+    std::unique_ptr<viz::OffscreenView> offscreen;
+    if (options.size.isValid())
+      offscreen = std::make_unique<viz::OffscreenView>(m_view.renderer(), options.size.width(),
+                                                       options.size.height());
     QProgressDialog progress(QString("Rendering %1 frames of %2 s to %3 s\u2026")
                                  .arg(frames)
-                                 .arg(from, 0, 'f', 1)
-                                 .arg(to, 0, 'f', 1),
+                                 .arg(options.from, 0, 'f', 1)
+                                 .arg(options.to, 0, 'f', 1),
                              "Cancel", 0, frames, dialogParent);
     progress.setWindowTitle("Export animation");
     progress.setWindowModality(Qt::WindowModal);
     progress.setMinimumDuration(0);
     for (int k = 0; k < frames; ++k) {
       progress.setValue(k);
-      // the writer, destroyed unfinished, removes every file it began
+      // the writer, destroyed unfinished, stops ffmpeg and removes every file it began
       if (progress.wasCanceled()) {
         emit done(QString("Animation export cancelled; nothing written"));
         return cancelled();
       }
-      if (!m_view.scrubTo(from + k / fps)) throw std::runtime_error("the recording did not answer");
-      const QImage shot = m_view.grab().convertToFormat(QImage::Format_RGB888);
+      const double shownTime = m_view.scrubTo(options.from + k / options.fps);  // [s]
+      if (!std::isfinite(shownTime)) throw std::runtime_error("the recording did not answer");
+      QImage shot;
+      if (offscreen) {
+        const std::vector<unsigned char> rgb = offscreen->render();
+        shot = QImage(rgb.data(), offscreen->width(), offscreen->height(), 3 * offscreen->width(),
+                      QImage::Format_RGB888)
+                   .copy();
+      } else {
+        shot = m_view.grab().convertToFormat(QImage::Format_RGB888);
+      }
+      overlay.paint(shot, shownTime);
       // QImage pads its rows to 4 bytes: hand the writer packed rows
       QByteArray rows(3 * shot.width() * shot.height(), Qt::Uninitialized);
       for (int y = 0; y < shot.height(); ++y)
@@ -112,6 +196,7 @@ QString ExportController::exportAnimation(const QString& path, double from, doub
       writer.writeFrame(reinterpret_cast<const unsigned char*>(rows.constData()), shot.width(),
                         shot.height());
     }
+    progress.setLabelText("Finishing " + path + "\u2026");
     writer.finish();
   } catch (const std::exception& e) {
     return fail(QString("Cannot export the animation: %1").arg(e.what()));

@@ -20,7 +20,6 @@
 #include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
-#include <QInputDialog>
 #include <QLabel>
 #include <QMenu>
 #include <QMenuBar>
@@ -38,10 +37,12 @@
 #include <QVBoxLayout>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "gui/DocumentController.h"
 #include "gui/ExportController.h"
 #include "gui/LivePlots.h"
+#include "gui/MovieDialog.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Error.h"
@@ -116,8 +117,13 @@ QString breathingText(const sim::Summary* b) {
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_scene(std::make_unique<viz::ModelScene>()) {
   setWindowTitle("Pneuma");
   resize(1280, 800);
-  m_export =
-      new ExportController({[this] { return grabView(); }, [this](double t) { return scrubTo(t); }}, this);
+  m_export = new ExportController(
+      {[this] { return grabView(); },
+       [this](double t) {
+         return scrubTo(t) ? m_shown->state.time : std::numeric_limits<double>::quiet_NaN();
+       },
+       [this] { return m_scene->renderer(); }, [this]() -> const PlotView* { return m_plots->volumePlot(); }},
+      this);
   connect(m_export, &ExportController::failed, this, &MainWindow::report);
   connect(m_export, &ExportController::done, this,
           [this](const QString& message) { showMessage(message, 5000); });
@@ -257,17 +263,8 @@ void MainWindow::buildActions() {
   });
   exportMenu->addAction("Animation of the recording\u2026", this, [this] {
     if (!m_shown) return;
-    const QString path = QFileDialog::getSaveFileName(this, "Export animation", "breathing.ogv",
-                                                      "Ogg Theora movie (*.ogv);;PNG sequence (*.png)");
-    if (path.isEmpty()) return;
-    // the time range: the whole recording unless narrowed
-    bool ok = false;
-    const double from = QInputDialog::getDouble(this, "Export animation", "From [s]", m_shown->recordedFrom,
-                                                m_shown->recordedFrom, m_shown->recordedTo, 2, &ok);
-    if (!ok) return;
-    const double to = QInputDialog::getDouble(this, "Export animation", "To [s]", m_shown->recordedTo, from,
-                                              m_shown->recordedTo, 2, &ok);
-    if (ok) exportAnimation(path, from, to, 25.0);
+    MovieDialog dialog(m_shown->recordedFrom, m_shown->recordedTo, viewSize(), this);
+    if (dialog.exec() == QDialog::Accepted) exportAnimation(dialog.path(), dialog.options());
   });
   exportMenu->addAction("Run as ParaView series (.pvd)\u2026", this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, "Export run", "run.pvd", "ParaView data (*.pvd)");
@@ -988,13 +985,15 @@ bool MainWindow::runUntil(double time, int timeoutMs) {
 bool MainWindow::scrubTo(double time, int timeoutMs) {
   if (!m_worker) return false;
   pause();
+  // the instant shown before does not count, even when it was scrubbed to (a movie's previous frame)
+  const Snapshot* before = m_shown.get();
   m_worker->requestScrub(time);
   QElapsedTimer clock;
   clock.start();
   while (clock.elapsed() < timeoutMs) {
     QApplication::processEvents(QEventLoop::AllEvents, 10);
     refresh();
-    if (m_shown && m_shown->isScrubbed) return true;
+    if (m_shown && m_shown.get() != before && m_shown->isScrubbed) return true;
   }
   return false;
 }
@@ -1183,9 +1182,9 @@ QString MainWindow::exportPlot(const PlotView* plot, const QString& path) {
 
 QString MainWindow::exportViewImage(const QString& path) { return m_export->exportViewImage(path); }
 
-QString MainWindow::exportAnimation(const QString& path, double from, double to, double fps) {
-  if (!m_worker) return m_export->exportAnimation(path, 0.0, 0.0, fps);  // refused: nothing recorded
-  return m_export->exportAnimation(path, from, to, fps, this);
+QString MainWindow::exportAnimation(const QString& path, const ExportController::MovieOptions& options) {
+  if (!m_worker) return m_export->exportAnimation(path, {});  // refused: nothing recorded
+  return m_export->exportAnimation(path, options, this);
 }
 
 QString MainWindow::exportRun(const QString& pvdPath) {

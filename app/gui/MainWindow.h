@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "gui/DocumentController.h"
+#include "gui/ExportController.h"
 #include "gui/SimWorker.h"
 #include "viz/ModelScene.h"
 
@@ -30,7 +31,6 @@ class QVTKOpenGLNativeWidget;
 
 namespace pneuma::app {
 
-class ExportController;
 class LivePlots;
 class ParameterPanel;
 class PlotView;
@@ -98,11 +98,11 @@ class MainWindow : public QMainWindow {
   QString exportPlot(const PlotView* plot, const QString& path);
   /// Writes a PNG of the 3D view. @return empty or the error.
   QString exportViewImage(const QString& path);
-  /// Renders the recorded run from `from` to `to` [s] at `fps` frames per second, as an Ogg Theora
-  /// movie (.ogv) or a PNG sequence (any other suffix: <base>_0000.png, ...). @return empty or the error.
-  /// A progress dialog shows the frames written; its Cancel leaves no file (returns
-  /// ExportController::cancelled()).
-  QString exportAnimation(const QString& path, double from, double to, double fps);
+  /// Renders the recorded run over `options`' range, size and overlays (File > Export > Animation, the
+  /// MovieDialog) as an MP4 (H.264 through ffmpeg), an Ogg Theora movie (.ogv) or a PNG sequence (any other
+  /// suffix: <base>_0000.png, ...). @return empty or the error. A progress dialog shows the frames written;
+  /// its Cancel leaves no file (returns ExportController::cancelled()).
+  QString exportAnimation(const QString& path, const ExportController::MovieOptions& options);
   /// Writes the recorded run as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it.
   /// Blocks (processing events) until the worker has written it. @return empty or the error.
   QString exportRun(const QString& pvdPath);

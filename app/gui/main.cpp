@@ -1,6 +1,8 @@
 // pneuma: the desktop app. `pneuma --screenshot FILE [--after SECONDS] [--style NAME] [--trace CSV]
 // [--magnify N]
 // [--model DIR]` starts, simulates for the given time, saves a grab of the whole window and exits.
+// `pneuma --movie FILE [--from S] [--to S] [--size WxH] [--overlay time,volume]` simulates until --to and
+// writes the recording from --from to --to as a movie (File > Export > Animation), then exits.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -17,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/ExportController.h"
 #include "gui/LivePlots.h"
 #include "gui/MainWindow.h"
 
@@ -122,8 +125,25 @@ int main(int argc, char** argv) {
       "Draw a second run dashed over the plots: a scenario (.json) run on the same model, or a recording "
       "(a pneuma-cli simulate folder or its timeseries.csv).",
       "FILE");
-  parser.addOptions({model, style, affect, volumeTrace, posture, camera, labels, skin, magnify, physiology,
-                     speed, screenshot, after, exportGltf, measure, morphPlayback, scenario, compare});
+  const QCommandLineOption movie(
+      "movie",
+      "Simulate until --to, write the recording from --from to --to as a movie to FILE (.mp4: H.264 through "
+      "ffmpeg; .ogv: Ogg Theora; else a PNG sequence) at 25 frames per second, and exit.",
+      "FILE");
+  const QCommandLineOption movieFrom(
+      "from", "With --movie: first instant [s] (default: the recording's start).", "S");
+  const QCommandLineOption movieTo("to", "With --movie: last instant [s] (default 6).", "S", "6");
+  const QCommandLineOption movieSize(
+      "size", "With --movie: frame size WxH in pixels, e.g. 1280x720 (default: the 3D view as shown).",
+      "WxH");
+  const QCommandLineOption overlay(
+      "overlay",
+      "With --movie: overlays drawn on each frame, comma-separated: time (a time stamp), volume (the "
+      "volume plot with a cursor).",
+      "LIST");
+  parser.addOptions({model,    style,      affect, volumeTrace, posture, camera,     labels,  skin,
+                     magnify,  physiology, speed,  screenshot,  after,   exportGltf, measure, morphPlayback,
+                     scenario, compare,    movie,  movieFrom,   movieTo, movieSize,  overlay});
   if (!parser.parse(arguments)) {
     std::fprintf(stderr, "pneuma: %s\n%s", qPrintable(parser.errorText()), qPrintable(parser.helpText()));
     return 2;
@@ -166,6 +186,59 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  // the movie: range, size and overlays, checked before anything is simulated
+  pneuma::app::ExportController::MovieOptions movieOptions;
+  const bool isMovie = parser.isSet(movie);
+  if (isMovie) {
+    movieOptions.to = parser.value(movieTo).toDouble(&isNumber);
+    if (!isNumber || !(movieOptions.to > 0.0)) {
+      std::fprintf(stderr, "pneuma: --to: expected seconds > 0, got '%s'\n",
+                   qPrintable(parser.value(movieTo)));
+      return 2;
+    }
+    if (parser.isSet(movieFrom)) {
+      movieOptions.from = parser.value(movieFrom).toDouble(&isNumber);
+      if (!isNumber || !(movieOptions.from >= 0.0) || !(movieOptions.from < movieOptions.to)) {
+        std::fprintf(stderr, "pneuma: --from: expected seconds >= 0 and before --to (%g s), got '%s'\n",
+                     movieOptions.to, qPrintable(parser.value(movieFrom)));
+        return 2;
+      }
+    }
+    if (parser.isSet(movieSize)) {
+      const QStringList wh = parser.value(movieSize).toLower().split('x');
+      bool isWidth = false, isHeight = false;
+      const int w = wh.size() == 2 ? wh[0].toInt(&isWidth) : 0;
+      const int h = wh.size() == 2 ? wh[1].toInt(&isHeight) : 0;
+      if (!isWidth || !isHeight || w < 16 || h < 16 || w > 7680 || h > 4320) {
+        std::fprintf(stderr,
+                     "pneuma: --size: expected WxH in pixels from 16x16 to 7680x4320 (e.g. 1280x720), got "
+                     "'%s'\n",
+                     qPrintable(parser.value(movieSize)));
+        return 2;
+      }
+      movieOptions.size = QSize(w, h);
+    }
+    if (parser.isSet(overlay)) {
+      for (const QString& name : parser.value(overlay).split(',')) {
+        if (name.trimmed() == "time") {
+          movieOptions.hasTimeStamp = true;
+        } else if (name.trimmed() == "volume") {
+          movieOptions.hasVolumePanel = true;
+        } else {
+          std::fprintf(stderr, "pneuma: --overlay: unknown overlay '%s' (valid: time, volume)\n",
+                       qPrintable(name));
+          return 2;
+        }
+      }
+    }
+  } else {
+    for (const QCommandLineOption* o : {&movieFrom, &movieTo, &movieSize, &overlay})
+      if (parser.isSet(*o)) {
+        std::fprintf(stderr, "pneuma: --%s needs --movie FILE\n", qPrintable(o->names().first()));
+        return 2;
+      }
+  }
+
   const std::map<QString, pneuma::viz::CameraPreset> presets{
       {"anterior", pneuma::viz::CameraPreset::Anterior},
       {"lateral", pneuma::viz::CameraPreset::Lateral},
@@ -194,7 +267,7 @@ int main(int argc, char** argv) {
   window.setSpeed(speedValue);
   window.show();
   QApplication::processEvents();
-  const bool isScripted = parser.isSet(screenshot);
+  const bool isScripted = parser.isSet(screenshot) || isMovie;
   if (parser.isSet(style) && !window.setBreathStyle(parser.value(style)).isEmpty() && isScripted) return 2;
   if (parser.isSet(posture) && !window.setPosture(parser.value(posture)).isEmpty() && isScripted) return 2;
   const QString modelDir =
@@ -252,6 +325,28 @@ int main(int argc, char** argv) {
     if (!hasModel) return 1;
     window.showMorphPlaybackAt(afterSeconds);
     return saveScreenshot();
+  }
+  if (isMovie) {
+    // simulate until the movie's end, then replay its span through the export (progress dialog included)
+    if (!hasModel) return 1;
+    if (!window.runUntil(movieOptions.to)) {
+      std::fprintf(stderr, "pneuma: simulation did not reach t = %g s: %s\n", movieOptions.to,
+                   qPrintable(window.lastError()));
+      return 1;
+    }
+    const double recordedFrom = window.shown()->recordedFrom;  // [s]
+    if (!parser.isSet(movieFrom)) {
+      movieOptions.from = recordedFrom;
+    } else if (movieOptions.from < recordedFrom - 1e-9) {
+      std::fprintf(stderr, "pneuma: --from: %g s is before the recording's start (%g s)\n", movieOptions.from,
+                   recordedFrom);
+      return 2;
+    }
+    const QString file = parser.value(movie);
+    if (!window.exportAnimation(file, movieOptions).isEmpty()) return 1;  // the error is on stderr
+    std::printf("pneuma: wrote %s (%d frames, %.2f s to %.2f s)\n", qPrintable(file),
+                pneuma::app::ExportController::frameCount(movieOptions), movieOptions.from, movieOptions.to);
+    return 0;
   }
   if (isScripted) {
     // simulate, show that instant, grab what the user would see

@@ -4,6 +4,7 @@
 #include "gui/MainWindow.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <vtkCaptionActor2D.h>
 #include <vtkCoordinate.h>
 #include <vtkDoubleArray.h>
@@ -16,8 +17,11 @@
 #include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDialogButtonBox>
+#include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QFile>
+#include <QFileInfo>
 #include <QLabel>
 #include <QLineEdit>
 #include <QProgressDialog>
@@ -28,15 +32,18 @@
 #include <QTextStream>
 #include <QTimer>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <set>
 #include <tuple>
 
 #include "../cli/CliRunner.h"
+#include "../viz/MovieProbe.h"
 #include "GuiTestSupport.h"
 #include "gui/ExportController.h"
 #include "gui/FlowVolumeLoop.h"
 #include "gui/LivePlots.h"
+#include "gui/MovieDialog.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
 #include "pneuma/sim/Metrics.h"
@@ -46,6 +53,7 @@
 #include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/pattern/Pattern.h"
 #include "viz/GltfWriter.h"
+#include "viz/MovieWriter.h"
 
 using namespace pneuma;
 using namespace pneuma::app::test;
@@ -930,48 +938,234 @@ TEST_F(DefaultModelWindow, PushedAffectPlotsItsTargetBesideTheSimulatedVolume) {
   EXPECT_TRUE(series.size() < 2 || series[1].y.empty() || !std::isfinite(series[1].y.back()));
 }
 
-TEST(MainWindow, AnimationExportsAsMovieAndPngSequence) {
+// movie options over [from, to] [s] at `fps`, at `size` (empty: as shown)
+app::ExportController::MovieOptions movieOptions(double from, double to, QSize size = {}, double fps = 25.0) {
+  app::ExportController::MovieOptions o;
+  o.from = from;
+  o.to = to;
+  o.size = size;
+  o.fps = fps;
+  return o;
+}
+
+// true when this process has no child left, running or unreaped (ffmpeg was stopped and waited for)
+bool hasNoChildProcess() {
+  int status = 0;
+  return waitpid(-1, &status, WNOHANG) == -1 && errno == ECHILD;
+}
+
+// pixels that differ between two images of one size inside `area`
+int differingPixels(const QImage& a, const QImage& b, const QRect& area) {
+  int n = 0;
+  for (int y = area.top(); y <= area.bottom(); ++y)
+    for (int x = area.left(); x <= area.right(); ++x) n += a.pixel(x, y) != b.pixel(x, y) ? 1 : 0;
+  return n;
+}
+
+TEST(MainWindow, AnimationExportsAsMp4OggAndPngSequenceOverTheRangeAndSize) {
   ToyWindow w;
-  ASSERT_TRUE(w.window.runUntil(1.0));
+  ASSERT_TRUE(w.window.runUntil(1.5));
   QTemporaryDir out;
   // 0.2 s at 25 fps: 6 frames
-  ASSERT_EQ(w.window.exportAnimation(out.filePath("breath.png"), 0.4, 0.6, 25.0), QString());
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("breath.png"), movieOptions(0.4, 0.6)), QString());
   const QStringList frames = QDir(out.path()).entryList({"breath_*.png"}, QDir::Files, QDir::Name);
   ASSERT_EQ(frames.size(), 6);
-  EXPECT_FALSE(QImage(out.filePath(frames.front())).isNull());
+  EXPECT_EQ(QImage(out.filePath(frames.front())).size(), w.window.viewSize());
 
-  ASSERT_EQ(w.window.exportAnimation(out.filePath("breath.ogv"), 0.4, 0.6, 25.0), QString());
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("breath.ogv"), movieOptions(0.4, 0.6)), QString());
   QFile movie(out.filePath("breath.ogv"));
   ASSERT_TRUE(movie.open(QIODevice::ReadOnly));
   EXPECT_TRUE(movie.read(4) == "OggS");  // an Ogg container
   EXPECT_GT(movie.size(), 1000);
+
+  // MP4 as shown: the view's size, cropped to even numbers
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("shown.mp4"), movieOptions(0.4, 0.6)), QString());
+  test::expectMp4(out.filePath("shown.mp4").toStdString(), 6, w.window.viewSize().width() & ~1,
+                  w.window.viewSize().height() & ~1);
+
+  // a chosen range and size: 0.4 s to 1.2 s is 21 frames, 0.84 s of movie, rendered at 1280 x 720
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("range.mp4"), movieOptions(0.4, 1.2, QSize(1280, 720))),
+            QString());
+  test::expectMp4(out.filePath("range.mp4").toStdString(), 21, 1280, 720);
   EXPECT_TRUE(QDir(out.path()).entryList({"*.tmp-*"}, QDir::Files).isEmpty());
+  EXPECT_TRUE(hasNoChildProcess());
+
+  // the view is back on screen afterwards: it draws the model again (the rendering left the off-screen
+  // window)
+  const QImage after = w.window.grabView();
+  EXPECT_GT(distinctColours(after), 20);
 }
 
-// a movie export shows its progress, and Cancel part-way leaves no file behind (neither the movie nor a
-// temporary), with no error reported
+// the overlays are drawn where they are said to be, over the same picture: the time stamp at the top left,
+// the volume panel at the bottom left, nothing else changed; the panel's cursor moves with the frame
+TEST(MainWindow, MovieOverlaysDrawTheTimeStampAndTheVolumePanel) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(2.0));
+  QTemporaryDir out;
+  // 0.8 s to 1.6 s at 2.5 frames per second: the instants 0.8, 1.2 and 1.6 s
+  app::ExportController::MovieOptions plain = movieOptions(0.8, 1.6, QSize(640, 360), 2.5);
+  app::ExportController::MovieOptions overlaid = plain;
+  overlaid.hasTimeStamp = true;
+  overlaid.hasVolumePanel = true;
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("plain.png"), plain), QString());
+  ASSERT_EQ(w.window.exportAnimation(out.filePath("over.png"), overlaid), QString());
+  const QImage a = QImage(out.filePath("plain_0000.png")).convertToFormat(QImage::Format_RGB32);
+  const QImage b = QImage(out.filePath("over_0000.png")).convertToFormat(QImage::Format_RGB32);
+  const QImage b2 = QImage(out.filePath("over_0002.png")).convertToFormat(QImage::Format_RGB32);
+  ASSERT_EQ(a.size(), QSize(640, 360));
+  ASSERT_EQ(b.size(), a.size());
+  const QRect stamp(220, 0, 200, 40);   // "t = 0.80 s" at the top centre, 9 px down
+  const QRect panel(9, 231, 268, 120);  // 42 % of the width, 120 px high (the least), 9 px from the corner
+  const QRect rest(300, 45, 340, 315);  // neither overlay
+  const QRect corner(0, 0, 150, 40);    // the view's caption "motion x5" stays visible
+  EXPECT_GT(differingPixels(a, b, stamp), 500) << "the time stamp";
+  EXPECT_GT(differingPixels(a, b, panel), 0.5 * panel.width() * panel.height()) << "the volume panel";
+  EXPECT_EQ(differingPixels(a, b, rest), 0) << "the overlays cover nothing else";
+  EXPECT_EQ(differingPixels(a, b, corner), 0) << "nor the magnification caption";
+  // 1.2 s later the stamp reads another time and the panel's cursor stands elsewhere
+  EXPECT_GT(differingPixels(b, b2, stamp), 50);
+  EXPECT_GT(differingPixels(b, b2, panel), 100);
+}
+
+// File > Export > Animation: the dialog offers the whole recording, shows the frame count and the estimated
+// size of what it will write before rendering, refuses an empty range, and writes what it announced
+TEST(MainWindow, MovieDialogAnnouncesFramesAndSizeAndWritesThem) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(1.5));
+  QTemporaryDir out;
+  QAction* animation = nullptr;
+  for (QAction* a : w.window.findChildren<QAction*>())
+    if (a->text().startsWith("Animation of the recording")) animation = a;
+  ASSERT_NE(animation, nullptr);
+  QString summary, emptyRange;
+  bool wasRefused = false;
+  QTimer::singleShot(0, [&] {
+    auto* d = qobject_cast<app::MovieDialog*>(QApplication::activeModalWidget());
+    if (!d) {
+      ADD_FAILURE() << "no movie dialog";
+      if (QApplication::activeModalWidget()) QApplication::activeModalWidget()->close();
+      return;
+    }
+    EXPECT_NEAR(d->fromBox()->value(), w.window.shown()->recordedFrom, 0.01);
+    EXPECT_NEAR(d->toBox()->value(), w.window.shown()->recordedTo, 0.01);
+    d->setPath(out.filePath("dialog.mp4"));
+    d->fromBox()->setValue(1.2);
+    d->toBox()->setValue(0.4);
+    emptyRange = d->summary();
+    wasRefused = !d->findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Ok)->isEnabled();
+    d->fromBox()->setValue(0.4);
+    d->toBox()->setValue(1.2);
+    d->sizeBox()->setCurrentIndex(1);  // 640 x 360
+    d->timeStampBox()->setChecked(true);
+    d->volumePanelBox()->setChecked(true);
+    summary = d->summary();
+    d->accept();
+  });
+  animation->trigger();
+  EXPECT_TRUE(wasRefused) << emptyRange.toStdString();
+  EXPECT_TRUE(emptyRange.contains("From must come before To")) << emptyRange.toStdString();
+  EXPECT_TRUE(summary.contains("21 frames (0.80 s at 25 fps), 640 x 360 px, MP4")) << summary.toStdString();
+  EXPECT_TRUE(summary.contains(QRegularExpression("about [0-9.]+ (kB|MB)"))) << summary.toStdString();
+  test::expectMp4(out.filePath("dialog.mp4").toStdString(), 21, 640, 360);
+}
+
+// the dialog's size estimate holds for the default model's view: an MP4 at 640 x 360 and at 1280 x 720 comes
+// within a factor of two of viz::MovieWriter::estimatedBytes()
+TEST_F(DefaultModelWindow, MovieSizeEstimateHoldsForTheDefaultModel) {
+  ASSERT_TRUE(window.runUntil(5.0)) << window.lastError().toStdString();
+  QTemporaryDir out;
+  for (const QSize size : {QSize(640, 360), QSize(1280, 720)}) {
+    const QString path = out.filePath(QString("calm_%1.mp4").arg(size.width()));
+    const app::ExportController::MovieOptions o = movieOptions(3.0, 5.0, size);
+    ASSERT_EQ(window.exportAnimation(path, o), QString());
+    const double estimate = viz::MovieWriter::estimatedBytes(
+        viz::MovieWriter::Format::Mp4, size.width(), size.height(), app::ExportController::frameCount(o));
+    const double written = static_cast<double>(QFileInfo(path).size());  // [bytes]
+    EXPECT_GT(written, 0.5 * estimate) << size.width() << ": " << written << " bytes, estimated " << estimate;
+    EXPECT_LT(written, 2.0 * estimate) << size.width() << ": " << written << " bytes, estimated " << estimate;
+  }
+}
+
+// a movie export shows its progress, and Cancel part-way stops ffmpeg and leaves no file of its own behind
+// (neither the movie nor a temporary) while another file in the folder stays, with no error reported
 TEST(MainWindow, CancelledAnimationExportLeavesNoFile) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(1.5));
   QTemporaryDir out;
-  int shownAt = -1;
-  QTimer clicker;
-  QObject::connect(&clicker, &QTimer::timeout, [&] {
-    for (QProgressDialog* dialog : w.window.findChildren<QProgressDialog*>())
-      if (dialog->isVisible() && dialog->value() >= 3 && shownAt < 0) {
-        shownAt = dialog->value();
-        EXPECT_EQ(dialog->maximum(), 26) << "1 s at 25 fps";
-        dialog->cancel();
-      }
-  });
-  clicker.start(2);
-  const QString error = w.window.exportAnimation(out.filePath("breath.ogv"), 0.4, 1.4, 25.0);
-  clicker.stop();
-  EXPECT_EQ(error, app::ExportController::cancelled());
-  EXPECT_GE(shownAt, 3) << "the progress dialog was shown and counted frames";
-  EXPECT_TRUE(QDir(out.path()).entryList(QDir::Files | QDir::Hidden).isEmpty())
-      << QDir(out.path()).entryList(QDir::Files | QDir::Hidden).join(", ").toStdString();
-  EXPECT_EQ(w.window.lastError(), QString()) << "a cancel is not an error";
+  {
+    QFile other(out.filePath("notes.txt"));
+    ASSERT_TRUE(other.open(QIODevice::WriteOnly));
+    other.write("the lecturer's notes");
+  }
+  for (const QString name : {"breath.mp4", "breath.ogv"}) {
+    int shownAt = -1;
+    QTimer clicker;
+    QObject::connect(&clicker, &QTimer::timeout, [&] {
+      for (QProgressDialog* dialog : w.window.findChildren<QProgressDialog*>())
+        if (dialog->isVisible() && dialog->value() >= 3 && shownAt < 0) {
+          shownAt = dialog->value();
+          EXPECT_EQ(dialog->maximum(), 26) << "1 s at 25 fps";
+          dialog->cancel();
+        }
+    });
+    clicker.start(2);
+    const QString error = w.window.exportAnimation(out.filePath(name), movieOptions(0.4, 1.4));
+    clicker.stop();
+    EXPECT_EQ(error, app::ExportController::cancelled()) << name.toStdString();
+    EXPECT_GE(shownAt, 3) << "the progress dialog was shown and counted frames";
+    EXPECT_EQ(QDir(out.path()).entryList(QDir::Files | QDir::Hidden), QStringList{"notes.txt"})
+        << QDir(out.path()).entryList(QDir::Files | QDir::Hidden).join(", ").toStdString();
+    EXPECT_EQ(w.window.lastError(), QString()) << "a cancel is not an error";
+  }
+  EXPECT_TRUE(hasNoChildProcess()) << "ffmpeg was stopped and reaped";
+}
+
+// without ffmpeg, an MP4 is refused with a message that says what to install, in the dialog and the export,
+// and an Ogg movie still exports
+TEST(MainWindow, MissingFfmpegIsExplainedAndOggStillWorks) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(1.0));
+  QTemporaryDir out;
+  setenv("PNEUMA_FFMPEG", "/nonexistent/ffmpeg", 1);
+  app::MovieDialog dialog(0.0, 1.0, QSize(320, 240));
+  dialog.setPath(out.filePath("breath.mp4"));
+  const QString summary = dialog.summary();
+  const bool isEnabled = dialog.findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Ok)->isEnabled();
+  const QString error = w.window.exportAnimation(out.filePath("breath.mp4"), movieOptions(0.4, 0.6));
+  const QString ogg = w.window.exportAnimation(out.filePath("breath.ogv"), movieOptions(0.4, 0.6));
+  unsetenv("PNEUMA_FFMPEG");
+  EXPECT_FALSE(isEnabled);
+  EXPECT_TRUE(summary.contains("apt install ffmpeg")) << summary.toStdString();
+  EXPECT_TRUE(error.contains("apt install ffmpeg")) << error.toStdString();
+  EXPECT_EQ(w.window.lastError(), error);
+  EXPECT_EQ(ogg, QString());
+  EXPECT_EQ(QDir(out.path()).entryList(QDir::Files | QDir::Hidden), QStringList{"breath.ogv"});
+}
+
+// pneuma --movie: simulates, writes the asked range at the asked size with overlays, and exits; bad options
+// are refused by name before anything runs
+TEST(App, MovieFromTheCommandLine) {
+  application();
+  QTemporaryDir dir;
+  const QString model = writeToyModel(dir);
+  const std::string movie = dir.filePath("cli.mp4").toStdString();
+  const test::CliResult r =
+      test::runProgram("pneuma", {"--model", model.toStdString(), "--movie", movie, "--from", "0.5", "--to",
+                                  "1.5", "--size", "640x360", "--overlay", "time,volume"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("26 frames"), std::string::npos) << r.out;
+  test::expectMp4(movie, 26, 640, 360);
+
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
+      {{"--movie", movie, "--size", "640by360"}, "--size"},
+      {{"--movie", movie, "--overlay", "time,pressure"}, "unknown overlay 'pressure'"},
+      {{"--movie", movie, "--from", "2", "--to", "1"}, "--from"},
+      {{"--size", "640x360"}, "--size needs --movie FILE"}};
+  for (const auto& [args, message] : bad) {
+    const test::CliResult refused = test::runProgram("pneuma", args);
+    EXPECT_EQ(refused.exitCode, 2) << refused.err;
+    EXPECT_NE(refused.err.find(message), std::string::npos) << refused.err;
+  }
 }
 
 TEST(MainWindow, SimulationBlowUpPausesAndShowsTheSimsError) {
