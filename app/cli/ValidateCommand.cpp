@@ -3,6 +3,7 @@
 /// report.html (self-contained, plots embedded), report.md and report.json. Exit 0 iff every check passes.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -152,6 +153,12 @@ void runValidate(const ValidateArgs& args) {
   sim::ImpactRun impact;
   const bool hasImpact =
       attempt("impact", "heavy impact", [&] { impact = sim::runHeavyImpact(model, settings); });
+  // the teaching presets against calm upright breathing (docs/app.md "Teaching presets")
+  std::vector<sim::TeachingRun> teachingRuns;
+  for (const std::string& scenario : sim::teachingScenarios())
+    attempt("teaching." + std::filesystem::path(scenario).stem().string(),
+            "teaching scenario '" + scenario + "'",
+            [&] { teachingRuns.push_back(sim::runTeachingScenario(model, scenario, sim::resourceDir())); });
   const double wallSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
 
@@ -183,6 +190,9 @@ void runValidate(const ValidateArgs& args) {
     }
   }
   const std::vector<sim::Check> silhouette = sim::silhouetteChecks(breaths);
+  const std::vector<sim::Check> teaching = sim::teachingChecks(teachingRuns);
+  int teachingWithin = 0;
+  for (const sim::Check& c : teaching) teachingWithin += c.isPassed();
   int silhouetteWithin = 0;
   for (const sim::Check& c : silhouette) silhouetteWithin += c.isPassed();
   std::vector<BreathOutlines> outlines;
@@ -241,7 +251,7 @@ void runValidate(const ValidateArgs& args) {
   j["failed_count"] = failed;
   using CheckList = std::pair<const char*, const std::vector<sim::Check>*>;
   for (const auto& [key, list] : {CheckList{"checks", &checks}, CheckList{"physiology", &physiology},
-                                  CheckList{"silhouette", &silhouette}})
+                                  CheckList{"silhouette", &silhouette}, CheckList{"teaching", &teaching}})
     for (const sim::Check& c : *list)
       j[key].push_back(
           {{"id", c.id},
@@ -255,6 +265,7 @@ void runValidate(const ValidateArgs& args) {
            {"source", c.source}});
   j["physiology_within"] = within;
   j["silhouette_within"] = silhouetteWithin;
+  j["teaching_within"] = teachingWithin;
   for (const sim::StyleRun& r : runs) {
     nlohmann::json& style = j["styles"][r.style.name];
     // as in summary.json, the breath figures are null when no full breath was found (a forced exhale)
@@ -308,9 +319,16 @@ void runValidate(const ValidateArgs& args) {
                << "</td></tr>\n";
     }
   };
-  std::ostringstream physMd, physHtml, silMd, silHtml;
+  std::ostringstream physMd, physHtml, silMd, silHtml, teachMd, teachHtml;
   rangeRows(physiology, physMd, physHtml);
   rangeRows(silhouette, silMd, silHtml);
+  rangeRows(teaching, teachMd, teachHtml);
+  const std::string teachIntro =
+      "The teaching presets (resources/scenarios/teaching/), each run for " + number(sim::kTeachingSeconds) +
+      " s against calm upright breathing (calm.json): the figure each preset's description names, in the "
+      "direction the physiology it cites gives. " +
+      std::to_string(teachingWithin) + " of " + std::to_string(teaching.size()) +
+      " as published; not part of the exit status.";
   const std::string silIntro =
       silhouetteProblem.empty()
           ? "The body's silhouette seen from the side at end-inspiration and end-expiration of each style "
@@ -331,6 +349,7 @@ void runValidate(const ValidateArgs& args) {
   md << "## Physiology\n\n" << physIntro << "\n\n" << rangeHeader << physMd.str() << "\n";
   md << "## Silhouette\n\n" << silIntro << "\n\n";
   if (!silhouette.empty()) md << rangeHeader << silMd.str() << "\n";
+  md << "## Teaching presets\n\n" << teachIntro << "\n\n" << rangeHeader << teachMd.str() << "\n";
   for (const BreathOutlines& b : outlines)
     md << "![" << b.breath.style << "](silhouette_" << b.breath.style << "_lateral.png)\n\n";
   for (const Figure& f : figures)
@@ -361,6 +380,11 @@ void runValidate(const ValidateArgs& args) {
     html << "<img alt=\"silhouette " << htmlEscape(b.breath.style)
          << "\" style=\"width:49%\" src=\"data:image/png;base64,"
          << base64(silhouettePlot(b, sim::SilhouetteView::Lateral).toPng()) << "\">";
+  html << "<h2>Teaching presets</h2>\n<p>" << htmlEscape(teachIntro)
+       << "</p>\n<table><tr><th>check</th><th>what</th><th>measured</th><th>published</th><th></"
+          "th><th>source</"
+          "th></tr>\n"
+       << teachHtml.str() << "</table>\n";
   if (!outlines.empty())
     html << "\n<p>Lateral silhouettes of the trunk, to scale (mm): end-expiration blue, end-inspiration red; "
             "dashed, the chest and belly lines.</p>\n";
@@ -378,24 +402,26 @@ void runValidate(const ValidateArgs& args) {
     std::printf("%-32s %-8s %-14s %s\n", c.id.c_str(), c.isPassed() ? "pass" : "FAIL",
                 (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
   for (const sim::Check& c : blowUps) std::printf("  %s: %s\n", c.id.c_str(), c.what.c_str());
-  std::printf("\n%-36s %-8s %-14s %s\n", "physiology", "range", "measured", "published");
-  for (const sim::Check& c : physiology)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("physiology."),
-                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
-                c.target.c_str());
-  if (!silhouette.empty())
-    std::printf("\n%-36s %-8s %-14s %s\n", "silhouette", "range", "measured", "published");
-  for (const sim::Check& c : silhouette)
-    std::printf("%-36s %-8s %-14s %s\n", c.id.c_str() + std::strlen("silhouette."),
-                c.isPassed() ? "within" : "OUTSIDE", (number(c.measured) + " " + c.unit).c_str(),
-                c.target.c_str());
+  // a table of checks against published ranges, the ids without their section prefix, padded to the longest
+  const auto rangeTable = [](const char* section, const std::vector<sim::Check>& list) {
+    const std::size_t prefix = std::strlen(section) + 1;
+    int width = 36;
+    for (const sim::Check& c : list) width = std::max(width, static_cast<int>(c.id.size() - prefix));
+    std::printf("\n%-*s %-8s %-14s %s\n", width, section, "range", "measured", "published");
+    for (const sim::Check& c : list)
+      std::printf("%-*s %-8s %-14s %s\n", width, c.id.c_str() + prefix, c.isPassed() ? "within" : "OUTSIDE",
+                  (number(c.measured) + " " + c.unit).c_str(), c.target.c_str());
+  };
+  rangeTable("physiology", physiology);
+  if (!silhouette.empty()) rangeTable("silhouette", silhouette);
   if (!silhouetteProblem.empty()) std::printf("silhouette: none (%s)\n", silhouetteProblem.c_str());
+  rangeTable("teaching", teaching);
   std::printf(
-      "%s; physiology: %d of %zu within published ranges; silhouette: %d of %zu; report: %s/report.html "
-      "(%.0f "
-      "s)\n",
-      verdict.c_str(), within, physiology.size(), silhouetteWithin, silhouette.size(), args.out.c_str(),
-      wallSeconds);
+      "%s; physiology: %d of %zu within published ranges; silhouette: %d of %zu; teaching: %d of %zu; "
+      "report: "
+      "%s/report.html (%.0f s)\n",
+      verdict.c_str(), within, physiology.size(), silhouetteWithin, silhouette.size(), teachingWithin,
+      teaching.size(), args.out.c_str(), wallSeconds);
   if (failed > 0) throw CLI::RuntimeError(kExitFailed);
 }
 

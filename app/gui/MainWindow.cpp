@@ -593,7 +593,11 @@ void MainWindow::setDisplayOptions(const viz::DisplayOptions& options) {
   m_scene->setOptions(options);
   m_params->setMagnification(options.magnification);
   syncDisplayWidgets();
-  if (m_shown) poseScene(*m_shown);
+  // the playback's own pose (its weights, magnified anew), not the paused physics'
+  if (m_player)
+    m_scene->updateMorphPlayback(*m_morphs, m_player->weightsAt(*m_morphs, m_playbackTime));
+  else if (m_shown)
+    poseScene(*m_shown);
   m_view->renderWindow()->Render();
 }
 
@@ -939,11 +943,7 @@ void MainWindow::showMorphPlaybackAt(double t) {
   if (t < m_playbackTime) setMorphPlayback(true);  // back in time: the pattern from its start
   QElapsedTimer clock;
   clock.start();
-  const Eigen::VectorXd w = m_player->weightsAt(*m_morphs, t);
-  Eigen::Matrix3Xd displacement = Eigen::Matrix3Xd::Zero(3, m_morphs->vertexCount());  // [m]
-  for (std::size_t k = 0; k < m_morphs->targets.size(); ++k)
-    displacement += w(static_cast<Eigen::Index>(k)) * m_morphs->targets[k].displacement;
-  m_scene->updateMorphPlayback(m_morphs->base, displacement);
+  m_scene->updateMorphPlayback(*m_morphs, m_player->weightsAt(*m_morphs, t));
   m_view->renderWindow()->Render();
   countRender(clock.nsecsElapsed());
   m_playbackTime = t;

@@ -281,7 +281,8 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkScalarBarActor> skinBar = makeScalarBar(skinTable, "Skin\ndisplacement\n[mm]", 0.31);
   // "motion x5" at the top left of the view while the motion is magnified
   vtkSmartPointer<vtkTextActor> motionText = vtkSmartPointer<vtkTextActor>::New();
-  std::string playback;  // the affect of the morph playback on show; empty: the physics
+  std::string playback;            // the affect of the morph playback on show; empty: the physics
+  std::vector<char> playbackBone;  // per body: posed by the playback (a baked bone), so drawn in it
   DisplayOptions options;
 
   sim::Model model;
@@ -359,6 +360,7 @@ struct ModelScene::Impl {
     resetAutoRange();
     referenceTime = std::numeric_limits<double>::quiet_NaN();
     playback.clear();
+    playbackBone.clear();
   }
 
   std::vector<vtkProp*> ownedProps() const {
@@ -679,15 +681,14 @@ struct ModelScene::Impl {
     for (const auto& g : ghost) g.second->SetVisibility(hasGhost && options.showGhost);
     motionText->SetInput(motionCaption().c_str());
     motionText->SetVisibility(!motionCaption().empty());
-    // morph playback: the skin alone, opaque and plain; everything the physics moves is hidden
+    // morph playback: the skin, plain, and the baked bones; everything else the physics moves is hidden
     if (!playback.empty()) {
-      for (vtkProp* prop : ownedProps()) prop->SetVisibility(prop == skinActor.GetPointer());
+      for (vtkProp* prop : ownedProps()) prop->SetVisibility(prop == skinActor.GetPointer() && isSkinShown);
+      for (std::size_t b = 0; b < bodies.size(); ++b)
+        bodies[b]->SetVisibility(options.showBones && b < playbackBone.size() && playbackBone[b]);
       for (vtkProp* bar : {forceBar.GetPointer(), gutBar.GetPointer(), skinBar.GetPointer()})
         bar->SetVisibility(false);
-      if (skinActor) {
-        skinActor->GetProperty()->SetOpacity(1.0);
-        skinActor->GetMapper()->SetScalarVisibility(false);
-      }
+      if (skinActor) skinActor->GetMapper()->SetScalarVisibility(false);
     }
     for (const Label& l : labels) {
       const bool relevant = l.group >= 0      ? options.showGroup[static_cast<std::size_t>(l.group)]
@@ -950,11 +951,37 @@ void ModelScene::setMorphPlayback(const std::string& affect) {
 
 const std::string& ModelScene::morphPlayback() const { return m_impl->playback; }
 
-void ModelScene::updateMorphPlayback(const Eigen::Matrix3Xd& base, const Eigen::Matrix3Xd& displacement) {
-  if (!m_impl->skin || base.cols() != m_impl->skin->GetNumberOfPoints()) return;
-  const Eigen::Matrix3Xd x = base + m_impl->options.magnification * displacement;
-  Impl::setPoints(m_impl->skin, x);
-  Impl::setNormals(m_impl->skin, x, m_impl->model.skin.triangles, m_impl->normalScratch);
+void ModelScene::updateMorphPlayback(const sim::MorphTargets& targets, const Eigen::VectorXd& weights) {
+  Impl& s = *m_impl;
+  if (!s.skinActor || !s.skin || targets.base.cols() != s.skin->GetNumberOfPoints() ||
+      weights.size() != static_cast<Eigen::Index>(targets.targets.size()))
+    return;
+  // the skin: base + m sum_k w_k D_k [m]
+  const double m = s.options.magnification;
+  Eigen::Matrix3Xd x = targets.base;
+  for (std::size_t k = 0; k < targets.targets.size(); ++k)
+    x += m * weights(static_cast<Eigen::Index>(k)) * targets.targets[k].displacement;
+  Impl::setPoints(s.skin, x);
+  Impl::setNormals(s.skin, x, s.model.skin.triangles, s.normalScratch);
+  // the bones by the same (magnified) weights; a body the targets do not carry stays hidden
+  const std::vector<Eigen::Isometry3d> poses = sim::blendBones(targets, m * weights);
+  s.playbackBone.assign(s.bodies.size(), 0);
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const auto& names = s.model.bodies.name;
+    const auto b =
+        static_cast<std::size_t>(std::find(names.begin(), names.end(), targets.bones[k]) - names.begin());
+    if (b >= s.bodies.size()) continue;
+    if (s.posed.body.size() != s.bodies.size())
+      s.posed.body.resize(s.bodies.size(), Eigen::Isometry3d::Identity());
+    s.playbackBone[b] = 1;
+    s.posed.body[b] = poses[k];
+    const Eigen::Matrix4d T = poses[k].matrix();
+    vtkMatrix4x4* pose = s.bodyPose[b];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 4; ++j) pose->SetElement(i, j, T(i, j));
+    pose->Modified();
+  }
+  s.applyOptions();
 }
 
 void ModelScene::setOptions(const DisplayOptions& options) {

@@ -15,6 +15,7 @@
 
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/Model.h"
+#include "pneuma/sim/MorphTargets.h"
 #include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/State.h"
 
@@ -151,17 +152,17 @@ class ModelScene {
   /// physics \u00b7 motion \u00d75"; "motion \u00d75"; empty at 1x without playback).
   std::string motionCaption() const;
 
-  /// Morph playback (de Melo et al. 2010, docs/app.md): with a non-empty `affect` the view shows the skin
-  /// alone, opaque and plain, and hides the bones, muscles, gut, lungs, landmarks, labels and colour bars
-  /// (they are not moved by the playback); the caption names the affect. Empty: back to the physics view
-  /// (the next update() moves the skin back).
+  /// Morph playback (de Melo et al. 2010, docs/app.md): with a non-empty `affect` the view shows the skin,
+  /// plain (no colouring), and the baked bones (MorphTargets::bones, posed by the same weights), and hides
+  /// the muscles, gut, lungs, landmarks, labels and colour bars (the playback does not move them); the
+  /// caption names the affect. Empty: back to the physics view (the next update() moves everything back).
   void setMorphPlayback(const std::string& affect);
   /// The affect of the morph playback on show; empty when the physics is shown.
   const std::string& morphPlayback() const;
-  /// Moves the skin to base + magnification x displacement (both 3 x #V [m], posed by sim::poseGeometry():
-  /// sim::MorphTargets::base and the blend's displacement sum_k w_k D_k). Ignored when the sizes differ
-  /// from the model's skin.
-  void updateMorphPlayback(const Eigen::Matrix3Xd& base, const Eigen::Matrix3Xd& displacement);
+  /// Poses the playback from morph weights w (#K): the skin at base + m sum_k w_k D_k and the baked bones at
+  /// sim::blendBones(targets, m w), m the magnification, so that skin and bones move together (posed() holds
+  /// the bones' poses). Ignored when `targets` do not fit the model's skin.
+  void updateMorphPlayback(const sim::MorphTargets& targets, const Eigen::VectorXd& weights);
 
   /// Applies display options (visibility, colouring, translucency).
   void setOptions(const DisplayOptions& options);

@@ -8,6 +8,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/Silhouette.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
@@ -528,6 +529,170 @@ std::vector<Check> impactChecks(const ImpactRun& run) {
                 run.maxVolumeError * kPct, 0.0, 0.5),
           check("impact.dent", "largest posterior displacement of the umbilicus after the impact",
                 "> 5 mm (the wall visibly dents)", fig4, "mm", run.maxDent * kMm, 5.0, kBig)};
+}
+
+namespace {
+
+// the gut nodes that hold a diaphragm element of one side ({left, right}); midline strands belong to both
+// halves and are left out
+std::array<std::vector<int>, 2> hemidiaphragmNodes(const Model& m, const StepWork& w) {
+  std::array<std::vector<int>, 2> out;
+  std::vector<char> seen(static_cast<std::size_t>(m.nodes.size()) * 2, 0);
+  for (int e = 0; e < m.elements.size(); ++e) {
+    if (m.elements.group[static_cast<std::size_t>(e)] != ElementGroup::Diaphragm) continue;
+    const double share = w.constants.elementRightShare(e);
+    if (share != 0.0 && share != 1.0) continue;
+    const int side = share == 1.0 ? 1 : 0;
+    for (const AnchorSet* a : {&m.elements.endA, &m.elements.endB})
+      for (int k = 0; k < 3; ++k) {
+        const int n = a->nodes(k, e);
+        if (a->body[static_cast<std::size_t>(e)] >= 0 || n < 0 || m.nodes.isFixed(n)) continue;
+        char& mark = seen[static_cast<std::size_t>(2 * n + side)];
+        if (!mark) out[static_cast<std::size_t>(side)].push_back(n);
+        mark = 1;
+      }
+  }
+  return out;
+}
+
+// least-squares slope of y against x
+double slope(const std::vector<double>& x, const std::vector<double>& y) {
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) mx += x[i], my += y[i];
+  mx /= static_cast<double>(x.size());
+  my /= static_cast<double>(y.size());
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx);
+  return sxx > 0.0 ? sxy / sxx : 0.0;
+}
+
+}  // namespace
+
+std::vector<std::string> teachingScenarios() {
+  return {"calm.json",
+          "teaching/paralysed-left-hemidiaphragm.json",
+          "teaching/paralysed-right-hemidiaphragm.json",
+          "teaching/weak-intercostals.json",
+          "teaching/stiff-chest-wall.json",
+          "teaching/abdominal-binding.json",
+          "teaching/supine.json"};
+}
+
+TeachingRun runTeachingScenario(std::shared_ptr<const Model> model, const std::string& scenario,
+                                const std::string& resourceDir) {
+  const Scenario s = loadScenario(resourceDir + "/scenarios/" + scenario);
+  SimulationOptions o = s.options;
+  o.outputRate = 30.0;
+  o.recordSeconds = kTraceOnlyRecordSeconds;
+  Simulation sim(model, makeController(s, model, resourceDir), o);
+  const auto nodes = hemidiaphragmNodes(*model, sim.stepWork());
+  std::vector<double> volume;               // [L]
+  std::array<std::vector<double>, 2> dome;  // [mm]
+  sim.advance(o.settleTime + kTeachingSeconds, [&](const Simulation& sm) {
+    if (sm.state().time < o.settleTime) return true;
+    volume.push_back(sm.latestMetrics().lungVolume * 1e3);
+    for (std::size_t side = 0; side < 2; ++side) {
+      double z = 0.0;
+      for (int n : nodes[side]) z += sm.state().nodePosition(2, n);
+      dome[side].push_back(nodes[side].empty() ? 0.0 : z / static_cast<double>(nodes[side].size()) * kMm);
+    }
+    return true;
+  });
+  TeachingRun r;
+  r.scenario = scenario;
+  r.summary = sim.summary();
+  for (std::size_t side = 0; side < 2; ++side) r.domeRisePerLitre[side] = slope(volume, dome[side]);
+  return r;
+}
+
+std::vector<Check> teachingChecks(const std::vector<TeachingRun>& runs) {
+  const auto find = [&](const std::string& scenario) -> const TeachingRun* {
+    for (const TeachingRun& r : runs)
+      if (r.scenario == scenario) return &r;
+    return nullptr;
+  };
+  const TeachingRun* calm = find("calm.json");
+  std::vector<Check> out;
+  if (!calm) return out;
+  const double calmTidal = calm->summary.tidalVolume * kMl;
+  const double calmShare = kPct * calm->summary.motion.ribCageShare();
+  const char* sides[2] = {"left", "right"};
+  for (std::size_t side = 0; side < 2; ++side)
+    out.push_back(check(std::string("teaching.calm.") + sides[side] + "_dome_rise",
+                        std::string(sides[side]) + " hemidiaphragm height per litre inhaled, calm",
+                        "< -1 mm/L (descends)", "both domes descend on inspiration (Boussuges et al. 2009)",
+                        "mm/L", calm->domeRisePerLitre[side], -kBig, -1.0));
+  // the tidal volume as a fraction of calm's, below `upper`
+  const auto tidal = [&](const std::string& id, const TeachingRun& r, double upper,
+                         const std::string& source) {
+    out.push_back(check("teaching." + id + ".tidal_volume", "tidal volume against calm, " + id,
+                        "< " + std::to_string(static_cast<int>(std::lround(upper * 100))) + " % of calm",
+                        source, "% of calm", kPct * r.summary.tidalVolume * kMl / calmTidal, -kBig,
+                        kPct * upper * (1.0 - 1e-12)));
+  };
+  // the rib-cage share against calm's, shifted by at least `shift` points (down when negative)
+  const auto share = [&](const std::string& id, const TeachingRun& r, double shift,
+                         const std::string& source) {
+    const double d = kPct * r.summary.motion.ribCageShare() - calmShare;
+    const std::string target =
+        (shift < 0 ? "< " : "> ") + std::to_string(static_cast<int>(shift)) + " points";
+    out.push_back(check("teaching." + id + ".rib_cage_share", "rib-cage share minus calm's, " + id, target,
+                        source, "points", d, shift < 0 ? -kBig : shift, shift < 0 ? shift : kBig));
+  };
+  for (std::size_t paralysed = 0; paralysed < 2; ++paralysed) {
+    const std::string id = std::string("paralysed-") + sides[paralysed] + "-hemidiaphragm";
+    const TeachingRun* r = find("teaching/" + id + ".json");
+    if (!r) continue;
+    tidal(id, *r, 0.9,
+          "unilateral paralysis costs about a quarter of the vital capacity (Laroche et al. 1988, Thorax "
+          "43:170)");
+    const std::string sniff = "paradoxical rise of the paralysed dome (Alexander 1966, Clin Radiol 17:79)";
+    out.push_back(
+        check("teaching." + id + ".paralysed_dome_rise",
+              std::string("paralysed (") + sides[paralysed] + ") hemidiaphragm height per litre inhaled",
+              "> 0 mm/L (rises)", sniff, "mm/L", r->domeRisePerLitre[paralysed], 0.0, kBig));
+    out.push_back(
+        check("teaching." + id + ".other_dome_rise",
+              std::string("working (") + sides[1 - paralysed] + ") hemidiaphragm height per litre inhaled",
+              "< -1 mm/L (descends)", sniff, "mm/L", r->domeRisePerLitre[1 - paralysed], -kBig, -1.0));
+  }
+  if (const TeachingRun* r = find("teaching/weak-intercostals.json")) {
+    const std::string src =
+        "intercostal paralysis: abdominal breathing (De Troyer & Estenne 1984, J Appl Physiol 57:899; Urmey "
+        "et al. 1986, J Appl Physiol 60:618)";
+    share("weak-intercostals", *r, -5.0, src);
+    tidal("weak-intercostals", *r, 0.9, src);
+  }
+  if (const TeachingRun* r = find("teaching/stiff-chest-wall.json")) {
+    const std::string src = "ankylosing spondylitis (Romagnoli et al. 2004, Eur Respir J 24:453)";
+    share("stiff-chest-wall", *r, -20.0, src);
+    out.push_back(check("teaching.stiff-chest-wall.lower_rib_expansion", "rib-8 widening against calm",
+                        "< 50 % of calm", src, "% of calm",
+                        kPct * r->summary.motion.lowerRibExpansion / calm->summary.motion.lowerRibExpansion,
+                        -kBig, 50.0));
+    out.push_back(check(
+        "teaching.stiff-chest-wall.umbilicus_forward", "umbilicus anterior motion minus calm's",
+        "> 0 mm (the abdomen takes over)", src, "mm",
+        (r->summary.motion.umbilicusAnterior - calm->summary.motion.umbilicusAnterior) * kMm, 1e-9, kBig));
+    tidal("stiff-chest-wall", *r, 0.9, src);
+  }
+  if (const TeachingRun* r = find("teaching/abdominal-binding.json")) {
+    const std::string src =
+        "Hussain et al. 1985, J Appl Physiol 58:2020; Konno & Mead 1967, J Appl Physiol 22:407";
+    share("abdominal-binding", *r, 5.0, src);
+    tidal("abdominal-binding", *r, 1.0, src);
+  }
+  if (const TeachingRun* r = find("teaching/supine.json")) {
+    share("supine", *r, -5.0,
+          "supine breathing is more abdominal (Sharp et al. 1975, J Appl Physiol 39:608)");
+    out.push_back(check("teaching.supine.end_expiratory_volume", "end-expiratory lung volume against upright",
+                        "< 99 % of upright",
+                        "lung volumes 5-15 % larger upright (Yamada et al. 2020, Sci Rep)", "% of upright",
+                        kPct * r->summary.endExpiratoryVolume / calm->summary.endExpiratoryVolume, -kBig,
+                        99.0));
+  }
+  return out;
 }
 
 }  // namespace pneuma::sim

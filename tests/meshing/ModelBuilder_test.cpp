@@ -235,6 +235,72 @@ TEST_P(BuiltPresets, LungsSplitAsOnCtAroundTheMediastinum) {
               (cavityVolume - m.lungs.mediastinumVolume) * 1e6, volume[0] * 1e6, volume[1] * 1e6);
 }
 
+// each lung's flat face on the central mediastinal block (x constant, its vertices where the block's side
+// meets the cavity's walls) is a Delaunay triangulation in that plane (LungCavity.cpp, flipMediastinalFaces,
+// Lawson 1977): no interior edge of the face has the opposite corner of its other triangle inside its
+// triangle's circumcircle. The corefinement's slivers there folded through the walls and the gut as they
+// moved (crossing pairs summed over every style and affect, tests/validation/Surfaces_test.cpp: 1558 with the
+// slivers, 877 after the flips)
+TEST_P(BuiltPresets, LungMediastinalFacesAreDelaunay) {
+  const sim::Model& m = model();
+  const Eigen::Matrix3Xd cavity = restPoints(m.cavity.vertices, m);
+  for (const sim::LungSurface* lung : {&m.lungs.right, &m.lungs.left}) {
+    const std::string side = lung == &m.lungs.right ? "right" : "left";
+    Eigen::Matrix3Xd x;
+    sim::lungPositions(*lung, cavity, x);
+    // the face's plane: the x that most of the lung's vertices share (to 1 um), those where the block's side
+    // meets the cavity's walls
+    std::map<long long, int> atX;
+    for (int v = 0; v < lung->vertexCount(); ++v) ++atX[std::llround(x(0, v) * 1e6)];
+    const auto plane = std::max_element(atX.begin(), atX.end(),
+                                        [](const auto& a, const auto& b) { return a.second < b.second; });
+    ASSERT_GT(plane->second, 20) << GetParam() << " " << side;
+    double faceX = 0.0;
+    for (int v = 0; v < lung->vertexCount(); ++v)
+      if (std::llround(x(0, v) * 1e6) == plane->first) faceX += x(0, v) / plane->second;
+    std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> edges;  // edge -> (triangle, opposite)
+    int flat = 0;
+    for (int f = 0; f < lung->triangles.cols(); ++f) {
+      const Eigen::Vector3i t = lung->triangles.col(f);
+      if ((x(0, t(0)) - faceX) * (x(0, t(0)) - faceX) + (x(0, t(1)) - faceX) * (x(0, t(1)) - faceX) +
+              (x(0, t(2)) - faceX) * (x(0, t(2)) - faceX) >
+          1e-14)
+        continue;
+      ++flat;
+      for (int k = 0; k < 3; ++k) {
+        const int a = t(k), b = t((k + 1) % 3);
+        edges[{std::min(a, b), std::max(a, b)}].push_back({f, t((k + 2) % 3)});
+      }
+    }
+    EXPECT_GT(flat, 20) << GetParam() << " " << side;
+    // > 0 when d lies inside the circumcircle of (a, b, c), for either orientation (y-z coordinates)
+    auto inCircle = [&](int a, int b, int c, int d) {
+      Eigen::Matrix3d q;
+      const int abc[3] = {a, b, c};
+      for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector2d p = x.block<2, 1>(1, abc[i]) - x.block<2, 1>(1, d);
+        q.row(i) << p.x(), p.y(), p.squaredNorm();
+      }
+      const Eigen::Vector2d u = x.block<2, 1>(1, b) - x.block<2, 1>(1, a),
+                            w = x.block<2, 1>(1, c) - x.block<2, 1>(1, a);
+      return (u.x() * w.y() - u.y() * w.x() > 0.0 ? 1.0 : -1.0) * q.determinant();
+    };
+    int notDelaunay = 0, interior = 0;
+    for (const auto& [e, sides] : edges) {
+      if (sides.size() != 2) continue;
+      ++interior;
+      const int c = sides[0].second, d = sides[1].second;
+      double size = 0.0;
+      for (const int v : {e.second, c, d}) size = std::max(size, (x.col(v) - x.col(e.first)).norm());
+      // a tolerance of the flips' own (1e-6 of the quadrilateral's size^4) and the rounding of the rest pose
+      notDelaunay += inCircle(e.first, e.second, c, d) > 1e-5 * std::pow(size, 4);
+    }
+    EXPECT_GT(interior, 10) << GetParam() << " " << side;
+    EXPECT_EQ(notDelaunay, 0) << GetParam() << " " << side << ": of " << interior << " interior edges on "
+                              << flat << " triangles";
+  }
+}
+
 TEST_P(BuiltPresets, TetGenVolumeEqualsSurfaceVolumeAndSurfaceHasNoSlivers) {
   const BuildReport& r = built().report;
   EXPECT_NEAR(r.tetVolume, r.summary.gutVolume, 1e-3 * r.summary.gutVolume);

@@ -5,6 +5,7 @@
 // already reused, so a restart that dropped the solver memory (SolverMemory, Step.h) would not match; the
 // last test shows that it does not.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -110,7 +111,9 @@ void expectExactRestarts(const ControllerFactory& makeController, const std::str
   Simulation whole(model, makeController(), options);
   std::string text;
   const SimulationCheckpoint checkpoint = runToCheckpoint(whole, text);
-  const std::string path = ::testing::TempDir() + "pneuma_restart_" + name + ".txt";
+  // per process: worktrees' test runs share the temporary folder
+  const std::string path =
+      ::testing::TempDir() + "pneuma_restart_" + std::to_string(::getpid()) + "_" + name + ".txt";
   std::ofstream(path) << text;
   whole.advance(checkpoint.state.time + kAfter - whole.state().time);
   const State uninterrupted = whole.state();

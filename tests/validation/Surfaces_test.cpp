@@ -88,12 +88,19 @@ int medialCrossings(const LungSurface& l, const Eigen::Matrix3Xd& x) {
 // they are gone those pairs are reported and the test is skipped naming them; set this to true to enforce
 // them.
 constexpr bool kEnforceWallCrossings = false;
+// Until then their sum may not grow: crossing pairs summed over both phases of the breath styles and of the
+// affects. Measured: 264 and 1294 before the Delaunay flips of the lungs' mediastinal faces
+// (meshing/src/LungCavity.cpp, flipMediastinalFaces), 130 and 747 after (in total 1558 -> 877: the left
+// lung's own 159 -> 42, the right lung's 122 -> 117, the lungs with the cavity 748 -> 438, with the gut 516
+// -> 267); the budgets leave about 10 % for the run-to-run spread of other changes.
+constexpr int kStyleCrossingBudget = 145;
+constexpr int kAffectCrossingBudget = 820;
 
 // runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
 // settling: the two lungs never cross each other nor does a mediastinal face cross anything; the other
 // crossings are added to `wall` (see kEnforceWallCrossings)
 void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> controller, double duration,
-                       std::ostringstream& wall) {
+                       std::ostringstream& wall, int& sum) {
   const auto model = defaultModel();
   SimulationOptions o;
   o.settleTime = 2.0;
@@ -124,12 +131,16 @@ void expectNoCrossings(const std::string& name, std::unique_ptr<Controller> cont
     if (kEnforceWallCrossings) {
       EXPECT_EQ(total, 0) << name << " at " << phase << ": " << describe(c);
     }
+    sum += total;
     if (total > 0) wall << "\n  " << name << " at " << phase << ": " << describe(c);
   }
 }
 
-// the known crossings where the dome folds, reported as a skip until kEnforceWallCrossings
-void reportWallCrossings(const std::ostringstream& wall) {
+// the known crossings where the dome folds, reported as a skip until kEnforceWallCrossings; their sum over
+// the runs may not grow past `budget`
+void reportWallCrossings(const std::ostringstream& wall, int sum, int budget) {
+  testing::Test::RecordProperty("crossings", sum);
+  EXPECT_LE(sum, budget) << "crossing pairs summed over the runs:" << wall.str();
   if (!wall.str().empty())
     GTEST_SKIP() << "surfaces cross where the dome folds (kEnforceWallCrossings):" << wall.str();
 }
@@ -145,13 +156,14 @@ TEST(Surfaces, DefaultModelAtRestHasNoCrossings) {
 TEST(Surfaces, NoCrossingsInAnyBreathStyle) {
   REQUIRE_DEFAULT_MODEL();
   std::ostringstream wall;
+  int sum = 0;
   for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) {
     const BreathStyle s = loadBreathStyle(style);
     // one breath of the periodic styles (at least 4 s), the forced exhale's whole manoeuvre
     const double duration = s.cycles > 0 ? 7.0 : std::max(4.0, 60.0 / s.breathsPerMinute);
-    expectNoCrossings(style, std::make_unique<BreathStyleController>(s), duration, wall);
+    expectNoCrossings(style, std::make_unique<BreathStyleController>(s), duration, wall, sum);
   }
-  reportWallCrossings(wall);
+  reportWallCrossings(wall, sum, kStyleCrossingBudget);
 }
 
 TEST(Surfaces, NoCrossingsInAnyAffect) {
@@ -163,10 +175,12 @@ TEST(Surfaces, NoCrossingsInAnyAffect) {
   std::sort(names.begin(), names.end());
   ASSERT_GE(names.size(), 10u);
   std::ostringstream wall;
+  int sum = 0;
   for (const std::string& name : names)
     expectNoCrossings("affect " + name,
-                      pattern::makeAffectController(name, PNEUMA_RESOURCE_DIR, 1, calibration), 4.0, wall);
-  reportWallCrossings(wall);
+                      pattern::makeAffectController(name, PNEUMA_RESOURCE_DIR, 1, calibration), 4.0, wall,
+                      sum);
+  reportWallCrossings(wall, sum, kAffectCrossingBudget);
 }
 
 }  // namespace

@@ -69,6 +69,19 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
     within += c["passed"].get<bool>();
   }
   EXPECT_EQ(report["physiology_within"].get<int>(), within);
+  // the teaching section: a row per teaching check, 18 of them (the calm reference and six presets, each
+  // with its figures), counted the same way
+  ASSERT_TRUE(report["teaching"].is_array());
+  EXPECT_EQ(report["teaching"].size(), 18u);
+  int teachingWithin = 0;
+  for (const auto& c : report["teaching"]) {
+    const std::string id = c["id"].get<std::string>();
+    EXPECT_NE(md.find("| " + id + " |"), std::string::npos) << id;
+    EXPECT_NE(html.find("<td>" + id + "</td>"), std::string::npos) << id;
+    teachingWithin += c["passed"].get<bool>();
+  }
+  EXPECT_EQ(report["teaching_within"].get<int>(), teachingWithin);
+  EXPECT_NE(html.find("<h2>Teaching presets</h2>"), std::string::npos);
   const std::string row =
       "| physiology.calm.dome_descent | dome descent (central tendon, craniocaudal), calm | ";
   const std::size_t at = md.find(row);

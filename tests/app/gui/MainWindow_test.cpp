@@ -1047,6 +1047,32 @@ TEST_F(DefaultModelWindow, MorphPlaybackBreathesTheSkinWithThePhysicsPaused) {
     if (t > 4.0 && a > high) std::tie(high, tHigh) = std::make_pair(a, t);
   }
   ASSERT_GT(high, low + 0.1) << "the neutral breath moves the weights";
+  const int sternum = static_cast<int>(std::find(morphs->bones.begin(), morphs->bones.end(), "sternum") -
+                                       morphs->bones.begin());
+  ASSERT_LT(sternum, static_cast<int>(morphs->bones.size())) << "the targets carry the bones";
+  window.showMorphPlaybackAt(tLow);
+  const Eigen::Vector3d sternumLow =
+      window.scene().posed().body[static_cast<std::size_t>(sternum)].translation();
+  window.showMorphPlaybackAt(tHigh);
+  const Eigen::Vector3d sternumHigh =
+      window.scene().posed().body[static_cast<std::size_t>(sternum)].translation();
+  // the bones ride with the skin: the sternum moves forward (+y) on the inhale, magnified 5x
+  EXPECT_GT(sternumHigh.y() - sternumLow.y(), 0.005) << "the sternum moves forward at end-inspiration";
+  // and they are drawn inside the translucent skin: hiding them changes the picture
+  const QImage withBones = window.grabView();
+  viz::DisplayOptions noBones = window.scene().options();
+  noBones.showBones = false;
+  window.setDisplayOptions(noBones);
+  const QImage withoutBones = window.grabView();
+  noBones.showBones = true;
+  window.setDisplayOptions(noBones);
+  EXPECT_GT(differing(withBones, withoutBones), withBones.width() * withBones.height() / 50)
+      << "the playback draws the bones";
+
+  // the silhouette, with the skin opaque as a user would show it
+  viz::DisplayOptions opaque = window.scene().options();
+  opaque.skin = viz::SkinDisplay::Opaque;
+  window.setDisplayOptions(opaque);
   window.showMorphPlaybackAt(std::min(tLow, tHigh));
   const std::vector<bool> first = bodyMask(window.grabView());
   window.showMorphPlaybackAt(std::max(tLow, tHigh));

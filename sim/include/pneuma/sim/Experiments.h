@@ -13,6 +13,7 @@
 ///    umbilicus is struck posteriorly; the gut deforms while its volume error stays small.
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <memory>
 #include <string>
@@ -211,5 +212,41 @@ ImpactRun runHeavyImpact(std::shared_ptr<const Model> model, const ExperimentSet
 
 /// Volume error below 0.5 % after the impact (Figure 4), with a visible dent (> 5 mm).
 std::vector<Check> impactChecks(const ImpactRun& run);
+
+/// A run of a shipped scenario for teaching (resources/scenarios/teaching/, docs/app.md "Teaching presets"),
+/// or of the calm reference (resources/scenarios/calm.json): `kTeachingSeconds` after the scenario's
+/// settling, at 30 frames/s.
+struct TeachingRun {
+  std::string scenario;  ///< the file relative to resources/scenarios/, e.g. "teaching/supine.json"
+  Summary summary;       ///< from the scenario's settle time on
+  /// [mm/L] least-squares slope of each hemidiaphragm's mean height (the gut nodes its diaphragm elements
+  /// hold, midline strands excluded) against the lung volume over the run, {left, right}: < 0 when the half
+  /// descends on inspiration, > 0 when it rises with it (paradoxical motion)
+  std::array<double, 2> domeRisePerLitre{};
+};
+constexpr double kTeachingSeconds = 12.0;  ///< [s] simulated after settling in a TeachingRun
+
+/// The calm reference and the teaching presets teachingChecks() knows, relative to resources/scenarios/
+/// (the calm reference first).
+std::vector<std::string> teachingScenarios();
+
+/// Runs `scenario` (relative to `resourceDir`/scenarios/) on `model`.
+/// @throws Error when the scenario cannot be read or the run blows up.
+TeachingRun runTeachingScenario(std::shared_ptr<const Model> model, const std::string& scenario,
+                                const std::string& resourceDir);
+
+/// Each teaching preset against calm upright breathing: the figure its description names moves in the
+/// direction the physiology it cites gives (ids "teaching.<preset>.<figure>"):
+///  - calm: both hemidiaphragms descend on inspiration (< -1 mm/L);
+///  - paralysed left/right hemidiaphragm: tidal volume < 90 % of calm (Laroche et al. 1988), the paralysed
+///    dome rises with inspiration (> 0 mm/L) while the other descends (Alexander 1966, the sniff test);
+///  - weak intercostals: rib-cage share 5 points below calm, tidal volume < 90 % (De Troyer & Estenne 1984);
+///  - stiff chest wall: rib-cage share 20 points below calm, rib-8 widening < half of calm, the umbilicus
+///    moving further forward, tidal volume < 90 % (Romagnoli et al. 2004);
+///  - abdominal binding: rib-cage share 5 points above calm, a smaller tidal volume (Hussain et al. 1985);
+///  - supine: rib-cage share 5 points below upright (Sharp et al. 1975), end-expiratory volume 1 % lower
+///    (Yamada et al. 2020).
+/// Runs missing from `runs` (found by TeachingRun::scenario) give no checks; without the calm run, none.
+std::vector<Check> teachingChecks(const std::vector<TeachingRun>& runs);
 
 }  // namespace pneuma::sim
