@@ -23,6 +23,8 @@ void writeMotion(const sim::Motion& m, nlohmann::json& j) {
   j["xiphoid_anterior_mm"] = jsonNumber(m.xiphoidAnterior * kMm);
   j["xiphoid_cranial_mm"] = jsonNumber(m.xiphoidCranial * kMm);
   j["lower_rib_expansion_mm"] = jsonNumber(m.lowerRibExpansion * kMm);
+  // only a model with a shoulder girdle has acromions
+  if (std::isfinite(m.acromionCranial)) j["acromion_cranial_mm"] = m.acromionCranial * kMm;
   j["umbilicus_anterior_mm"] = jsonNumber(m.umbilicusAnterior * kMm);
   j["umbilicus_anterior_min_mm"] = jsonNumber(m.umbilicusAnteriorMin * kMm);
   j["rib_cage_tidal_ml"] = jsonNumber(m.ribCageTidal * kMl);

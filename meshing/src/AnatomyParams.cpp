@@ -1,5 +1,6 @@
 #include "pneuma/meshing/AnatomyParams.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -141,7 +142,7 @@ Gains readGains(const Reader& r) {
   r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s",
                "abdominal_wall_tone_upright", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
                "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
-               "diaphragm_mass_kg", "joints"});
+               "diaphragm_mass_kg", "joints", "shoulder_springs"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -177,14 +178,41 @@ Gains readGains(const Reader& r) {
   }
   g.wallMass = r.at("gut_wall_mass_kg").positiveAtMost(100.0);
   g.diaphragmMass = r.at("diaphragm_mass_kg").positiveAtMost(10.0);
+  // one row per kind of joint
   const Reader joints = r.at("joints");
-  joints.allowKeys({"costovertebral_friction", "costovertebral_stiffness", "costotransverse_stiffness",
-                    "spine_friction", "spine_stiffness"});
-  g.costovertebralFriction = joints.at("costovertebral_friction").numberIn(0.0, 1e6);
-  g.costovertebralStiffness = joints.at("costovertebral_stiffness").numberIn(0.0, 1e6);
-  g.costotransverseStiffness = joints.at("costotransverse_stiffness").numberIn(0.0, 1e6);
-  g.spineFriction = joints.at("spine_friction").numberIn(0.0, 1e6);
-  g.spineStiffness = joints.at("spine_stiffness").numberIn(0.0, 1e6);
+  for (const std::string& key : joints.keys())
+    if (std::find(kJointKinds.begin(), kJointKinds.end(), key) == kJointKinds.end())
+      joints.at(key).fail("unknown kind of joint");
+  for (std::size_t k = 0; k < kJointKinds.size(); ++k) {
+    const Reader row = joints.at(kJointKinds[k]);
+    row.allowKeys({"friction", "stiffness", "lock_stiffness"});
+    JointGains& j = g.joints[k];
+    j.friction = row.at("friction").numberIn(0.0, 1e6);
+    j.stiffness = row.at("stiffness").numberIn(0.0, 1e6);
+    j.lockStiffness = row.at("lock_stiffness").numberIn(0.0, 1e6);
+  }
+  const Reader shoulder = r.at("shoulder_springs");
+  shoulder.allowKeys({"kpe", "b"});
+  g.shoulder.kpe = shoulder.at("kpe").numberIn(0.0, 1e9);
+  g.shoulder.damping = shoulder.at("b").numberIn(0.0, 1e9);
+  return g;
+}
+
+GirdleParams readGirdle(const Reader& r) {
+  r.allowKeys({"body_mass_kg", "clavicle_length_mm", "upper_arm_length_mm", "forearm_length_mm",
+               "hand_length_mm", "upper_arm_mass_fraction", "forearm_mass_fraction", "hand_mass_fraction",
+               "abduction_deg", "elbow_flexion_deg"});
+  GirdleParams g;
+  g.bodyMass = r.at("body_mass_kg").numberIn(20.0, 300.0);
+  g.clavicleLength = mm(r.at("clavicle_length_mm"), 60.0, 300.0);
+  g.upperArmLength = mm(r.at("upper_arm_length_mm"), 100.0, 600.0);
+  g.forearmLength = mm(r.at("forearm_length_mm"), 100.0, 600.0);
+  g.handLength = mm(r.at("hand_length_mm"), 50.0, 400.0);
+  g.upperArmMassFraction = r.at("upper_arm_mass_fraction").numberIn(0.001, 0.2);
+  g.forearmMassFraction = r.at("forearm_mass_fraction").numberIn(0.001, 0.2);
+  g.handMassFraction = r.at("hand_mass_fraction").numberIn(0.001, 0.2);
+  g.abduction = r.at("abduction_deg").numberIn(0.0, 90.0) * kDeg;
+  g.elbowFlexion = r.at("elbow_flexion_deg").numberIn(0.0, 120.0) * kDeg;
   return g;
 }
 
@@ -200,7 +228,7 @@ AnatomyParams parseAnatomy(const std::string& anatomyText, const std::string& ga
   const sim::JsonDocument doc = sim::JsonDocument::parse(anatomyText, sourceName);
   const Reader r = doc.root();
   r.allowKeys({"name", "description", "gains", "bone_density_kg_m3", "floating_ribs_moving", "ribs", "spine",
-               "sternum", "pelvis", "abdomen", "resolution"});
+               "sternum", "pelvis", "abdomen", "resolution", "shoulder_girdle", "girdle"});
   AnatomyParams a;
   a.source = sourceName;
   a.name = r.at("name").string();
@@ -219,6 +247,9 @@ AnatomyParams parseAnatomy(const std::string& anatomyText, const std::string& ga
   a.abdomen = readAbdomen(r.at("abdomen"));
   a.resolution = readResolution(r.at("resolution"));
   a.gains = readGains(sim::JsonDocument::parse(gainsText, gainsName).root());
+  // optional: no shoulder girdle when absent
+  if (r.has("shoulder_girdle")) a.hasShoulderGirdle = r.at("shoulder_girdle").boolean();
+  if (r.has("girdle") || a.hasShoulderGirdle) a.girdle = readGirdle(r.at("girdle"));
   return a;
 }
 

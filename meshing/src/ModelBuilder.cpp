@@ -27,6 +27,12 @@ constexpr double kTetVolumeTolerance = 1e-3;  // [-] TetGen vs divergence-theore
 void buildBodies(const AnatomyParams& a, const Skeleton& sk, BuiltModel& out) {
   std::map<int, int> mirrorOf;  // left rib -> right rib
   for (const auto& pair : sk.rib) mirrorOf[pair[kLeft]] = pair[kRight];
+  if (sk.hasGirdle) {
+    const GirdleSide &r = sk.girdle[kRight], &l = sk.girdle[kLeft];
+    for (const auto& [left, right] : {std::pair{l.clavicle, r.clavicle}, std::pair{l.scapula, r.scapula},
+                                      std::pair{l.humerus, r.humerus}, std::pair{l.forearm, r.forearm}})
+      mirrorOf[left] = right;
+  }
 
   const int n = static_cast<int>(sk.bones.size());
   std::vector<TriangleMesh> world(static_cast<std::size_t>(n));
@@ -40,11 +46,17 @@ void buildBodies(const AnatomyParams& a, const Skeleton& sk, BuiltModel& out) {
                                              ? world[static_cast<std::size_t>(m->second)].mirroredX()
                                              : remeshIsotropic(bone.mesh, a.resolution.boneEdge, bone.name);
     const MassProperties mp = massProperties(world[static_cast<std::size_t>(i)], a.boneDensity);
+    // a segment of given mass: the mesh's shape at the density that gives it
+    const double scale = bone.mass > 0.0 ? bone.mass / mp.mass : 1.0;
     b.name.push_back(bone.name);
     b.isFixed.push_back(bone.isFixed ? 1 : 0);
-    b.mass(i) = mp.mass;
+    if (bone.isSupported) {
+      b.isSupported.resize(static_cast<std::size_t>(n), 0);
+      b.isSupported[static_cast<std::size_t>(i)] = 1;
+    }
+    b.mass(i) = scale * mp.mass;
     b.com.col(i) = mp.com;
-    b.inertia.push_back(mp.inertia);
+    b.inertia.push_back(scale * mp.inertia);
     b.mesh.push_back("meshes/" + bone.name + ".vtp");
     out.bodyMeshes.push_back(world[static_cast<std::size_t>(i)].translated(-mp.com));
     out.report.boneTriangles += world[static_cast<std::size_t>(i)].triangleCount();
@@ -64,10 +76,11 @@ void buildJoints(const AnatomyParams& a, const Skeleton& sk, sim::Joints& j) {
     j.parent.push_back(s.parent);
     j.child.push_back(s.child);
     j.anchor.col(i) = s.anchor;
-    j.friction(i) = s.isSpine ? a.gains.spineFriction : a.gains.costovertebralFriction;
-    j.stiffness(i) = s.isSpine ? a.gains.spineStiffness : a.gains.costovertebralStiffness;
-    j.axis.col(i) = s.isSpine ? Eigen::Vector3d::UnitX() : s.axis;
-    j.lockStiffness(i) = s.isSpine ? 0.0 : a.gains.costotransverseStiffness;
+    const JointGains& g = a.gains.joints[static_cast<std::size_t>(s.kind)];
+    j.friction(i) = g.friction;
+    j.stiffness(i) = g.stiffness;
+    j.axis.col(i) = s.axis;
+    j.lockStiffness(i) = g.lockStiffness;
   }
 }
 
@@ -151,6 +164,12 @@ void buildLandmarks(const AnatomyParams& a, const Skeleton& sk, const GutSurface
     add(side == kRight ? "rib8_lateral_right" : "rib8_lateral_left",
         Endpoint::onBody(sk.rib[7][static_cast<std::size_t>(side)], r.centre[best]));
   }
+  // acromions: the superolateral tips of the scapulae, when the model has them
+  if (sk.hasGirdle)
+    for (int side : {kRight, kLeft}) {
+      const GirdleSide& s = sk.girdle[static_cast<std::size_t>(side)];
+      add(side == kRight ? "acromion_right" : "acromion_left", Endpoint::onBody(s.scapula, s.acromion));
+    }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <tuple>
+#include <utility>
 
 #include "Anchors.h"
 #include "pneuma/sim/Error.h"
@@ -40,13 +41,17 @@ class ElementSink {
   /// Adds one element; `active` [-] scales kac (0: a passive element), `stiffness` [-] scales kpe and b.
   void add(ElementGroup group, const Endpoint& a, const Endpoint& b, double active = 1.0,
            double stiffness = 1.0) {
+    add(group, a, b, m_gains.group[static_cast<std::size_t>(group)], active, stiffness);
+  }
+  /// Adds one element of `group` with the gains `g` (at the reference length) instead of the group's.
+  void add(ElementGroup group, const Endpoint& a, const Endpoint& b, const GroupGains& g, double active = 1.0,
+           double stiffness = 1.0) {
     const double l0 = (a.world - b.world).norm();
     if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
     sim::Elements& e = m_model.elements;
     e.group.push_back(group);
     addEndpoint(e.endA, a, m_model.bodies);
     addEndpoint(e.endB, b, m_model.bodies);
-    const GroupGains& g = m_gains.group[static_cast<std::size_t>(group)];
     const double scale = m_gains.referenceLength / l0;
     const Eigen::Index n = static_cast<Eigen::Index>(e.group.size());
     for (Eigen::VectorXd* v : {&e.restLength, &e.kac, &e.kpe, &e.damping}) v->conservativeResize(n);
@@ -327,6 +332,7 @@ void addCartilage(const Skeleton& sk, ElementSink& sink) {
 /// Physiol Rev 85:717). The model has no cervical spine, so three passive structural springs per side
 /// run from rib 1 up by kScaleneLength to anchors on the fixed lumbar-spine body (a fixed world point).
 void addScalenes(const Skeleton& sk, ElementSink& sink) {
+  if (sk.hasGirdle) return;  // addNeckAndShoulders() hangs rib 1 from the cervical spine
   for (int side : {kRight, kLeft}) {
     const RibCurve& r = sk.ribCurve[0][static_cast<std::size_t>(side)];
     const int b = sk.rib[0][static_cast<std::size_t>(side)];
@@ -336,6 +342,102 @@ void addScalenes(const Skeleton& sk, ElementSink& sink) {
                Endpoint::onBody(sk.lumbar, p + kScaleneLength * Eigen::Vector3d::UnitZ()),
                Endpoint::onBody(b, p));
     }
+  }
+}
+
+/// The neck and the shoulder girdle (AnatomyParams::hasShoulderGirdle), per side:
+///  - scalenes: from the transverse processes of C3-C5 on the fixed cervical spine to the front half of rib 1
+///    (scalenus anterior, medius; the posterior to rib 2 is folded into them), structural springs with the
+///    cartilage group's gains like the model's scalenes without a neck (addScalenes()). On the back half of
+///    rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale;
+///  - sternocleidomastoid: from the mastoid process to the manubrium (sternal head) and the medial clavicle
+///    (clavicular head), passive at the shoulder gains;
+///  - Breathe Easy's 26 shoulder elements (Zordan et al. 2004, Table 1: 52 in all), passive at the shoulder
+///    gains (kpe 10, b 1): upper (3), middle (2) and lower (2) trapezius, levator scapulae (2), rhomboids
+///    (3), serratus anterior (5), pectoralis minor (3) and major (3), subclavius (1) and deltoid (2).
+/// Two-sided springs of the cartilage group: the element groups are the respiratory muscles the breath styles
+/// drive, and none of these is driven.
+void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
+  if (!sk.hasGirdle) return;
+  const GroupGains& shoulder = a.gains.shoulder;
+  // a point on the spinous process of thoracic vertebra t (1..12) and its body
+  auto spinous = [&](int t) {
+    const std::size_t i = static_cast<std::size_t>(t - 1);
+    const double y = sk.vertebraCentreY[i];
+    const Eigen::Vector3d p(0, 2 * y - sk.thoracicFront[i].y() - 0.02, sk.thoracicFront[i].z());
+    return Endpoint::onBody(sk.thoracicSegment[i], p);
+  };
+  // cervical vertebra c (1..7): its spinous process (side 0) or transverse process on a side
+  auto cervical = [&](int c, double x) {
+    const Eigen::Vector3d& p = sk.cervicalCentre[static_cast<std::size_t>(c - 1)];
+    return Endpoint::onBody(sk.cervical, x == 0.0 ? Eigen::Vector3d(p + Eigen::Vector3d(0, -0.035, 0))
+                                                  : Eigen::Vector3d(p + Eigen::Vector3d(x, -0.004, 0)));
+  };
+  auto ribAt = [&](int level, int side, double f) {
+    const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+    return Endpoint::onBody(sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)],
+                            r.at(f * r.length()));
+  };
+  for (int side : {kRight, kLeft}) {
+    const GirdleSide& s = sk.girdle[static_cast<std::size_t>(side)];
+    const double sx = side == kRight ? 1.0 : -1.0;
+    auto clavicle = [&](double f) {
+      return Endpoint::onBody(s.clavicle,
+                              s.sternoclavicular + f * (s.acromioclavicular - s.sternoclavicular));
+    };
+    auto scapula = [&](const Eigen::Vector3d& p) { return Endpoint::onBody(s.scapula, p); };
+    auto medialBorder = [&](double f) {
+      return scapula(s.superiorAngle + f * (s.inferiorAngle - s.superiorAngle));
+    };
+    auto superiorBorder = [&](double f) {
+      return scapula(s.superiorAngle + f * (s.acromion - s.superiorAngle));
+    };
+    auto humerus = [&](double f) {
+      return Endpoint::onBody(s.humerus, s.glenohumeral + f * (s.elbow - s.glenohumeral));
+    };
+    auto spring = [&](const Endpoint& p, const Endpoint& q) {
+      sink.add(ElementGroup::Cartilage, p, q, shoulder, 0.0);
+    };
+
+    // scalenes and sternocleidomastoid
+    for (const auto& [c, f] : {std::pair{3, 0.8}, std::pair{4, 0.88}, std::pair{5, 0.96}})
+      sink.add(ElementGroup::Cartilage, cervical(c, sx * 0.028), ribAt(1, side, f));
+    const Endpoint mastoid = Endpoint::onBody(sk.head, s.mastoid);
+    spring(mastoid, Endpoint::onBody(sk.sternum, sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) +
+                                                     0.01 * sk.sternumAxis));
+    spring(mastoid, clavicle(0.15));
+
+    // trapezius: upper from the neck to the clavicle and acromion, middle and lower from T1-T7 to the
+    // scapular spine
+    spring(cervical(2, 0.0), clavicle(0.75));
+    spring(cervical(4, 0.0), scapula(s.acromion));
+    spring(cervical(7, 0.0), superiorBorder(0.8));
+    spring(spinous(1), superiorBorder(0.3));
+    spring(spinous(3), superiorBorder(0.5));
+    spring(spinous(5), scapula(s.spineRoot));
+    spring(spinous(7), medialBorder(0.2));
+    // levator scapulae: C1 and C3 transverse processes to the superior angle
+    spring(cervical(1, sx * 0.03), scapula(s.superiorAngle));
+    spring(cervical(3, sx * 0.03), medialBorder(0.1));
+    // rhomboids: C7-T4 to the medial border
+    spring(cervical(7, 0.0), medialBorder(0.1));
+    spring(spinous(2), medialBorder(0.5));
+    spring(spinous(4), medialBorder(0.9));
+    // serratus anterior: the medial border round the chest wall to ribs 2-8 laterally
+    for (const auto& [f, level] :
+         {std::pair{0.1, 2}, std::pair{0.3, 3}, std::pair{0.5, 4}, std::pair{0.7, 6}, std::pair{0.9, 8}})
+      spring(medialBorder(f), ribAt(level, side, 0.5));
+    // pectoralis minor: coracoid to ribs 3-5 in front
+    for (int level : {3, 4, 5}) spring(scapula(s.coracoid), ribAt(level, side, 0.85));
+    // pectoralis major: humerus to the clavicle, the sternum and rib 6's cartilage
+    spring(humerus(0.2), clavicle(0.4));
+    spring(humerus(0.2), Endpoint::onBody(sk.sternum, sk.jugularNotch + 0.08 * sk.sternumAxis));
+    spring(humerus(0.2), ribAt(6, side, 0.95));
+    // subclavius: clavicle to rib 1's front
+    spring(clavicle(0.5), ribAt(1, side, 1.0));
+    // deltoid: acromion and lateral clavicle to the deltoid tuberosity
+    spring(scapula(s.acromion), humerus(0.45));
+    spring(clavicle(0.85), humerus(0.45));
   }
 }
 
@@ -350,6 +452,7 @@ void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   addTransversusObliques(gut, sink);
   addCartilage(sk, sink);
   addScalenes(sk, sink);
+  addNeckAndShoulders(a, sk, sink);
 }
 
 }  // namespace pneuma::meshing

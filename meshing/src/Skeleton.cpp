@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "pneuma/meshing/Sweep.h"
 #include "pneuma/sim/Error.h"
@@ -167,7 +169,7 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     return vert[static_cast<std::size_t>(4 + 13 - t)];
   };  // T1..T12
   auto addBone = [&](const std::string& name, bool isFixed, TriangleMesh mesh) {
-    sk.bones.push_back({name, isFixed, std::move(mesh)});
+    sk.bones.push_back({name, isFixed, std::move(mesh), 0.0, false});
     return static_cast<int>(sk.bones.size()) - 1;
   };
 
@@ -240,7 +242,7 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     const int child = sk.thoracicSegment[static_cast<std::size_t>(last - 1)];
     sk.joints.push_back({"spine_" + sk.bones[static_cast<std::size_t>(child)].name, parent, child,
                          Eigen::Vector3d(0, 0.5 * (below.y + above.y), 0.5 * (below.zTop + above.zBottom)),
-                         true});
+                         kSpineJoint});
   }
 
   // sternum: manubrium, body and xiphoid swept down and forward from the jugular notch
@@ -300,10 +302,10 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
       const Eigen::Vector3d axisRight(std::cos(phi), -std::sin(phi), 0.0),
           axisLeft(-std::cos(phi), -std::sin(phi), 0.0);
       const int parent = sk.thoracicSegment[static_cast<std::size_t>(level - 1)];
+      sk.joints.push_back({"costovertebral_" + n + "_right", parent, br, right.centre.front(),
+                           kCostovertebralJoint, axisRight});
       sk.joints.push_back(
-          {"costovertebral_" + n + "_right", parent, br, right.centre.front(), false, axisRight});
-      sk.joints.push_back(
-          {"costovertebral_" + n + "_left", parent, bl, left.centre.front(), false, axisLeft});
+          {"costovertebral_" + n + "_left", parent, bl, left.centre.front(), kCostovertebralJoint, axisLeft});
     }
   }
 
@@ -321,7 +323,205 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
       throw sim::Error(s.str());
     }
   }
+  if (a.hasShoulderGirdle) addGirdle(a, sk);
   return sk;
+}
+
+}  // namespace pneuma::meshing
+
+namespace pneuma::meshing {
+
+namespace {
+
+constexpr int kCervicalCount = 7;             // C7..C1
+constexpr double kCervicalHeight = 0.014;     // [m] cervical vertebral body height
+constexpr double kCervicalDisc = 0.005;       // [m] cervical disc height
+constexpr double kCervicalLordosis = 0.012;   // [m] anterior bulge of the cervical curve
+constexpr double kClavicleRetraction = 20.0;  // [deg] backward turn of the clavicle from the frontal plane
+constexpr double kClavicleElevation = 10.0;   // [deg] upward tilt of the clavicle
+constexpr double kScapulaClearance =
+    0.012;  // [m] scapula blade behind the back of the ribs (serratus, fascia)
+
+/// The posterior face of the rib cage behind (x, z): the back of the rib centreline point nearest in (x, z)
+/// among the posterior halves of ribs 1-10 [m, y].
+double backOfRibs(const Skeleton& sk, double x, double z) {
+  double best = 1e9, y = 0.0;
+  for (std::size_t level = 0; level < 10; ++level)
+    for (const RibCurve& c : sk.ribCurve[level])
+      for (std::size_t i = 0; i < c.centre.size() && c.arc[i] < 0.45 * c.length(); ++i) {
+        const Eigen::Vector3d& p = c.centre[i];
+        const double d = (p.x() - x) * (p.x() - x) + (p.z() - z) * (p.z() - z);
+        if (d < best) {
+          best = d;
+          y = p.y() - 0.5 * c.thickness;
+        }
+      }
+  return y;
+}
+
+Eigen::Vector3d sideX(int side, double x) { return Eigen::Vector3d(side == kRight ? x : -x, 0, 0); }
+
+}  // namespace
+
+void addGirdle(const AnatomyParams& a, Skeleton& sk) {
+  const GirdleParams& g = a.girdle;
+  auto addBone = [&](const std::string& name, bool isFixed, TriangleMesh mesh, double mass = 0.0) {
+    sk.bones.push_back({name, isFixed, std::move(mesh), mass, !isFixed});
+    return static_cast<int>(sk.bones.size()) - 1;
+  };
+  sk.hasGirdle = true;
+
+  // fixed cervical spine C7..C1 on T1, curving forward (lordosis), and the head on C1
+  {
+    const double t1Top = sk.vertebraTop.front();
+    const double t1Y = sk.vertebraCentreY.front();
+    TriangleMesh cervical;
+    std::vector<Eigen::Vector3d> centre(kCervicalCount);
+    for (int k = 0; k < kCervicalCount; ++k) {  // k = 0 is C7
+      const double f = (k + 0.5) / kCervicalCount;
+      Vertebra v;
+      v.zBottom = t1Top + a.spine.thoracicDisc + k * (kCervicalHeight + kCervicalDisc);
+      v.zTop = v.zBottom + kCervicalHeight;
+      v.width = a.spine.thoracicBodyTop[0] * 0.85;
+      v.depth = a.spine.thoracicBodyTop[1] * 0.9;
+      v.y = t1Y + kCervicalLordosis * std::sin(M_PI * f) + 0.01 * f;
+      cervical.append(vertebraMesh(v, k == 0 ? 0.03 : 0.02));
+      centre[static_cast<std::size_t>(kCervicalCount - 1 - k)] =
+          Eigen::Vector3d(0, v.y, 0.5 * (v.zBottom + v.zTop));
+    }
+    sk.cervicalCentre = centre;
+    sk.cervical = addBone("cervical_spine", true, cervical);
+    // the head: an ellipsoid 15 x 19 x 22 cm (breadth, length, height) sitting on C1, its centre forward of
+    // it
+    const Eigen::Vector3d c1 = centre.front();
+    const Eigen::Vector3d headCentre(0, c1.y() + 0.025, c1.z() + kCervicalHeight + 0.07);
+    std::vector<SweepStation> head;
+    for (int i = 0; i <= 12; ++i) {
+      const double t = M_PI * (0.06 + 0.88 * i / 12.0);
+      head.push_back({headCentre + Eigen::Vector3d(0, 0, -0.11 * std::cos(t)), Eigen::Vector3d::UnitY(),
+                      0.095 * std::sin(t), 0.075 * std::sin(t)});
+    }
+    sk.head = addBone("head", true, sweepTube(head, kAround, false));
+    for (int side : {kRight, kLeft})
+      sk.girdle[static_cast<std::size_t>(side)].mastoid =
+          Eigen::Vector3d(side == kRight ? 0.045 : -0.045, c1.y() - 0.005, c1.z() + 0.02);
+  }
+
+  // rib 8's lateral half-breadth sets the shoulders' breadth (acromion about 1.4 times it)
+  double rib8 = 0.0;
+  for (const Eigen::Vector3d& p : sk.ribCurve[7][kRight].centre) rib8 = std::max(rib8, p.x());
+  const double kDeg = M_PI / 180.0;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), forward = Eigen::Vector3d::UnitY();
+
+  // joint centres and landmarks per side
+  for (int side : {kRight, kLeft}) {
+    GirdleSide& s = sk.girdle[static_cast<std::size_t>(side)];
+    const double sx = side == kRight ? 1.0 : -1.0;
+    // sternoclavicular joint at the manubrium's clavicular notch; the clavicle runs laterally, back and up
+    s.sternoclavicular = sk.jugularNotch + 0.1 * a.sternum.manubriumLength * sk.sternumAxis +
+                         sideX(side, 0.5 * a.sternum.manubriumWidth + 0.003);
+    const Eigen::Vector3d dir(sx * std::cos(kClavicleRetraction * kDeg) * std::cos(kClavicleElevation * kDeg),
+                              -std::sin(kClavicleRetraction * kDeg) * std::cos(kClavicleElevation * kDeg),
+                              std::sin(kClavicleElevation * kDeg));
+    s.acromioclavicular = s.sternoclavicular + g.clavicleLength * dir;
+    s.acromion = s.acromioclavicular + sideX(side, 0.015) + 0.004 * up - 0.005 * forward;
+    // the humeral head under the acromion, slightly forward and lateral
+    s.glenohumeral = s.acromioclavicular + sideX(side, 0.005) + 0.012 * forward - 0.038 * up;
+    s.coracoid = s.glenohumeral + sideX(side, -0.025) + 0.028 * forward + 0.012 * up;
+    // scapula: superior angle level with the top of T2, inferior angle with T7, on the back of the ribs
+    const double zSup = sk.vertebraTop[1], zInf = sk.vertebraTop[6] - 0.01;
+    s.superiorAngle = Eigen::Vector3d(sx * 0.07, backOfRibs(sk, sx * 0.07, zSup) - kScapulaClearance, zSup);
+    s.inferiorAngle = Eigen::Vector3d(sx * 0.095, backOfRibs(sk, sx * 0.095, zInf) - kScapulaClearance, zInf);
+    s.spineRoot = s.superiorAngle + 0.3 * (s.inferiorAngle - s.superiorAngle);
+    // the arm in the skin's A-pose: abducted in the frontal plane, the elbow flexed forward
+    const Eigen::Vector3d upperArm(sx * std::sin(g.abduction), 0.0, -std::cos(g.abduction));
+    const Eigen::Vector3d forearm =
+        (std::cos(g.elbowFlexion) * upperArm + std::sin(g.elbowFlexion) * forward).normalized();
+    s.elbow = s.glenohumeral + g.upperArmLength * upperArm;
+    s.wrist = s.elbow + g.forearmLength * forearm;
+  }
+
+  // bones, right then left (the left ones are mirrored when remeshed)
+  const double armMass = g.bodyMass;
+  std::array<TriangleMesh, 4> right;
+  {
+    const GirdleSide& s = sk.girdle[kRight];
+    // clavicle: a tube between its joints
+    const Eigen::Vector3d cl = s.acromioclavicular - s.sternoclavicular;
+    std::vector<SweepStation> clavicle;
+    for (double f : {0.04, 0.3, 0.7, 0.96})
+      clavicle.push_back({s.sternoclavicular + f * cl, up, 0.007, 0.009 + 0.003 * (f < 0.2 || f > 0.8)});
+    right[0] = sweepTube(clavicle, kAround, false);
+    // scapula: a plate from the inferior angle up to its superior border (superior angle to acromion)
+    const Eigen::Vector3d top = 0.5 * (s.superiorAngle + s.acromion);
+    Eigen::Vector3d normal =
+        (s.acromion - s.superiorAngle).cross(s.inferiorAngle - s.superiorAngle).normalized();
+    if (normal.y() > 0) normal = -normal;  // posterior
+    const double topHalf = 0.5 * (s.acromion - s.superiorAngle).norm();
+    std::vector<SweepStation> blade;
+    for (int i = 0; i <= 6; ++i) {
+      const double f = i / 6.0;
+      blade.push_back(
+          {s.inferiorAngle + f * (top - s.inferiorAngle), normal, 0.004, 0.006 + f * (topHalf - 0.006)});
+    }
+    right[1] = sweepTube(blade, kAround, false);
+    // humerus: head, shaft and condyles
+    const Eigen::Vector3d ua = s.elbow - s.glenohumeral;
+    const double l = ua.norm();
+    std::vector<SweepStation> humerus;
+    for (const auto& [d, r] : std::initializer_list<std::pair<double, double>>{{-0.018, 0.010},
+                                                                               {0.0, 0.022},
+                                                                               {0.025, 0.016},
+                                                                               {0.07, 0.011},
+                                                                               {0.5 * l, 0.010},
+                                                                               {l - 0.03, 0.013},
+                                                                               {l, 0.020},
+                                                                               {l + 0.012, 0.010}})
+      humerus.push_back({s.glenohumeral + d / l * ua, forward, r, r});
+    right[2] = sweepTube(humerus, kAround, false);
+    // forearm and hand: one segment, the palm facing the thigh
+    const Eigen::Vector3d fa = (s.wrist - s.elbow).normalized();
+    const Eigen::Vector3d palm = (Eigen::Vector3d::UnitX() - fa.x() * fa).normalized();
+    std::vector<SweepStation> arm;
+    for (const auto& [d, h, w] : std::initializer_list<std::tuple<double, double, double>>{
+             {0.015, 0.012, 0.014},
+             {0.3 * g.forearmLength, 0.014, 0.020},
+             {g.forearmLength, 0.011, 0.024},
+             {g.forearmLength + 0.4 * g.handLength, 0.013, 0.040},
+             {g.forearmLength + 0.6 * g.handLength, 0.010, 0.036},
+             {g.forearmLength + 0.97 * g.handLength, 0.006, 0.014}})
+      arm.push_back({s.elbow + d * fa, palm, h, w});
+    right[3] = sweepTube(arm, kAround, false);
+  }
+  const double upperArmMass = g.upperArmMassFraction * armMass;
+  const double forearmMass = (g.forearmMassFraction + g.handMassFraction) * armMass;
+  for (int part = 0; part < 4; ++part) {
+    static const char* kNames[4] = {"clavicle", "scapula", "humerus", "forearm"};
+    const double mass = part == 2 ? upperArmMass : part == 3 ? forearmMass : 0.0;
+    const int r =
+        addBone(std::string(kNames[part]) + "_right", false, right[static_cast<std::size_t>(part)], mass);
+    const int l = addBone(std::string(kNames[part]) + "_left", false,
+                          right[static_cast<std::size_t>(part)].mirroredX(), mass);
+    for (int side : {kRight, kLeft}) {
+      GirdleSide& s = sk.girdle[static_cast<std::size_t>(side)];
+      const int b = side == kRight ? r : l;
+      (part == 0 ? s.clavicle : part == 1 ? s.scapula : part == 2 ? s.humerus : s.forearm) = b;
+    }
+  }
+
+  // joints: sternum - clavicle - scapula - humerus - forearm
+  for (int side : {kRight, kLeft}) {
+    const GirdleSide& s = sk.girdle[static_cast<std::size_t>(side)];
+    const std::string n = side == kRight ? "_right" : "_left";
+    const Eigen::Vector3d upperArm = (s.elbow - s.glenohumeral).normalized();
+    sk.joints.push_back(
+        {"sternoclavicular" + n, sk.sternum, s.clavicle, s.sternoclavicular, kSternoclavicularJoint});
+    sk.joints.push_back(
+        {"acromioclavicular" + n, s.clavicle, s.scapula, s.acromioclavicular, kAcromioclavicularJoint});
+    sk.joints.push_back({"glenohumeral" + n, s.scapula, s.humerus, s.glenohumeral, kGlenohumeralJoint});
+    sk.joints.push_back({"elbow" + n, s.humerus, s.forearm, s.elbow, kElbowJoint,
+                         upperArm.cross(Eigen::Vector3d::UnitY()).normalized()});
+  }
 }
 
 }  // namespace pneuma::meshing

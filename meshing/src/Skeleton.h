@@ -34,7 +34,9 @@ struct RibCurve {
 struct Bone {
   std::string name;
   bool isFixed = false;
-  TriangleMesh mesh;  ///< [m] world frame, closed, outward
+  TriangleMesh mesh;         ///< [m] world frame, closed, outward
+  double mass = 0.0;         ///< [kg] segment mass; 0: the mesh's volume at the bone density
+  bool isSupported = false;  ///< held against gravity by a postural support (sim::Bodies::isSupported)
 };
 
 /// A ball joint between two bones.
@@ -43,8 +45,25 @@ struct JointSpec {
   int parent = -1;
   int child = -1;
   Eigen::Vector3d anchor{0, 0, 0};  ///< [m] world
-  bool isSpine = false;             ///< spine joint (else costovertebral)
-  Eigen::Vector3d axis{1, 0, 0};    ///< [-] unit rib-neck axis, world at rest (costovertebral joints only)
+  JointKind kind = kSpineJoint;     ///< its row of gains (muscle_gains.json `joints`)
+  Eigen::Vector3d axis{1, 0,
+                       0};  ///< [-] unit axis, world at rest: the rib-neck axis, the elbow's flexion axis
+};
+
+/// One side of the shoulder girdle and arm (world, rest) [m].
+struct GirdleSide {
+  int clavicle = -1, scapula = -1, humerus = -1, forearm = -1;  ///< bone indices
+  Eigen::Vector3d sternoclavicular{0, 0, 0};                    ///< joint centres
+  Eigen::Vector3d acromioclavicular{0, 0, 0};
+  Eigen::Vector3d glenohumeral{0, 0, 0};
+  Eigen::Vector3d elbow{0, 0, 0};
+  Eigen::Vector3d wrist{0, 0, 0};
+  Eigen::Vector3d acromion{0, 0, 0};       ///< the acromion's superolateral tip (landmark)
+  Eigen::Vector3d coracoid{0, 0, 0};       ///< the coracoid process's tip
+  Eigen::Vector3d superiorAngle{0, 0, 0};  ///< of the scapula
+  Eigen::Vector3d inferiorAngle{0, 0, 0};
+  Eigen::Vector3d spineRoot{0, 0, 0};  ///< the medial end of the scapular spine
+  Eigen::Vector3d mastoid{0, 0, 0};    ///< the mastoid process (on the head)
 };
 
 /// The whole rest-pose skeleton.
@@ -66,7 +85,16 @@ struct Skeleton {
   std::vector<double> vertebraTop;             ///< [m] z of the top of T1..T12
   std::vector<double> vertebraCentreY;         ///< [m] y of the body centre of T1..T12
   std::vector<Eigen::Vector3d> thoracicFront;  ///< [m] anterior mid-height points of T1..T12
+  // the shoulder girdle (AnatomyParams::hasShoulderGirdle), else empty
+  bool hasGirdle = false;
+  std::array<GirdleSide, 2> girdle;             ///< [kRight, kLeft]
+  int cervical = -1;                            ///< bone index of the fixed cervical spine
+  int head = -1;                                ///< bone index of the fixed head
+  std::vector<Eigen::Vector3d> cervicalCentre;  ///< [m] vertebral body centres C1..C7 (index 0 = C1)
 };
+
+/// Adds the shoulder girdle, arms, cervical spine and head of `a` to `sk` (built by buildSkeleton()).
+void addGirdle(const AnatomyParams& a, Skeleton& sk);
 
 /// Builds the bones and joints of `a`. @throws sim::Error when ribs overlap (naming the rib levels).
 Skeleton buildSkeleton(const AnatomyParams& a);

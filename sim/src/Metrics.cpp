@@ -98,6 +98,8 @@ Motion measureMotion(const Trace& t, const std::vector<std::string>& names,
           std::min(m.umbilicusAnteriorMin, t.landmarks[insp[static_cast<std::size_t>(c)]](1, u) -
                                                t.landmarks[exp[static_cast<std::size_t>(c)]](1, u));
   }
+  if (landmark("acromion_left") >= 0 && landmark("acromion_right") >= 0)
+    m.acromionCranial = 0.5 * (axis("acromion_left", 2, 1.0) + axis("acromion_right", 2, 1.0));
   const int left = landmark("rib8_lateral_left"), right = landmark("rib8_lateral_right");
   if (left >= 0 && right >= 0)
     m.lowerRibExpansion =
@@ -271,7 +273,9 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
     const Vector3d om = r.transpose() * state.bodyAngularVelocity.col(b);
     kinetic += 0.5 * model.bodies.mass(b) * state.bodyVelocity.col(b).squaredNorm() +
                0.5 * om.dot(model.bodies.inertia[at(b)] * om);
-    gravity -= model.bodies.mass(b) * g.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
+    // a supported body's weight is carried (postureSupport()): no gravity energy
+    if (!model.bodies.supported(b))
+      gravity -= model.bodies.mass(b) * g.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
   }
   for (int n = 0; n < model.nodes.size(); ++n) {
     if (model.nodes.isFixed(n)) continue;

@@ -351,6 +351,8 @@ void validateModel(const Model& m) {
       m.bodies.com.cols() != nB || static_cast<int>(m.bodies.inertia.size()) != nB ||
       static_cast<int>(m.bodies.mesh.size()) != nB)
     invalid("bodies", "inconsistent array sizes");
+  if (!m.bodies.isSupported.empty() && static_cast<int>(m.bodies.isSupported.size()) != nB)
+    invalid("bodies", "inconsistent supported list");
   std::set<std::string> names;
   for (int i = 0; i < nB; ++i) {
     const std::string f = "bodies[" + std::to_string(i) + "]";
@@ -547,7 +549,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.bodies.com.resize(3, static_cast<Eigen::Index>(nB));
   for (std::size_t i = 0; i < nB; ++i) {
     const Reader b = bodies[i];
-    b.allowKeys({"name", "fixed", "mass", "com", "inertia", "mesh"});
+    b.allowKeys({"name", "fixed", "mass", "com", "inertia", "mesh", "supported"});
     m.bodies.name.push_back(b.at("name").string());
     m.bodies.isFixed.push_back(b.at("fixed").boolean() ? 1 : 0);
     m.bodies.mass[static_cast<Eigen::Index>(i)] = b.at("mass").number();
@@ -558,6 +560,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     for (std::size_t r = 0; r < 3; ++r) I.row(static_cast<Eigen::Index>(r)) = inertia[r].vec3().transpose();
     m.bodies.inertia.push_back(I);
     m.bodies.mesh.push_back(b.has("mesh") ? b.at("mesh").string() : std::string());
+    // optional: no postural support when absent
+    if (b.has("supported") && b.at("supported").boolean()) {
+      m.bodies.isSupported.resize(nB, 0);
+      m.bodies.isSupported[i] = 1;
+    }
   }
 
   // joints
@@ -718,6 +725,7 @@ std::string serializeModel(const Model& m) {
     b["com"] = vec(m.bodies.com.col(i));
     b["inertia"] = {vec(I.row(0).transpose()), vec(I.row(1).transpose()), vec(I.row(2).transpose())};
     b["mesh"] = m.bodies.mesh[static_cast<std::size_t>(i)];
+    if (m.bodies.supported(i)) b["supported"] = true;
     bodies.push_back(std::move(b));
   }
   doc["bodies"] = std::move(bodies);

@@ -152,13 +152,15 @@ StepWork makeStepWork(const Model& model) {
   w.constants.fixedDofs =
       Eigen::Map<const Eigen::VectorXi>(fixed.data(), static_cast<Eigen::Index>(fixed.size()));
   w.scratch.jointMassInverse.assign(at(nj), Matrix3d::Zero());
-  // the joint tree: joints whose child hangs on no other joint, ordered parents first (a joint closing a
-  // loop stays with the impulse solver of stage 3 only)
+  // the joint tree: joints whose child hangs on no other joint, ordered parents first, from the roots: the
+  // fixed bodies and the free bodies that hang on no joint (the sternum, on which the shoulder girdle hangs);
+  // a joint closing a loop stays with the impulse solver of stage 3 only
   w.scratch.treeLeverParent = Eigen::Matrix3Xd::Zero(3, nj);
   w.scratch.treeLeverChild = Eigen::Matrix3Xd::Zero(3, nj);
   {
-    std::vector<char> placed(at(nb), 0), taken(at(nj), 0);
-    for (int b = 0; b < nb; ++b) placed[at(b)] = model.bodies.isFixed[at(b)];
+    std::vector<char> placed(at(nb), 1), taken(at(nj), 0);
+    for (int i = 0; i < nj; ++i)
+      if (!model.bodies.isFixed[at(model.joints.child[at(i)])]) placed[at(model.joints.child[at(i)])] = 0;
     for (bool grew = true; grew;) {
       grew = false;
       for (int i = 0; i < nj; ++i) {

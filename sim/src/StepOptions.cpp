@@ -84,6 +84,11 @@ Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o) {
   return g;
 }
 
+Eigen::Vector3d postureSupport(const Model& model, int b, const StepOptions& o) {
+  if (!model.bodies.supported(b)) return Eigen::Vector3d::Zero();
+  return -model.bodies.mass(b) * postureGravity(model, o);
+}
+
 double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 1e-5 : 1.0 / 60.0; }
 
 void validateStepOptions(const StepOptions& o) {

@@ -314,3 +314,38 @@ TEST(Step, HemidiaphragmHalvesFollowTheSideOfTheRestMidpoint) {
 
 }  // namespace
 }  // namespace pneuma::sim
+
+namespace pneuma::sim {
+namespace {
+
+// a postural support carries its body's weight in every posture (postureSupport()): an arm held out
+// horizontally from a fixed shoulder on a free ball joint stays where it is in all five postures, and
+// without the support gravity swings it
+TEST(PosturalSupport, CarriesItsBodyAgainstGravityInEveryPosture) {
+  Model m;
+  test::addBody(m, "neck", true, 1.0, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity());
+  const double mass = 2.0;  // [kg] an upper arm
+  test::addBody(m, "arm", false, mass, Eigen::Vector3d(0.15, 0.05, 0.0), 0.01 * Eigen::Matrix3d::Identity());
+  test::addJoint(m, "shoulder", 0, 1, Eigen::Vector3d::Zero(), 0.0, 0.0);
+  m.bodies.isSupported = {0, 1};
+  for (const char* name : {"upright", "supine", "prone", "left-lateral", "right-lateral"}) {
+    SCOPED_TRACE(name);
+    StepOptions o;
+    ASSERT_TRUE(postureFromName(name, o.posture));
+    EXPECT_EQ(postureSupport(m, 1, o), -mass * postureGravity(m, o));
+    EXPECT_EQ(postureSupport(m, 0, o), Eigen::Vector3d::Zero());
+    State s = makeInitialState(m);
+    StepWork w = makeStepWork(m);
+    for (int i = 0; i < 100; ++i) step(m, s, 0.01, relaxedActivations(), o, w);
+    EXPECT_LT((s.bodyPosition.col(1) - m.bodies.com.col(1)).norm(), 1e-9);
+  }
+  // unsupported, the arm falls about its joint
+  m.bodies.isSupported.clear();
+  State s = makeInitialState(m);
+  StepWork w = makeStepWork(m);
+  for (int i = 0; i < 30; ++i) step(m, s, 0.01, relaxedActivations(), StepOptions{}, w);
+  EXPECT_GT((s.bodyPosition.col(1) - m.bodies.com.col(1)).norm(), 0.01);
+}
+
+}  // namespace
+}  // namespace pneuma::sim

@@ -100,6 +100,28 @@ struct GroupGains {
   double damping = 0.0;  ///< [N s/m] at the reference length
 };
 
+/// Gains of one kind of joint (muscle_gains.json `joints.<kind>`; sim::Joints has the law).
+struct JointGains {
+  double friction = 0.0;       ///< [N m s/rad] mu of Eq. 3
+  double stiffness = 0.0;      ///< [N m/rad] k, every direction
+  double lockStiffness = 0.0;  ///< [N m/rad] k_lock against turning off the joint's axis (0: a ball joint)
+};
+
+/// The kinds of joint, each one row of muscle_gains.json `joints`: "spine" (between thoracic segments),
+/// "costovertebral" (rib heads; its lock stands for the costotransverse joint), and the shoulder girdle's
+/// "sternoclavicular", "acromioclavicular", "glenohumeral" and "elbow" (a hinge: its lock holds the flexion
+/// axis).
+enum JointKind : int {
+  kSpineJoint = 0,
+  kCostovertebralJoint,
+  kSternoclavicularJoint,
+  kAcromioclavicularJoint,
+  kGlenohumeralJoint,
+  kElbowJoint
+};
+constexpr std::array<const char*, 6> kJointKinds = {
+    "spine", "costovertebral", "sternoclavicular", "acromioclavicular", "glenohumeral", "elbow"};
+
 /// Everything of resources/anatomy/muscle_gains.json.
 struct Gains {
   double referenceLength = 0.0;  ///< [m] element length at which the group gains apply unscaled
@@ -119,15 +141,29 @@ struct Gains {
   /// Troyer, Kirkwood & Wilson 2005, Physiol Rev 85:717; De Troyer, Gorman & Gandevia 2002, J Physiol
   /// 546:943)
   std::array<double, 11> externalIntercostalSpaceScale{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
-  double costovertebralFriction = 0.0;   ///< [N m s/rad] mu of Eq. 3
-  double costovertebralStiffness = 0.0;  ///< [N m/rad] about the rib-neck axis
-  /// [N m/rad] the costotransverse joint's resistance to rotation off the rib-neck axis (a rib with both its
-  /// head and its tubercle articulated turns about the line through them)
-  double costotransverseStiffness = 0.0;
-  double spineFriction = 0.0;   ///< [N m s/rad]
-  double spineStiffness = 0.0;  ///< [N m/rad]
-  double wallMass = 0.0;        ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
-  double diaphragmMass = 0.0;   ///< [kg] total mass of the diaphragm dome nodes
+  /// gains per kind of joint, indexed by JointKind
+  std::array<JointGains, kJointKinds.size()> joints{};
+  /// [N/m], [N s/m] kpe and damping (kac unused) of the shoulder girdle's passive springs at the reference
+  /// length: Zordan et al. 2004, Table 1, the 52 shoulder elements (kpe 10, b 1), and the
+  /// sternocleidomastoids
+  GroupGains shoulder{};
+  double wallMass = 0.0;       ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
+  double diaphragmMass = 0.0;  ///< [kg] total mass of the diaphragm dome nodes
+};
+
+/// The shoulder girdle, arms and neck (anatomy option `shoulder_girdle`): segment lengths and masses of the
+/// arms after de Leva 1996 (J Biomech 29:1223, Table 4), the arms in the A-pose of the skin mesh.
+struct GirdleParams {
+  double bodyMass = 0.0;              ///< [kg] whole-body mass the arm segments are a fraction of
+  double clavicleLength = 0.0;        ///< [m] sternoclavicular to acromioclavicular joint
+  double upperArmLength = 0.0;        ///< [m] shoulder to elbow joint centre
+  double forearmLength = 0.0;         ///< [m] elbow to wrist joint centre
+  double handLength = 0.0;            ///< [m] wrist to the tip of the middle finger
+  double upperArmMassFraction = 0.0;  ///< [-] of bodyMass
+  double forearmMassFraction = 0.0;   ///< [-] of bodyMass
+  double handMassFraction = 0.0;      ///< [-] of bodyMass (carried by the forearm's body)
+  double abduction = 0.0;             ///< [rad] the upper arm's angle from the vertical in the frontal plane
+  double elbowFlexion = 0.0;          ///< [rad] the forearm's angle forward from the upper arm's line
 };
 
 /// A whole anatomy preset.
@@ -143,6 +179,10 @@ struct AnatomyParams {
   AbdomenParams abdomen;
   Resolution resolution;
   Gains gains;
+  /// build the shoulder girdle, arms, neck and head (`shoulder_girdle`, default false): clavicles, scapulae,
+  /// humeri and forearms as moving bodies, the cervical spine and head fixed
+  bool hasShoulderGirdle = false;
+  GirdleParams girdle;  ///< read when present; required when hasShoulderGirdle
 };
 
 /// Reads and validates an anatomy preset and the gains file it names ("gains", relative to the preset).

@@ -76,6 +76,9 @@ struct Motion {
   double xiphoidAnterior = kNaN;  ///< [m] anterior motion of "xiphoid"
   double xiphoidCranial = kNaN;   ///< [m] its cranial motion
   double lowerRibExpansion = kNaN;  ///< [m] change of the distance between "rib8_lateral_left" and "_right"
+  /// [m] cranial motion of the acromions ("acromion_left", "acromion_right": the shoulder girdle's), their
+  /// mean; NaN in a model without a shoulder girdle
+  double acromionCranial = kNaN;
   double umbilicusAnterior = kNaN;  ///< [m] anterior motion of "umbilicus"
   double umbilicusAnteriorMin =
       kNaN;  ///< [m] its smallest value over the cycles (> 0: forward on every inhale)

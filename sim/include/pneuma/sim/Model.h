@@ -67,8 +67,17 @@ struct Bodies {
   std::vector<Eigen::Matrix3d> inertia;  ///< [kg m^2] inertia tensor about the com, body frame       (#B)
   std::vector<std::string>
       mesh;  ///< render mesh (.vtp, body-frame coordinates [m]) relative to the model dir; may be empty (#B)
+  /// 1 when a postural support holds the body against gravity (#B, or empty: none). The shoulder girdle and
+  /// arms hang from the neck and the back by the tone of the trapezius, levator scapulae and rhomboids, not
+  /// from the rib cage: a support carries each such body's weight in every posture, f = -m g
+  /// (postureGravity()), so that the breathing rib cage does not carry the arms (postureSupport(), Step.h).
+  std::vector<std::uint8_t> isSupported;
 
   int size() const { return static_cast<int>(name.size()); }
+  /// Whether body `b` has a postural support.
+  bool supported(int b) const {
+    return !isSupported.empty() && isSupported[static_cast<std::size_t>(b)] != 0;
+  }
 };
 
 /// Ball joints (Zordan et al. 2004, Section 5): rib-spine costovertebral joints and the joints

@@ -128,6 +128,12 @@ double effectiveRestLength(const Model& model, int e, const StepOptions& o);
 /// rule every reader of gravity uses (the step's forces, the gravity energy of computeMetrics()).
 Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o);
 
+/// [N] The postural support of body `b` (Bodies::isSupported): f = -m_b postureGravity(), the body's weight
+/// carried by the neck and back muscles in the run's posture; zero for a body without one. The step adds it
+/// to the body's force, so a supported body feels no net gravity in any posture; computeMetrics() counts no
+/// gravity energy for it.
+Eigen::Vector3d postureSupport(const Model& model, int b, const StepOptions& o);
+
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
 /// @throws Error naming the field and value.
 void validateStepOptions(const StepOptions& o);

@@ -1,0 +1,194 @@
+// The shoulder girdle, arms and neck (anatomy option shoulder_girdle): the built bodies, joints and springs,
+// and the shoulders' motion in calm and deep breathing.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "pneuma/meshing/AnatomyParams.h"
+#include "pneuma/meshing/MeshTools.h"
+#include "pneuma/meshing/ModelBuilder.h"
+#include "pneuma/sim/Experiments.h"
+#include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/State.h"
+#include "pneuma/sim/Step.h"
+
+namespace pneuma::meshing {
+namespace {
+
+/// The preset `name` with the shoulder girdle on.
+AnatomyParams withGirdle(const std::string& name) {
+  const std::string dir = std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/";
+  std::string text = sim::readInputFile(dir + name + ".json");
+  const std::string off = "\"shoulder_girdle\": false";
+  const std::size_t at = text.find(off);
+  if (at == std::string::npos) throw std::runtime_error(name + ".json has no \"shoulder_girdle\": false");
+  text.replace(at, off.size(), "\"shoulder_girdle\": true");
+  return parseAnatomy(text, sim::readInputFile(dir + "muscle_gains.json"), name + ".json");
+}
+
+/// Each preset with the girdle, built once per test process (without a skin).
+const BuiltModel& built(const std::string& name) {
+  static std::map<std::string, BuiltModel> cache;
+  auto it = cache.find(name);
+  if (it == cache.end()) it = cache.emplace(name, buildModel(withGirdle(name), "")).first;
+  return it->second;
+}
+
+int body(const sim::Model& m, const std::string& name) {
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies.name[static_cast<std::size_t>(b)] == name) return b;
+  return -1;
+}
+
+int joint(const sim::Model& m, const std::string& name) {
+  for (int j = 0; j < m.joints.size(); ++j)
+    if (m.joints.name[static_cast<std::size_t>(j)] == name) return j;
+  return -1;
+}
+
+class GirdlePresets : public ::testing::TestWithParam<std::string> {};
+
+// the option is off in both shipped presets: their models have no girdle bodies, springs or acromions
+TEST_P(GirdlePresets, IsOffInTheShippedPreset) {
+  const AnatomyParams a = loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" + GetParam() + ".json");
+  EXPECT_FALSE(a.hasShoulderGirdle);
+  EXPECT_TRUE(withGirdle(GetParam()).hasShoulderGirdle);
+}
+
+// clavicles, scapulae, humeri and forearms move on the chain sternum - sternoclavicular - acromioclavicular
+// - glenohumeral - elbow, each held by a postural support; the arm segments weigh de Leva's (1996) shares of
+// the body mass; every bone is a closed surface
+TEST_P(GirdlePresets, BonesJointsAndSegmentMasses) {
+  const BuiltModel& b = built(GetParam());
+  const sim::Model& m = b.model;
+  const AnatomyParams a = withGirdle(GetParam());
+  for (const char* side : {"_right", "_left"}) {
+    SCOPED_TRACE(side);
+    const std::string s = side;
+    const int clavicle = body(m, "clavicle" + s), scapula = body(m, "scapula" + s),
+              humerus = body(m, "humerus" + s), forearm = body(m, "forearm" + s);
+    ASSERT_GE(clavicle, 0);
+    ASSERT_GE(scapula, 0);
+    ASSERT_GE(humerus, 0);
+    ASSERT_GE(forearm, 0);
+    for (int part : {clavicle, scapula, humerus, forearm}) {
+      EXPECT_FALSE(m.bodies.isFixed[static_cast<std::size_t>(part)]);
+      EXPECT_TRUE(m.bodies.supported(part));
+      const MeshCheck c = checkMesh(b.bodyMeshes[static_cast<std::size_t>(part)]);
+      EXPECT_TRUE(c.isValid()) << m.bodies.name[static_cast<std::size_t>(part)];
+    }
+    EXPECT_NEAR(m.bodies.mass(humerus), a.girdle.upperArmMassFraction * a.girdle.bodyMass, 1e-9);
+    EXPECT_NEAR(m.bodies.mass(forearm),
+                (a.girdle.forearmMassFraction + a.girdle.handMassFraction) * a.girdle.bodyMass, 1e-9);
+    const std::pair<std::string, std::pair<int, int>> chain[] = {
+        {"sternoclavicular", {body(m, "sternum"), clavicle}},
+        {"acromioclavicular", {clavicle, scapula}},
+        {"glenohumeral", {scapula, humerus}},
+        {"elbow", {humerus, forearm}}};
+    for (const auto& [name, pc] : chain) {
+      const int j = joint(m, name + s);
+      ASSERT_GE(j, 0) << name;
+      EXPECT_EQ(m.joints.parent[static_cast<std::size_t>(j)], pc.first) << name;
+      EXPECT_EQ(m.joints.child[static_cast<std::size_t>(j)], pc.second) << name;
+    }
+    // the elbow is a hinge about the axis normal to the upper arm and the forward direction
+    EXPECT_GT(m.joints.lockStiffness(joint(m, "elbow" + s)), 0.0);
+  }
+  EXPECT_TRUE(m.bodies.isFixed[static_cast<std::size_t>(body(m, "cervical_spine"))]);
+  EXPECT_TRUE(m.bodies.isFixed[static_cast<std::size_t>(body(m, "head"))]);
+  EXPECT_GE(m.landmarks.find("acromion_right"), 0);
+  EXPECT_GE(m.landmarks.find("acromion_left"), 0);
+}
+
+// the arms hang in the preset's A-pose: the upper arm abducted from the vertical in the frontal plane, the
+// forearm flexed forward at the elbow
+TEST_P(GirdlePresets, ArmsHangInTheAPose) {
+  const sim::Model& m = built(GetParam()).model;
+  const AnatomyParams a = withGirdle(GetParam());
+  for (const char* side : {"_right", "_left"}) {
+    const Eigen::Vector3d shoulder = m.joints.anchor.col(joint(m, std::string("glenohumeral") + side));
+    const Eigen::Vector3d elbow = m.joints.anchor.col(joint(m, std::string("elbow") + side));
+    const Eigen::Vector3d upper = (elbow - shoulder).normalized();
+    EXPECT_NEAR(std::acos(-upper.z()), a.girdle.abduction, 1e-9) << side;
+    EXPECT_NEAR(upper.y(), 0.0, 1e-12) << side;
+    EXPECT_NEAR((elbow - shoulder).norm(), a.girdle.upperArmLength, 1e-9) << side;
+    // the forearm's centre of mass lies forward of the elbow, in the flexion plane
+    const Eigen::Vector3d forearm = m.bodies.com.col(body(m, std::string("forearm") + side)) - elbow;
+    EXPECT_GT(forearm.y(), 0.0) << side;
+    EXPECT_NEAR(std::acos(forearm.normalized().dot(upper)), a.girdle.elbowFlexion, 0.1) << side;
+  }
+}
+
+// Breathe Easy's 52 shoulder elements (Table 1), two sternocleidomastoids and six scalenes per body: the
+// scalenes end on the front half of rib 1 (on its back half they pull rib 1 and T1 forward)
+TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
+  const BuiltModel& built1 = built(GetParam());
+  const sim::Model& m = built1.model;
+  std::map<std::string, int> perBody;
+  int shoulder = 0, scalenes = 0;
+  const int head = body(m, "head"), cervical = body(m, "cervical_spine");
+  const std::set<int> girdle = {body(m, "clavicle_right"), body(m, "clavicle_left"), body(m, "scapula_right"),
+                                body(m, "scapula_left"),   body(m, "humerus_right"), body(m, "humerus_left")};
+  for (int e = 0; e < m.elements.size(); ++e) {
+    const int a = m.elements.endA.body[static_cast<std::size_t>(e)],
+              b = m.elements.endB.body[static_cast<std::size_t>(e)];
+    const bool onGirdle = girdle.count(a) || girdle.count(b);
+    if (onGirdle && a != head && b != head) ++shoulder;
+    if (a == cervical && (b == body(m, "rib1_right") || b == body(m, "rib1_left"))) {
+      ++scalenes;
+      // the rib end lies in the front half of rib 1: in front of the middle between its head and its most
+      // anterior point
+      const int rib = b;
+      const Eigen::Vector3d end = m.bodies.com.col(rib) + m.elements.endB.local.col(e);
+      const int j = joint(m, std::string("costovertebral_") + m.bodies.name[static_cast<std::size_t>(rib)]);
+      const double front =
+          built1.bodyMeshes[static_cast<std::size_t>(rib)].vertices.row(1).maxCoeff() + m.bodies.com(1, rib);
+      EXPECT_GT(end.y(), 0.5 * (m.joints.anchor(1, j) + front)) << e;
+    }
+  }
+  EXPECT_EQ(shoulder, 52);
+  EXPECT_EQ(scalenes, 6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Presets, GirdlePresets, ::testing::Values("male", "female"));
+
+// a deep breath lifts the shoulders more than a calm one, and the clavicles stay in their sockets on the
+// manubrium (the sternoclavicular joints are in the implicit solver's joint tree from the free sternum)
+TEST(GirdleBreathing, AcromionRisesMoreInDeepThanInCalmBreathing) {
+  const auto model = std::make_shared<const sim::Model>(built("male").model);
+  const sim::ExperimentSettings settings = sim::ExperimentSettings::quick();
+  std::map<std::string, double> lift;
+  for (const char* style : {"calm", "deep"}) {
+    const sim::StyleRun r = sim::runBreathStyle(model, sim::loadBreathStyle(style), settings);
+    lift[style] = r.summary.motion.acromionCranial;
+    ASSERT_TRUE(std::isfinite(lift[style])) << style;
+    // the sockets: each sternoclavicular joint's anchor on the sternum and on the clavicle coincide
+    const sim::State& s = r.endInspiration;
+    ASSERT_TRUE(r.hasBreathPoses);
+    for (const char* side : {"_right", "_left"}) {
+      const int j = joint(*model, std::string("sternoclavicular") + side);
+      auto anchorOn = [&](int b) {
+        return Eigen::Vector3d(s.bodyPosition.col(b) +
+                               s.bodyOrientation[static_cast<std::size_t>(b)] *
+                                   Eigen::Vector3d(model->joints.anchor.col(j) - model->bodies.com.col(b)));
+      };
+      EXPECT_LT((anchorOn(model->joints.parent[static_cast<std::size_t>(j)]) -
+                 anchorOn(model->joints.child[static_cast<std::size_t>(j)]))
+                    .norm(),
+                1e-3)
+          << style << side;
+    }
+  }
+  RecordProperty("acromion_calm_mm", std::to_string(lift["calm"] * 1e3));
+  RecordProperty("acromion_deep_mm", std::to_string(lift["deep"] * 1e3));
+  EXPECT_GT(lift["deep"], lift["calm"]);
+}
+
+}  // namespace
+}  // namespace pneuma::meshing
