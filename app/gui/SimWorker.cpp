@@ -328,7 +328,8 @@ void SimWorker::exportRun(const SeriesRequest& request) {
     const int total = request.range.count(rec.size(), rec.frame(0).time, rec.frame(rec.size() - 1).time);
     if (total == 0) throw std::runtime_error("no recorded frame in the range asked for");
     // destroyed unfinished (cancelled, failed), the writer removes what it wrote
-    viz::VtkSeriesWriter writer(*m_model, request.modelDir, request.outDir, request.baseName);
+    viz::VtkSeriesWriter writer(*m_model, request.modelDir, request.outDir, request.baseName,
+                                viz::VtkSeriesWriter::Staging::TemporaryFolder);
     viz::SeriesSelector selector(request.range);
     sim::State state;
     sim::Metrics metrics = m_sim->latestMetrics();

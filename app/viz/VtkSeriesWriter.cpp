@@ -131,6 +131,7 @@ struct VtkSeriesWriter::Impl {
   std::vector<fs::path> written;  // the files written into it
   std::size_t bytesWritten = 0;
   bool isFinished = false;
+  bool isStaged = false;  // Staging::TemporaryFolder
 
   Impl(const sim::Model& m, const std::string& modelDir, std::string dir, std::string base)
       : model(m), outDir(std::move(dir)), baseName(std::move(base)) {
@@ -215,7 +216,8 @@ struct VtkSeriesWriter::Impl {
     } catch (const std::runtime_error& e) {
       std::string message = e.what();
       const std::string from = frameDir.string(), to = (fs::path(outDir) / baseName).string();
-      for (std::size_t at; (at = message.find(from)) != std::string::npos;)
+      for (std::size_t at = 0; from != to && (at = message.find(from, at)) != std::string::npos;
+           at += to.size())
         message.replace(at, from.size(), to);
       throw std::runtime_error(message);
     }
@@ -337,17 +339,19 @@ struct VtkSeriesWriter::Impl {
 };
 
 VtkSeriesWriter::VtkSeriesWriter(const sim::Model& model, const std::string& modelDir,
-                                 const std::string& outDir, const std::string& baseName)
+                                 const std::string& outDir, const std::string& baseName, Staging staging)
     : m_impl(std::make_unique<Impl>(model, modelDir, outDir, baseName)) {
-  // the frames go to a folder of this process's own, renamed into place by finish()
-  m_impl->frameDir = fs::path(temporaryPathFor((fs::path(outDir) / baseName).string()));
+  // staged, the frames go to a folder of this process's own, renamed into place by finish()
+  m_impl->isStaged = staging == Staging::TemporaryFolder;
+  const std::string folder = (fs::path(outDir) / baseName).string();
+  m_impl->frameDir = fs::path(m_impl->isStaged ? temporaryPathFor(folder) : folder);
   std::error_code ec;
   fs::create_directories(m_impl->frameDir, ec);
   if (ec) throw std::runtime_error("cannot create " + m_impl->frameDir.string() + ": " + ec.message());
 }
 
 VtkSeriesWriter::~VtkSeriesWriter() {
-  if (m_impl->isFinished) return;
+  if (m_impl->isFinished || !m_impl->isStaged) return;
   // unfinished (cancelled, failed): remove what this writer wrote, and its folder once empty
   std::error_code ec;
   for (const fs::path& f : m_impl->written) fs::remove(f, ec);
@@ -378,7 +382,7 @@ std::string VtkSeriesWriter::finish() {
   // else is left alone and refused
   const fs::path target = fs::path(s.outDir) / s.baseName;
   std::error_code ec;
-  if (fs::exists(target, ec)) {
+  if (s.isStaged && fs::exists(target, ec)) {
     for (const auto& entry : fs::directory_iterator(target, ec)) {
       const std::string name = entry.path().filename().string();
       if (!entry.is_regular_file() || !isPartFile(name))
@@ -388,7 +392,7 @@ std::string VtkSeriesWriter::finish() {
     fs::remove_all(target, ec);
     if (ec) throw std::runtime_error("cannot replace " + target.string() + ": " + ec.message());
   }
-  fs::rename(s.frameDir, target, ec);
+  if (s.isStaged) fs::rename(s.frameDir, target, ec);
   if (ec)
     throw std::runtime_error("cannot rename " + s.frameDir.string() + " to " + target.string() + ": " +
                              ec.message());

@@ -12,9 +12,12 @@
 ///                   lung_volume_m3
 ///   part 5 skin     the body surface [m] (empty for a model without one); point data displacement_m (3) from
 ///                   the rest pose
-/// The frames are written into a folder of the writer's own ("<baseName>.tmp-<pid>"), renamed to <baseName>/
-/// by finish(), which then writes the .pvd (temporary name and rename). A writer destroyed unfinished (a
-/// cancelled or failed export) removes the files it wrote and its folder, and nothing else.
+/// Every file is written to a temporary name and renamed; the .pvd is written by finish(). With
+/// Staging::TemporaryFolder (the app's export) the frames go into a folder of the writer's own
+/// ("<baseName>.tmp-<pid>"), renamed to <baseName>/ by finish(), and a writer destroyed unfinished (a
+/// cancelled or failed export) removes the files it wrote and its folder, and nothing else. With
+/// Staging::Direct (the CLI's run, whose --out folder is its own and whose partial results are kept) they go
+/// straight into <baseName>/, which may be a file system of its own.
 
 #include <cstddef>
 #include <limits>
@@ -58,12 +61,14 @@ class SeriesSelector {
 
 class VtkSeriesWriter {
  public:
+  enum class Staging { Direct, TemporaryFolder };
+
   /// Frames go to `outDir`/`baseName`/ (through the temporary folder), the collection to
   /// `outDir`/`baseName`.pvd. Body meshes are read relative to `modelDir`; bodies without a mesh are exported
   /// as a vertex at the com.
   /// @throws sim::Error when a body mesh cannot be read, std::runtime_error when `outDir` is not writable.
   VtkSeriesWriter(const sim::Model& model, const std::string& modelDir, const std::string& outDir,
-                  const std::string& baseName);
+                  const std::string& baseName, Staging staging = Staging::Direct);
   ~VtkSeriesWriter();
   VtkSeriesWriter(const VtkSeriesWriter&) = delete;
   VtkSeriesWriter& operator=(const VtkSeriesWriter&) = delete;

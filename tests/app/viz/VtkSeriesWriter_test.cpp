@@ -186,6 +186,8 @@ TEST(SeriesRange, CountIsWhatTheSelectorKeeps) {
             "--vtk-to: expected seconds at or after --vtk-from");
 }
 
+constexpr auto kStaged = viz::VtkSeriesWriter::Staging::TemporaryFolder;  // the app's export
+
 // a toy model with its bodies drawn as vertices, a posed frame of it, and a fresh folder
 struct SeriesFixture {
   sim::Model model = sim::test::makeToyTorso(2);
@@ -214,7 +216,7 @@ TEST(VtkSeriesWriter, UnfinishedWriterRemovesOnlyItsOwnFiles) {
   { std::ofstream(f.dir / "run" / "bones_000000.vtp") << "an earlier series"; }
   { std::ofstream(f.dir / "notes.txt") << "the lecturer's notes"; }
   {
-    viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run");
+    viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
     f.writeFrames(writer, 3);
     EXPECT_EQ(f.entries(f.dir), 3u) << "run, notes.txt and the writer's own folder";
   }
@@ -227,7 +229,7 @@ TEST(VtkSeriesWriter, UnfinishedWriterRemovesOnlyItsOwnFiles) {
   EXPECT_TRUE(fs::exists(f.dir / "notes.txt"));
 
   // finished, it replaces the earlier series whole
-  viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run");
+  viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
   f.writeFrames(writer, 2);
   EXPECT_EQ(writer.finish(), "run.pvd");
   EXPECT_EQ(f.entries(f.dir / "run"), 12u) << "two frames of six parts";
@@ -242,7 +244,7 @@ TEST(VtkSeriesWriter, AFolderHoldingOtherFilesIsNotReplaced) {
   fs::create_directories(f.dir / "run");
   { std::ofstream(f.dir / "run" / "thesis.tex") << "months of work"; }
   {
-    viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run");
+    viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
     f.writeFrames(writer, 2);
     try {
       writer.finish();
@@ -260,7 +262,7 @@ TEST(VtkSeriesWriter, FrameBytesIsTheSizeOfAWrittenFrame) {
   SeriesFixture f("bytes");
   const sim::State s = test::posedState(f.model, 1);
   const sim::Metrics m = test::someMetrics(f.model, s, 1);
-  viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run");
+  viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
   writer.writeFrame(s, m);
   writer.finish();
   std::size_t onDisk = 0;
