@@ -133,10 +133,17 @@ class MovieOverlay {
     }
     if (m_panel) {
       m_panel->setCursor(t);
-      const QSize size(std::max(200, static_cast<int>(0.42 * w)), std::max(120, static_cast<int>(0.3 * h)));
-      m_panel->resize(size);
+      // laid out once at its 1280x720 size and scaled to 42 % of the width and 30 % of the height, so that
+      // its labels and axes keep their proportions at every frame size
+      const QSize layout(538, 216);
+      const double scale = std::min(0.42 * w / layout.width(), 0.3 * h / layout.height());
+      m_panel->resize(layout);
+      painter.save();
       painter.setOpacity(0.92);
-      m_panel->render(&painter, QPoint(h / 40, h - size.height() - h / 40));
+      painter.translate(h / 40, h - scale * layout.height() - h / 40);
+      painter.scale(scale, scale);
+      m_panel->render(&painter, QPoint(0, 0));
+      painter.restore();
     }
   }
 

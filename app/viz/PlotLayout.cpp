@@ -144,8 +144,11 @@ PlotLayout layoutPlot(const Plot& plot, double width, double height, const TextM
   for (const std::string& s : L.y.labels) tickWidth = std::max(tickWidth, m.width(s));
   L.area.left = pad + lh + gap + tickWidth + gap;
   // a short x label ("time [s]") widens the margin rather than take a row of its own: height is the scarcer
-  const double xLabelWidth = m.width(plot.xLabel());
-  const bool isXLabelOwnRow = xLabelWidth > kMaxMarginLabel * lh;
+  // (and half the first x tick's label, which is centred on the box's left edge, beyond it)
+  const std::vector<std::string> xFirst = niceTicks(xlo, xhi, xTarget).labels;
+  const double xLabelWidth =
+      m.width(plot.xLabel()) + (xFirst.empty() ? 0.0 : m.width(xFirst.front()) / 2.0 + gap);
+  const bool isXLabelOwnRow = m.width(plot.xLabel()) > kMaxMarginLabel * lh;
   if (!isXLabelOwnRow) L.area.left = std::max(L.area.left, pad + xLabelWidth + gap);
   L.area.bottom = height - pad - lh - 0.15 * lh - (isXLabelOwnRow ? lh : 0.0);
   if (plot.hasEqualAspect() && L.area.width() > 0.0 && L.area.height() > 0.0) {
@@ -183,7 +186,8 @@ PlotLayout layoutPlot(const Plot& plot, double width, double height, const TextM
       isXLabelOwnRow
           ? PlotLayout::Text{plot.xLabel(), Box{L.area.left, tickRow + lh, L.area.right, tickRow + 2.0 * lh},
                              Align::Middle, false}
-          : PlotLayout::Text{plot.xLabel(), Box{pad, tickRow, L.area.left - gap, tickRow + lh}, Align::End,
+          : PlotLayout::Text{plot.xLabel(),
+                             Box{pad, tickRow, pad + m.width(plot.xLabel()) + gap, tickRow + lh}, Align::End,
                              false};
   L.yLabel = {fitted(plot.yLabel(), L.area.height(), m.width), Box{pad, L.area.top, pad + lh, L.area.bottom},
               Align::Middle, true};
