@@ -405,7 +405,7 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
     const Endpoint mastoid = Endpoint::onBody(sk.head, s.mastoid);
     spring(mastoid, Endpoint::onBody(sk.sternum, sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) +
                                                      0.01 * sk.sternumAxis));
-    spring(mastoid, clavicle(0.15));
+    spring(mastoid, clavicle(0.08));
 
     // trapezius: upper from the neck to the clavicle and acromion, middle and lower from T1-T7 to the
     // scapular spine

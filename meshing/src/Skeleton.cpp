@@ -333,10 +333,12 @@ namespace pneuma::meshing {
 
 namespace {
 
-constexpr int kCervicalCount = 7;             // C7..C1
-constexpr double kCervicalHeight = 0.014;     // [m] cervical vertebral body height
-constexpr double kCervicalDisc = 0.005;       // [m] cervical disc height
-constexpr double kCervicalLordosis = 0.012;   // [m] anterior bulge of the cervical curve
+constexpr int kCervicalCount = 7;  // C7..C1
+// the cervical spine in the skin mesh's neck, which is short and carries the head forward
+constexpr double kCervicalHeight = 0.010;     // [m] cervical vertebral body height
+constexpr double kCervicalDisc = 0.003;       // [m] cervical disc height
+constexpr double kCervicalLordosis = 0.008;   // [m] anterior bulge of the cervical curve
+constexpr double kCervicalLean = 0.045;       // [m] forward lean of C1 over C7
 constexpr double kClavicleRetraction = 20.0;  // [deg] backward turn of the clavicle from the frontal plane
 constexpr double kClavicleElevation = 10.0;   // [deg] upward tilt of the clavicle
 constexpr double kScapulaClearance =
@@ -384,27 +386,27 @@ void addGirdle(const AnatomyParams& a, Skeleton& sk) {
       v.zTop = v.zBottom + kCervicalHeight;
       v.width = a.spine.thoracicBodyTop[0] * 0.85;
       v.depth = a.spine.thoracicBodyTop[1] * 0.9;
-      v.y = t1Y + kCervicalLordosis * std::sin(M_PI * f) + 0.01 * f;
-      cervical.append(vertebraMesh(v, k == 0 ? 0.03 : 0.02));
+      v.y = t1Y + kCervicalLordosis * std::sin(M_PI * f) + kCervicalLean * f;
+      cervical.append(vertebraMesh(v, k == 0 ? 0.02 : 0.01));
       centre[static_cast<std::size_t>(kCervicalCount - 1 - k)] =
           Eigen::Vector3d(0, v.y, 0.5 * (v.zBottom + v.zTop));
     }
     sk.cervicalCentre = centre;
     sk.cervical = addBone("cervical_spine", true, cervical);
-    // the head: an ellipsoid 15 x 19 x 22 cm (breadth, length, height) sitting on C1, its centre forward of
-    // it
-    const Eigen::Vector3d c1 = centre.front();
-    const Eigen::Vector3d headCentre(0, c1.y() + 0.025, c1.z() + kCervicalHeight + 0.07);
+    // the cranium: an ellipsoid 12 x 13 x 13.6 cm (breadth, length, height) above C1, placed from the jugular
+    // notch by the proportions of the skin mesh (22.5 cm above the notch and 3.5 cm behind it), above and
+    // behind the mesh's mouth cavity
+    const Eigen::Vector3d headCentre = sk.jugularNotch + Eigen::Vector3d(0, -0.035, 0.225);
     std::vector<SweepStation> head;
     for (int i = 0; i <= 12; ++i) {
       const double t = M_PI * (0.06 + 0.88 * i / 12.0);
-      head.push_back({headCentre + Eigen::Vector3d(0, 0, -0.11 * std::cos(t)), Eigen::Vector3d::UnitY(),
-                      0.095 * std::sin(t), 0.075 * std::sin(t)});
+      head.push_back({headCentre + Eigen::Vector3d(0, 0, -0.068 * std::cos(t)), Eigen::Vector3d::UnitY(),
+                      0.065 * std::sin(t), 0.06 * std::sin(t)});
     }
     sk.head = addBone("head", true, sweepTube(head, kAround, false));
     for (int side : {kRight, kLeft})
       sk.girdle[static_cast<std::size_t>(side)].mastoid =
-          Eigen::Vector3d(side == kRight ? 0.045 : -0.045, c1.y() - 0.005, c1.z() + 0.02);
+          headCentre + Eigen::Vector3d(side == kRight ? 0.04 : -0.04, -0.01, -0.055);
   }
 
   // rib 8's lateral half-breadth sets the shoulders' breadth (acromion about 1.4 times it)
@@ -417,9 +419,10 @@ void addGirdle(const AnatomyParams& a, Skeleton& sk) {
   for (int side : {kRight, kLeft}) {
     GirdleSide& s = sk.girdle[static_cast<std::size_t>(side)];
     const double sx = side == kRight ? 1.0 : -1.0;
-    // sternoclavicular joint at the manubrium's clavicular notch; the clavicle runs laterally, back and up
+    // sternoclavicular joint at the manubrium's clavicular notch, behind its front face; the clavicle runs
+    // laterally, back and up
     s.sternoclavicular = sk.jugularNotch + 0.1 * a.sternum.manubriumLength * sk.sternumAxis +
-                         sideX(side, 0.5 * a.sternum.manubriumWidth + 0.003);
+                         sideX(side, 0.5 * a.sternum.manubriumWidth + 0.003) - 0.008 * forward;
     const Eigen::Vector3d dir(sx * std::cos(kClavicleRetraction * kDeg) * std::cos(kClavicleElevation * kDeg),
                               -std::sin(kClavicleRetraction * kDeg) * std::cos(kClavicleElevation * kDeg),
                               std::sin(kClavicleElevation * kDeg));
@@ -450,7 +453,7 @@ void addGirdle(const AnatomyParams& a, Skeleton& sk) {
     const Eigen::Vector3d cl = s.acromioclavicular - s.sternoclavicular;
     std::vector<SweepStation> clavicle;
     for (double f : {0.04, 0.3, 0.7, 0.96})
-      clavicle.push_back({s.sternoclavicular + f * cl, up, 0.007, 0.009 + 0.003 * (f < 0.2 || f > 0.8)});
+      clavicle.push_back({s.sternoclavicular + f * cl, up, 0.006, 0.007 + 0.002 * (f < 0.2 || f > 0.8)});
     right[0] = sweepTube(clavicle, kAround, false);
     // scapula: a plate from the inferior angle up to its superior border (superior angle to acromion)
     const Eigen::Vector3d top = 0.5 * (s.superiorAngle + s.acromion);
@@ -462,7 +465,7 @@ void addGirdle(const AnatomyParams& a, Skeleton& sk) {
     for (int i = 0; i <= 6; ++i) {
       const double f = i / 6.0;
       blade.push_back(
-          {s.inferiorAngle + f * (top - s.inferiorAngle), normal, 0.004, 0.006 + f * (topHalf - 0.006)});
+          {s.inferiorAngle + f * (top - s.inferiorAngle), normal, 0.0055, 0.006 + f * (topHalf - 0.006)});
     }
     right[1] = sweepTube(blade, kAround, false);
     // humerus: head, shaft and condyles
@@ -474,22 +477,22 @@ void addGirdle(const AnatomyParams& a, Skeleton& sk) {
                                                                                {0.025, 0.016},
                                                                                {0.07, 0.011},
                                                                                {0.5 * l, 0.010},
-                                                                               {l - 0.03, 0.013},
-                                                                               {l, 0.020},
+                                                                               {l - 0.03, 0.012},
+                                                                               {l, 0.016},
                                                                                {l + 0.012, 0.010}})
       humerus.push_back({s.glenohumeral + d / l * ua, forward, r, r});
     right[2] = sweepTube(humerus, kAround, false);
-    // forearm and hand: one segment, the palm facing the thigh
+    // forearm and hand: one segment, the palm facing the thigh; the bone ends in the palm (the skin's fingers
+    // follow it)
     const Eigen::Vector3d fa = (s.wrist - s.elbow).normalized();
     const Eigen::Vector3d palm = (Eigen::Vector3d::UnitX() - fa.x() * fa).normalized();
     std::vector<SweepStation> arm;
     for (const auto& [d, h, w] : std::initializer_list<std::tuple<double, double, double>>{
-             {0.015, 0.012, 0.014},
-             {0.3 * g.forearmLength, 0.014, 0.020},
-             {g.forearmLength, 0.011, 0.024},
-             {g.forearmLength + 0.4 * g.handLength, 0.013, 0.040},
-             {g.forearmLength + 0.6 * g.handLength, 0.010, 0.036},
-             {g.forearmLength + 0.97 * g.handLength, 0.006, 0.014}})
+             {0.015, 0.011, 0.013},
+             {0.3 * g.forearmLength, 0.012, 0.016},
+             {g.forearmLength, 0.007, 0.015},
+             {g.forearmLength + 0.3 * g.handLength, 0.006, 0.012},
+             {g.forearmLength + 0.45 * g.handLength, 0.004, 0.006}})
       arm.push_back({s.elbow + d * fa, palm, h, w});
     right[3] = sweepTube(arm, kAround, false);
   }

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <queue>
 #include <sstream>
@@ -27,6 +28,8 @@ constexpr double kDepthRibLateral = 0.020;
 constexpr double kDepthAsis = 0.015;
 constexpr double kDepthAcromion = 0.015;
 constexpr double kDepthSpine = 0.012;
+constexpr double kDepthScalp = 0.008;     // [m] scalp over the vertex of the skull
+constexpr double kDepthClavicle = 0.012;  // [m] skin and platysma over the clavicle's shaft
 constexpr double kBoneClearance = 0.006;  // [m] least distance from skin to bone after registration
 constexpr double kGutClearance = 0.010;   // [m] least distance from skin to the gut surface
 constexpr double kThighCut = 0.10;        // [m] legs cut this far below the crotch
@@ -282,8 +285,11 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
     }
     add(side > 0 ? "acromion_right" : "acromion_left", p, {0, 0, kDepthAcromion});
   }
-  // spine: the most posterior bone point on the midline at the xiphoid's and the umbilicus's levels
-  for (const char* level : {"xiphoid", "umbilicus"}) {
+  // spine: the most posterior bone point on the midline at the xiphoid's and the umbilicus's levels (and the
+  // jugular notch's, under the shoulder girdle)
+  std::vector<const char*> levels = {"xiphoid", "umbilicus"};
+  if (bodyNamed("clavicle_right") >= 0) levels.push_back("jugular_notch");
+  for (const char* level : levels) {
     const double z = at(level).z();
     Eigen::Vector3d best(0, 1e9, 0);
     for (int b = 0; b < m.bodies.size(); ++b) {
@@ -295,8 +301,110 @@ std::vector<Landmark> modelLandmarks(const AnatomyParams& a, const BuiltModel& b
     if (best.y() > 1e8) throw sim::Error(std::string("skin: no spine behind the ") + level);
     add(std::string("spine_at_") + level, best, {0, -kDepthSpine, 0});
   }
+  // the arms (a model with a shoulder girdle): elbow and wrist joint centres and the fingertips, matched with
+  // the centreline of the source's arms; the top of the head
+  for (int side : {1, -1}) {
+    const std::string n = side > 0 ? "_right" : "_left";
+    const int forearm = bodyNamed("forearm" + n);
+    int elbowJoint = -1;
+    for (int j = 0; j < m.joints.size(); ++j)
+      if (m.joints.name[static_cast<std::size_t>(j)] == "elbow" + n) elbowJoint = j;
+    if (forearm < 0 || elbowJoint < 0) continue;
+    const Eigen::Vector3d elbow = m.joints.anchor.col(elbowJoint);
+    const Eigen::Matrix3Xd fv = worldMesh(forearm);
+    Eigen::Index tip = 0;
+    (fv.colwise() - elbow).colwise().squaredNorm().maxCoeff(&tip);
+    const Eigen::Vector3d along = (fv.col(tip) - elbow).normalized();
+    add("elbow" + n, elbow, Eigen::Vector3d::Zero());
+    add("wrist" + n, elbow + a.girdle.forearmLength * along, Eigen::Vector3d::Zero());
+    add("fingertip" + n, elbow + (a.girdle.forearmLength + a.girdle.handLength) * along,
+        Eigen::Vector3d::Zero());
+  }
+  // the clavicles' middles, under the skin of the upper chest
+  for (int side : {1, -1}) {
+    const int clavicle = bodyNamed(side > 0 ? "clavicle_right" : "clavicle_left");
+    if (clavicle < 0) continue;
+    add(side > 0 ? "clavicle_right" : "clavicle_left", m.bodies.com.col(clavicle),
+        {0, kDepthClavicle, 0.004});
+  }
+  if (const int head = bodyNamed("head"); head >= 0) {
+    const Eigen::Matrix3Xd hv = worldMesh(head);
+    Eigen::Index top = 0;
+    hv.row(2).maxCoeff(&top);
+    add("head_top", hv.col(top), {0, 0, kDepthScalp});
+  }
   crotchZ = a.abdomen.floorLevel - kPerineumDepth;  // perineum, below the pelvic floor
   return out;
+}
+
+/// The elbow, wrist and fingertip of the source's arm on `side` (+1 right, -1 left): the arm is the part of
+/// the surface lateral of the acromion, its fingertip the most lateral vertex; the vertices binned by their
+/// distance from the fingertip over the surface give the arm's centreline (the bins' centroids), the elbow is
+/// the centreline point farthest from the line between its ends, the wrist lies between the elbow and the
+/// fingertip at the forearm's share of the forearm and hand.
+std::array<Eigen::Vector3d, 3> sourceArm(const TriangleMesh& s, const Eigen::Vector3d& acromion, int side,
+                                         double forearmShare, const std::string& file) {
+  const Eigen::Matrix3Xd& v = s.vertices;
+  const int nV = s.vertexCount();
+  const double height = v.row(2).maxCoeff() - v.row(2).minCoeff();
+  Eigen::Index tip = 0;
+  (side * v.row(0)).maxCoeff(&tip);
+  auto isArm = [&](int i) { return side * (v(0, i) - acromion.x()) > 0.0; };
+  // distances over the arm's edges from the fingertip (Dijkstra)
+  const auto nb = neighbours(nV, s.triangles);
+  std::vector<double> d(static_cast<std::size_t>(nV), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  d[static_cast<std::size_t>(tip)] = 0.0;
+  queue.push({0.0, static_cast<int>(tip)});
+  while (!queue.empty()) {
+    const auto [di, i] = queue.top();
+    queue.pop();
+    if (di > d[static_cast<std::size_t>(i)]) continue;
+    for (int j : nb[static_cast<std::size_t>(i)]) {
+      if (!isArm(j)) continue;
+      const double dj = di + (v.col(j) - v.col(i)).norm();
+      if (dj < d[static_cast<std::size_t>(j)]) {
+        d[static_cast<std::size_t>(j)] = dj;
+        queue.push({dj, j});
+      }
+    }
+  }
+  const double bin = 0.006 * height;
+  std::vector<Eigen::Vector3d> sum;
+  std::vector<int> count;
+  for (int i = 0; i < nV; ++i) {
+    if (!std::isfinite(d[static_cast<std::size_t>(i)])) continue;
+    const std::size_t k = static_cast<std::size_t>(d[static_cast<std::size_t>(i)] / bin);
+    if (k >= sum.size()) {
+      sum.resize(k + 1, Eigen::Vector3d::Zero());
+      count.resize(k + 1, 0);
+    }
+    sum[k] += v.col(i);
+    ++count[k];
+  }
+  Points centre;
+  for (std::size_t k = 0; k < sum.size(); ++k)
+    if (count[k] > 0) centre.push_back(sum[k] / count[k]);
+  if (centre.size() < 10) fail(file, "cannot find the arms (no surface lateral of the acromions)");
+  // the elbow: farthest from the chord between the centreline's ends
+  const Eigen::Vector3d a = centre.front(), chord = (centre.back() - a).normalized();
+  std::size_t elbow = 0;
+  double far = -1.0;
+  for (std::size_t k = 0; k < centre.size(); ++k) {
+    const Eigen::Vector3d r = centre[k] - a;
+    const double off = (r - r.dot(chord) * chord).norm();
+    if (off > far) {
+      far = off;
+      elbow = k;
+    }
+  }
+  // the wrist: along the centreline from the elbow toward the fingertip
+  std::vector<double> arc(elbow + 1, 0.0);  // arc length from the elbow
+  for (std::size_t k = elbow; k-- > 0;) arc[k] = arc[k + 1] + (centre[k + 1] - centre[k]).norm();
+  std::size_t wrist = elbow;
+  while (wrist > 0 && arc[wrist] < forearmShare * arc.front()) --wrist;
+  return {centre[elbow], centre[wrist], v.col(tip)};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -379,7 +487,30 @@ Points sourceLandmarks(const TriangleMesh& s, const std::vector<Landmark>& targe
   const double scaleX = (r8.xMax - r8.xMin) / (target[3].skin.x() - target[4].skin.x());
 
   Points out;
+  auto targetIndex = [&](const std::string& name) {
+    for (std::size_t k = 0; k < target.size(); ++k)
+      if (target[k].name == name) return k;
+    fail(file, "the model has no landmark " + name);
+  };
   for (const Landmark& t : target) {
+    // the arms, from their centrelines (the acromions are found before them), and the top of the head
+    if (t.name == "head_top") {
+      Eigen::Index top = 0;
+      v.row(2).maxCoeff(&top);
+      out.push_back(v.col(top));
+      continue;
+    }
+    if (t.name.rfind("elbow_", 0) == 0 || t.name.rfind("wrist_", 0) == 0 ||
+        t.name.rfind("fingertip_", 0) == 0) {
+      const std::string n = t.name.substr(t.name.find('_'));  // "_right" or "_left"
+      const Eigen::Vector3d& elbow = target[targetIndex("elbow" + n)].skin;
+      const Eigen::Vector3d& wrist = target[targetIndex("wrist" + n)].skin;
+      const Eigen::Vector3d& tip = target[targetIndex("fingertip" + n)].skin;
+      const double share = (wrist - elbow).norm() / ((wrist - elbow).norm() + (tip - wrist).norm());
+      const auto arm = sourceArm(s, out[targetIndex("acromion" + n)], n == "_right" ? 1 : -1, share, file);
+      out.push_back(arm[t.name[0] == 'e' ? 0 : t.name[0] == 'w' ? 1 : 2]);
+      continue;
+    }
     const double z = zOf(t.skin.z());
     const double x = x0 + scaleX * t.skin.x();
     // candidate points: the central piece of the sections within 1.5 slabs of z

@@ -18,6 +18,12 @@ namespace pneuma::meshing {
 ///     model's own proportions (a vertical map that sends the neck-to-crotch span onto the model's); each
 ///     landmark is then the extreme mesh point of its section (most anterior on the midline, most lateral at
 ///     rib 8, most superior over the acromion, most posterior over the spine at T8 and L3);
+///     A model with a shoulder girdle adds the arms and the head: on the mesh, the part lateral of each
+///     acromion is the arm, its most lateral vertex the fingertip; the vertices binned by their distance from
+///     it over the surface give the arm's centreline, whose point farthest from the line between its ends is
+///     the elbow and whose point at the forearm's share of the elbow-to-fingertip length is the wrist; these
+///     go to the model's elbow and wrist joint centres and the tip of the hand's bone, and the mesh's top to
+///     the head's;
 ///  2. a thin-plate-spline warp (kernel |r|, Bookstein 1989) sending them onto the model's landmarks set out
 ///     by a soft-tissue depth (AnatomyParams-free constants in Skin.cpp);
 ///  3. the legs cut at the thigh, 10 cm below the crotch (placed 7 cm below the pelvic floor), and the cuts

@@ -284,6 +284,16 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
                         "mm/L", m.domeDescent * kMm / (deep->summary.tidalVolume * 1e3), 20.0, 35.0));
     out.push_back(check("physiology.deep.lower_rib_expansion", "rib-8 lateral distance, change, deep",
                         ">= 10 mm", wilson, "mm", m.lowerRibExpansion * kMm, 10.0, kBig));
+    // the shoulders (a model with a shoulder girdle only): a deep breath lifts them visibly, a calm one
+    // barely
+    if (calm && std::isfinite(m.acromionCranial) && std::isfinite(calm->summary.motion.acromionCranial))
+      out.push_back(check(
+          "physiology.deep.shoulder_lift_over_calm", "acromion cranial motion, deep minus calm", ">= 10 mm",
+          "the accessory muscles (sternocleidomastoids, scalenes, upper trapezius) are recruited in deep "
+          "breathing and raise the shoulder girdle (De Troyer & Boriek 2011, Compr Physiol 1:1273); a "
+          "visible "
+          "lift of 1-2 cm is issue 16's target",
+          "mm", (m.acromionCranial - calm->summary.motion.acromionCranial) * kMm, 10.0, kBig));
   }
   return out;
 }

@@ -10,9 +10,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "SurfaceCrossings.h"
 #include "pneuma/meshing/AnatomyParams.h"
 #include "pneuma/meshing/MeshTools.h"
 #include "pneuma/meshing/ModelBuilder.h"
+#include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/Experiments.h"
 #include "pneuma/sim/JsonReader.h"
 #include "pneuma/sim/State.h"
@@ -154,6 +156,66 @@ TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   }
   EXPECT_EQ(shoulder, 52);
   EXPECT_EQ(scalenes, 6);
+}
+
+// The girdle's model with the default skin (built once per preset): the skin's arms registered to the bones.
+const BuiltModel& builtWithSkin(const std::string& name) {
+  static std::map<std::string, BuiltModel> cache;
+  auto it = cache.find(name);
+  if (it == cache.end()) it = cache.emplace(name, buildModel(withGirdle(name))).first;
+  return it->second;
+}
+
+Eigen::Matrix3Xd restSkin(const sim::Model& m) {
+  Eigen::Matrix3Xd x;
+  sim::skinPositions(m.skin, restPoints(m.skin.anchors, m), x);
+  return x;
+}
+
+// the skin's arms, shoulders and neck are registered to the girdle (elbows, wrists and fingertips matched
+// with the arm bones): the skin stays free of self-crossings and every vertex of the clavicles, scapulae,
+// humeri, forearms with the hands, the cervical spine and the head lies inside it
+TEST_P(GirdlePresets, EveryGirdleBoneLiesInsideTheSkin) {
+  const BuiltModel& b = builtWithSkin(GetParam());
+  const sim::Model& m = b.model;
+  const Eigen::Matrix3Xd skin = restSkin(m);
+  EXPECT_EQ(test::countSelfCrossings(skin, m.skin.triangles), 0);
+  for (const char* part :
+       {"clavicle_right", "clavicle_left", "scapula_right", "scapula_left", "humerus_right", "humerus_left",
+        "forearm_right", "forearm_left", "cervical_spine", "head"}) {
+    const int k = body(m, part);
+    ASSERT_GE(k, 0) << part;
+    const Eigen::Matrix3Xd bone =
+        b.bodyMeshes[static_cast<std::size_t>(k)].vertices.colwise() + m.bodies.com.col(k);
+    int outside = 0;
+    for (int i = 0; i < bone.cols(); ++i)
+      if (!test::isInside(bone.col(i), skin, m.skin.triangles)) ++outside;
+    EXPECT_EQ(outside, 0) << part << ": " << outside << " of " << bone.cols() << " vertices outside the skin";
+  }
+}
+
+// the sternocleidomastoids (from the mastoid) and the scalenes (from the cervical spine to rib 1) run inside
+// the neck: 11 points along each lie inside the skin
+TEST_P(GirdlePresets, NeckMusclesRunInsideTheSkin) {
+  const sim::Model& m = builtWithSkin(GetParam()).model;
+  const Eigen::Matrix3Xd skin = restSkin(m);
+  const Eigen::Matrix3Xd a = restPoints(m.elements.endA, m), z = restPoints(m.elements.endB, m);
+  const int head = body(m, "head"), cervical = body(m, "cervical_spine");
+  const std::set<int> rib1 = {body(m, "rib1_right"), body(m, "rib1_left")};
+  int muscles = 0;
+  for (int e = 0; e < m.elements.size(); ++e) {
+    const int from = m.elements.endA.body[static_cast<std::size_t>(e)];
+    const int to = m.elements.endB.body[static_cast<std::size_t>(e)];
+    if (from != head && !(from == cervical && rib1.count(to))) continue;
+    ++muscles;
+    for (int k = 0; k <= 10; ++k) {
+      const Eigen::Vector3d p = a.col(e) + k / 10.0 * (z.col(e) - a.col(e));
+      EXPECT_TRUE(test::isInside(p, skin, m.skin.triangles))
+          << "element " << e << " from " << m.bodies.name[static_cast<std::size_t>(from)] << " to "
+          << m.bodies.name[static_cast<std::size_t>(to)] << " at " << k / 10.0 << ": " << p.transpose();
+    }
+  }
+  EXPECT_EQ(muscles, 4 + 6);  // two heads of each sternocleidomastoid, three scalenes a side
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, GirdlePresets, ::testing::Values("male", "female"));

@@ -442,27 +442,6 @@ TEST_P(BuiltPresets, CorruptedModelJsonIsRejected) {
   }
 }
 
-// true when `p` lies inside the closed outward mesh (v, f): a ray from p crosses it an odd number of times
-bool isInside(const Eigen::Vector3d& p, const Eigen::Matrix3Xd& v, const Eigen::Matrix3Xi& f) {
-  const Eigen::Vector3d d = Eigen::Vector3d(0.5773, 0.5774, 0.5775).normalized();  // off every axis
-  int hits = 0;
-  for (Eigen::Index i = 0; i < f.cols(); ++i) {
-    // Moller-Trumbore
-    const Eigen::Vector3d a = v.col(f(0, i)), e1 = v.col(f(1, i)) - a, e2 = v.col(f(2, i)) - a;
-    const Eigen::Vector3d h = d.cross(e2);
-    const double det = e1.dot(h);
-    if (std::abs(det) < 1e-18) continue;
-    const Eigen::Vector3d s = p - a;
-    const double u = s.dot(h) / det;
-    if (u < 0.0 || u > 1.0) continue;
-    const Eigen::Vector3d q = s.cross(e1);
-    const double w = d.dot(q) / det;
-    if (w < 0.0 || u + w > 1.0) continue;
-    if (e2.dot(q) / det > 0.0) ++hits;
-  }
-  return hits % 2 == 1;
-}
-
 // the skin: a closed body surface free of self-crossings, no vertex inside or within 5 mm of a bone,
 // registered to the landmarks within 20 mm, and bound through a TetGen mesh of the soft tissue
 TEST_P(BuiltPresets, SkinIsAClosedBodySurfaceOutsideEveryBone) {
@@ -485,7 +464,7 @@ TEST_P(BuiltPresets, SkinIsAClosedBodySurfaceOutsideEveryBone) {
     for (int i = 0; i < x.cols(); ++i) {
       const Eigen::Vector3d p = x.col(i);
       if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-      if (isInside(p, bone, mesh.triangles)) {
+      if (pneuma::test::isInside(p, bone, mesh.triangles)) {
         ++inside;
         ADD_FAILURE() << "skin vertex " << i << " inside " << m.bodies.name[static_cast<std::size_t>(b)];
         if (inside > 5) return;

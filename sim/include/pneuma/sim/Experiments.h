@@ -113,6 +113,8 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 /// for every other periodic style among `runs` (deep, panting, ...) two flow reversals per breath and no jump
 /// above max(20 %, 2 x 2 pi f / fs) of peak flow, f the breathing frequency and fs the trace's frame rate
 /// (a pure sinusoid changes by up to 2 pi f / fs of its peak per frame: 21 % at 60 b/m and 30 frames/s).
+/// A model with a shoulder girdle (acromion landmarks) adds the deep breath's acromion lift over calm's,
+/// >= 10 mm.
 std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs);
 
 /// [m] backward sway of the spine top during inhales (Section 5: "during a deep inhale, as the ribs are
