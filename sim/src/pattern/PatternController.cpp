@@ -78,10 +78,11 @@ Levers levers(const DriveCalibration& c) {
 }
 
 // a channel's whole demand (as if it took all of the target): the static demand plus the inverse of its
-// lag, tau times the target's rate, with the tau of the lever that acts (the raising one when positive)
+// lag, tau times the target's rate, each lever with its own tau: the raising lever's positive part plus the
+// lowering lever's negative part. Continuous in the demand and the rate (picking one lever by the sign of
+// d + tau_in r jumped from 0 to d + tau_out r where the two lags differ, each time the rate changed sign)
 double channelDemand(double demand, double rate, const Channel& ch) {
-  const double up = demand + ch.in.tau * rate;
-  return up >= 0.0 ? up : std::min(demand + ch.out.tau * rate, 0.0);
+  return std::max(demand + ch.in.tau * rate, 0.0) + std::min(demand + ch.out.tau * rate, 0.0);
 }
 
 // the share of the target the chest takes: the balance b, lowered (raised) until the chest's (belly's)

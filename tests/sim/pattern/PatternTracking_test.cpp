@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "DefaultModel.h"
 #include "pneuma/sim/BreathStyleController.h"
@@ -182,4 +185,80 @@ TEST(TraceTracking, FollowsTheModelsOwnCalmBreathingPlayedBack) {
   const double rms = followTrace(parseVolumeTrace(csv.str(), "calm", kDriveTimeStep));
   RecordProperty("tracking_rms_pct", std::to_string(rms));
   EXPECT_LT(rms, 5.0);
+}
+
+// The drive adds no wiggle of its own to the flow: on every affect preset, the simulated flow (dV/dt of the
+// lung volume, central differences over the 60 Hz output frames the feedback runs on) reverses at most once
+// per breath more than the target pattern's own flow, counting a reversal when the flow crosses from beyond
+// +10 % of its peak to beyond -10 % (or back: a dead band, so that a hold's noise does not count), and its
+// largest frame-to-frame change stays under 45 % of peak flow or 2.5 times the target's own where that is
+// larger (the target's kinks: the start of a suspension, startle's gasp). Boredom is exempt from the jump
+// bound: its yawn ends in a sudden expiration that the rib cage cannot follow smoothly. Picking each
+// channel's lever by the sign of its lag-compensated demand made the demand jump whenever the target's rate
+// changed sign (3.3-4.1 reversals per breath in the fast presets, jumps of 98-116 %); the continuous demand
+// and the softer feedback (K_p 0.5, K_i 50 /s) give 2 per breath and jumps of 15-43 % (excitement, focus and
+// panic 41-43 %; boredom 50 %).
+namespace {
+
+struct FlowShape {
+  int reversals = 0;  // [-] sign changes of the flow through the dead band
+  double jump = 0.0;  // [-] largest frame-to-frame flow change over the peak |flow|
+};
+
+FlowShape flowShape(const std::vector<double>& t, const std::vector<double>& v) {
+  constexpr double kDeadBand = 0.1;  // [-] of the peak flow
+  std::vector<double> flow;
+  for (std::size_t i = 1; i + 1 < t.size(); ++i)
+    flow.push_back((v[i + 1] - v[i - 1]) / (t[i + 1] - t[i - 1]));
+  double peak = 0.0;
+  for (const double q : flow) peak = std::max(peak, std::abs(q));
+  FlowShape s;
+  if (peak == 0.0) return s;
+  int sign = 0;
+  for (std::size_t i = 0; i < flow.size(); ++i) {
+    if (i > 0) s.jump = std::max(s.jump, std::abs(flow[i] - flow[i - 1]) / peak);
+    const int now = flow[i] > kDeadBand * peak ? 1 : flow[i] < -kDeadBand * peak ? -1 : 0;
+    if (now != 0 && sign != 0 && now != sign) ++s.reversals;
+    if (now != 0) sign = now;
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(AffectFlow, IsAsSmoothAsItsTarget) {
+  REQUIRE_DEFAULT_MODEL();
+  constexpr double kFrom = 4.0, kTo = 20.0;  // [s] of control: after the first breath's blend
+  constexpr double kJumpBound = 0.45;        // [-] of peak flow
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(kResources + "/presets/affect"))
+    if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names.size(), 15u);
+  for (const std::string& affect : names) {
+    SimulationOptions options;
+    auto ctl = makeAffectController(affect, kResources, 1, calibration());
+    PatternController* live = ctl.get();
+    Simulation sim(defaultModel(), std::move(ctl), options);
+    std::vector<double> time, volume, target;  // [s], [m^3], [-]
+    sim.advance(options.settleTime + kTo, [&](const Simulation& s) {
+      if (s.latestMetrics().time >= options.settleTime + kFrom) {
+        time.push_back(s.latestMetrics().time);
+        volume.push_back(s.latestMetrics().lungVolume);
+        target.push_back(live->targetFraction());
+      }
+      return true;
+    });
+    const FlowShape simulated = flowShape(time, volume), wanted = flowShape(time, target);
+    const double breaths = std::max(1.0, 0.5 * wanted.reversals);
+    const double perBreath = simulated.reversals / breaths, wantedPerBreath = wanted.reversals / breaths;
+    RecordProperty(affect + ".reversals_per_breath", std::to_string(perBreath));
+    RecordProperty(affect + ".jump_pct", std::to_string(100.0 * simulated.jump));
+    std::printf("%-10s reversals per breath %.2f (target %.2f), jump %.0f %% (target %.0f %%)\n",
+                affect.c_str(), perBreath, wantedPerBreath, 100.0 * simulated.jump, 100.0 * wanted.jump);
+    EXPECT_LE(perBreath, wantedPerBreath + 1.0) << affect;
+    if (affect != "boredom") {
+      EXPECT_LE(simulated.jump, std::max(kJumpBound, 2.5 * wanted.jump)) << affect;
+    }
+  }
 }

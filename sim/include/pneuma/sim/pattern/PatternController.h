@@ -12,11 +12,14 @@
 /// Control law, every step, in volume-fraction units (a demand is a fraction change from rest):
 ///   d   = (v_T - v_rest) + K_p e + I,  dI/dt = K_i e     static feed-forward plus PI feedback on
 ///                                                      e = v_T - v_M (v_M measured at each frame)
-///   d_c = b d + tau_c b dv_T/dt                         chest channel (intercostals)
-///   d_a = (1 - b) d + tau_a (1 - b) dv_T/dt             belly channel (diaphragm, abdominal wall)
+///   D(tau_in, tau_out) = max(d + tau_in dv_T/dt, 0) + min(d + tau_out dv_T/dt, 0)
+///   d_c = b D(tau_c,in, tau_c,out)                      chest channel (intercostals)
+///   d_a = (1 - b) D(tau_a,in, tau_a,out)                belly channel (diaphragm, abdominal wall)
 /// with b the thoraco-abdominal balance [-], dv_T/dt [1/s] the target's rate (backward difference over
-/// the last step) and tau [s] the identified lag (DriveCalibration::timeConstant) of the lever that acts:
-/// the tau term inverts a first-order lag (tau dV/dt + V = u  =>  u = V + tau dV/dt). The rib friction
+/// the last step) and tau [s] the identified lags (DriveCalibration::timeConstant) of the channel's raising
+/// (in) and lowering (out) lever: the tau term inverts a first-order lag (tau dV/dt + V = u  =>  u = V +
+/// tau dV/dt). D is continuous in d and the rate, so the demand does not jump when the rate changes sign
+/// between two levers of different lag (docs/patterns.md, "Control law"). The rib friction
 /// makes the intercostals lag their activation by about 0.2 s on the default model; without the term
 /// the chest falls behind fast breathing and stays above the trough, waiting for the ribs' slow passive
 /// release. d_c > 0 drives the external intercostals, d_c < 0 the internal intercostals; d_a > 0 the
@@ -86,10 +89,13 @@ struct PatternControllerOptions {
   /// [-] proportional gain on the fraction error. The internal intercostals move the volume within one
   /// 10 ms step against the lungs' recoil (Cavity), so a stiff loop chatters: at K_p 3 their activation
   /// switched between 0 and 1 every step through focus's and panic's expirations (tracking RMS 15 % and
-  /// 12 %). K_p 2 / 1.5 / 1 / 0.7 give focus 11.7 / 8.6 / 4.9 / 4.0 % and panic 9.2 / 8.0 / 5.2 / 4.8 %,
-  /// with every hold within 0.8 % (pneuma_sim_pattern_tracking_test); K_i 100 /s carries the slow lag.
-  double kp = 1.0;
-  double ki = 100.0;                 ///< [1/s] integral gain
+  /// 12 %). K_p 2 / 1.5 / 1 / 0.7 give focus 11.7 / 8.6 / 4.9 / 4.0 % and panic 9.2 / 8.0 / 5.2 / 4.8 %.
+  /// K_p 0.5 with K_i 50 /s (from 1 and 100 /s) halves what the feedback adds to the feed-forward's smooth
+  /// demand, so that the simulated flow has no more reversals per breath than the target's and no
+  /// frame-to-frame jump above 45 % of peak flow on any affect (AffectFlow test; docs/patterns.md,
+  /// "Feedback"); the integral carries the slow lag.
+  double kp = 0.5;
+  double ki = 50.0;                  ///< [1/s] integral gain
   double integralLimit = 0.2;        ///< [-] clamp of the integral term I, in fraction units
   double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
 };
