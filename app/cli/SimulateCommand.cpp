@@ -45,7 +45,8 @@ struct SimulateArgs {
   std::string morphs;       // morph targets baked by `pneuma-cli bake`, "" to bake them now
   double outputRate = 0.0;  // [Hz]
   bool vtk = false;
-  bool force = false;  // replace an earlier run's results in `out`
+  viz::SeriesRange vtkRange;  // --vtk-from, --vtk-to, --vtk-stride
+  bool force = false;         // replace an earlier run's results in `out`
   std::uint64_t seed = 0;
   std::string integrator;
   std::string posture;
@@ -109,6 +110,8 @@ sim::Scenario scenarioFromArgs(const SimulateArgs& a) {
     s.options.outputRate = a.outputRate;
   }
   if (a.vtk) s.outputs.vtk = true;
+  const std::string vtkRangeError = a.vtkRange.error("--vtk-from", "--vtk-to", "--vtk-stride");
+  if (!vtkRangeError.empty()) fail(kExitBadInput, vtkRangeError);
   if (a.isGiven("--seed")) s.seed = a.seed;
   applyIntegrator(a.integrator, s.options.step.integrator);
   applyPosture(a.posture, s.options.step.posture);
@@ -197,9 +200,20 @@ void runSimulate(const SimulateArgs& args) {
   }
   viz::RunRecord& record = *recordOwner;
   std::unique_ptr<viz::VtkSeriesWriter> vtk;
+  viz::SeriesSelector vtkFrames(args.vtkRange);
+  int vtkFrameCount = 0;  // the series' frames, said before the run
   if (simulation && scenario.outputs.vtk) {
     try {
       vtk = std::make_unique<viz::VtkSeriesWriter>(*model, modelDir, args.out, "frames");
+      // what the series will hold, before the run: its frames (their size once the first is written)
+      const double total = scenario.options.settleTime + scenario.duration;  // [s] the output frames' span
+      const double rate = simulation->options().outputRate;                  // [1/s]
+      const auto frames = static_cast<std::size_t>(std::floor(total * rate + 1e-9)) + 1;
+      vtkFrameCount = args.vtkRange.count(frames, 0.0, static_cast<double>(frames - 1) / rate);
+      std::printf("ParaView series: %d frames (one in %d of the %g output frames per second, %g s to %g s)\n",
+                  vtkFrameCount, args.vtkRange.stride, rate, args.vtkRange.from,
+                  std::min(args.vtkRange.to, total));
+      std::fflush(stdout);
     } catch (const std::exception& e) {
       fail(kExitBadInput, std::string("--vtk: ") + e.what());
     }
@@ -215,7 +229,16 @@ void runSimulate(const SimulateArgs& args) {
                         s.controller().measuredFraction());
         else
           record.append(s.latestMetrics());
-        if (vtk) vtk->writeFrame(s.state(), s.latestMetrics());
+        if (vtk && vtkFrames.take(s.state().time)) {
+          vtk->writeFrame(s.state(), s.latestMetrics());
+          // the size, from the first frame's files (a frame at rest would compress better than the others)
+          if (vtk->frameCount() == 1) {
+            const double bytes = static_cast<double>(vtk->bytesWritten());  // [bytes]
+            std::printf("ParaView series: about %.1f MB (%.2f MB a frame)\n", bytes * vtkFrameCount / 1e6,
+                        bytes / 1e6);
+            std::fflush(stdout);
+          }
+        }
         // the glTF animation starts with the controller; each frame's skin fitted onto the morph targets
         const double t = s.state().time - scenario.options.settleTime;  // [s]
         if (gltf && t >= 0.0) gltf->add(t, s.state());
@@ -328,7 +351,15 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_flag("--force", args->force, "Replace the results of an earlier run in --out");
   cmd->add_option("--output-rate", args->outputRate,
                   "Frames per simulated second in CSV, plots and VTK [Hz] (default 60)");
-  cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
+  auto* vtk = cmd->add_flag("--vtk", args->vtk, "Also write a ParaView .pvd series of .vtp frames");
+  cmd->add_option("--vtk-from", args->vtkRange.from,
+                  "First instant of the ParaView series [s], on timeseries.csv's clock (default 0)")
+      ->needs(vtk);
+  cmd->add_option("--vtk-to", args->vtkRange.to, "Last instant of the ParaView series [s] (default: the end)")
+      ->needs(vtk);
+  cmd->add_option("--vtk-stride", args->vtkRange.stride,
+                  "Keep every N-th output frame in the ParaView series (default 1: all)")
+      ->needs(vtk);
   auto* gltf = cmd->add_option(
       "--gltf", args->gltf,
       "Also write the run as a glTF 2.0 .glb: skin morph weights and bone poses (needs a skin)");

@@ -236,13 +236,41 @@ QString ExportController::exportGltf(SimWorker* worker, const QString& modelDir,
   return {};
 }
 
-QString ExportController::exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath) {
+QString ExportController::exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath,
+                                    const viz::SeriesRange& range, QWidget* dialogParent) {
   if (!worker) return "no model loaded";
+  const std::string rangeError = range.error("from", "to", "stride");
+  if (!rangeError.empty())
+    return fail(
+        QString("Cannot export the run to '%1': %2").arg(pvdPath, QString::fromStdString(rangeError)));
   const QFileInfo info(pvdPath);
+  // the frames are written in the worker's thread; the dialog follows them and its Cancel stops them
+  QProgressDialog progress(QString("Writing the ParaView series %1\u2026").arg(pvdPath), "Cancel", 0, 1,
+                           dialogParent);
+  progress.setWindowTitle("Export run");
+  progress.setWindowModality(Qt::WindowModal);
+  progress.setMinimumDuration(0);
+  progress.setValue(0);
+  progress.show();  // at once: the worker's frames can keep the event loop too busy for its show timer
+  auto advanced =
+      connect(worker, &SimWorker::exportProgress, &progress, [&progress, worker](int written, int total) {
+        if (progress.wasCanceled()) return worker->cancelExport();  // cancel() called without the button
+        progress.setMaximum(total);
+        progress.setValue(written);
+      });
+  auto canceller = connect(
+      &progress, &QProgressDialog::canceled, worker, [worker] { worker->cancelExport(); },
+      Qt::DirectConnection);
   const QString error = waitForWorker(worker, [&] {
     worker->requestExportRun(modelDir.toStdString(), info.absolutePath().toStdString(),
-                             info.completeBaseName().toStdString());
+                             info.completeBaseName().toStdString(), range);
   });
+  disconnect(advanced);
+  disconnect(canceller);
+  if (error == SimWorker::kCancelled) {
+    emit done("Series export cancelled; nothing written");
+    return ExportController::cancelled();
+  }
   if (!error.isEmpty()) return fail(QString("Cannot export the run to '%1': %2").arg(pvdPath, error));
   emit done(QString("Run saved as %1").arg(pvdPath));
   return {};

@@ -12,6 +12,8 @@
 #include <QString>
 #include <functional>
 
+#include "viz/VtkSeriesWriter.h"
+
 class QImage;
 class vtkRenderer;
 
@@ -59,9 +61,12 @@ class ExportController : public QObject {
                           class QWidget* dialogParent = nullptr);
   /// What exportAnimation() returns when its Cancel was pressed.
   static QString cancelled() { return "cancelled"; }
-  /// Has `worker` write its recording as `pvdPath` plus a folder of .vtp frames (body meshes from
-  /// `modelDir`); blocks, processing events, until it is written.
-  QString exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath);
+  /// Has `worker` write the recorded frames `range` keeps as `pvdPath` plus a folder of .vtp frames (body
+  /// meshes from `modelDir`), with a progress dialog (parented to `dialogParent`, may be null) whose Cancel
+  /// stops it and removes what it wrote, nothing else (the result is then cancelled()); blocks, processing
+  /// events, until it is written.
+  QString exportRun(SimWorker* worker, const QString& modelDir, const QString& pvdPath,
+                    const viz::SeriesRange& range = {}, class QWidget* dialogParent = nullptr);
   /// Has `worker` write its recording as a glTF 2.0 .glb (skin morph weights and bone poses), or with
   /// `isBakeOnly` the model's baked morph targets alone; blocks, processing events, until it is written.
   QString exportGltf(SimWorker* worker, const QString& modelDir, const QString& path, bool isBakeOnly);

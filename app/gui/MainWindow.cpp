@@ -45,6 +45,7 @@
 #include "gui/MovieDialog.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
+#include "gui/SeriesDialog.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Resources.h"
 #include "pneuma/sim/pattern/Pattern.h"
@@ -267,8 +268,22 @@ void MainWindow::buildActions() {
     if (dialog.exec() == QDialog::Accepted) exportAnimation(dialog.path(), dialog.options());
   });
   exportMenu->addAction("Run as ParaView series (.pvd)\u2026", this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, "Export run", "run.pvd", "ParaView data (*.pvd)");
-    if (!path.isEmpty()) exportRun(path);
+    if (!m_shown || !model()) return;
+    // one frame encoded now gives the size of the series before it is written
+    double frameBytes = 0.0;  // [bytes]
+    try {
+      QApplication::setOverrideCursor(Qt::WaitCursor);
+      frameBytes = static_cast<double>(viz::VtkSeriesWriter::frameBytes(
+          *model(), m_document.modelDir().toStdString(), m_shown->state, m_shown->metrics));
+      QApplication::restoreOverrideCursor();
+    } catch (const std::exception& e) {
+      QApplication::restoreOverrideCursor();
+      report("Export failed", QString("Cannot export the run: %1").arg(e.what()));
+      return;
+    }
+    SeriesDialog dialog(m_shown->recordedFrom, m_shown->recordedTo, m_shown->recordedFrames, frameBytes,
+                        this);
+    if (dialog.exec() == QDialog::Accepted) exportRun(dialog.path(), dialog.range());
   });
   exportMenu->addAction("Run as glTF 2.0 (.glb)\u2026", this, [this] {
     const QString path =
@@ -1187,8 +1202,8 @@ QString MainWindow::exportAnimation(const QString& path, const ExportController:
   return m_export->exportAnimation(path, options, this);
 }
 
-QString MainWindow::exportRun(const QString& pvdPath) {
-  return m_export->exportRun(m_worker, m_document.modelDir(), pvdPath);
+QString MainWindow::exportRun(const QString& pvdPath, const viz::SeriesRange& range) {
+  return m_export->exportRun(m_worker, m_document.modelDir(), pvdPath, range, this);
 }
 
 QString MainWindow::exportGltf(const QString& path) {

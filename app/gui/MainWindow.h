@@ -103,9 +103,11 @@ class MainWindow : public QMainWindow {
   /// suffix: <base>_0000.png, ...). @return empty or the error. A progress dialog shows the frames written;
   /// its Cancel leaves no file (returns ExportController::cancelled()).
   QString exportAnimation(const QString& path, const ExportController::MovieOptions& options);
-  /// Writes the recorded run as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it.
-  /// Blocks (processing events) until the worker has written it. @return empty or the error.
-  QString exportRun(const QString& pvdPath);
+  /// Writes the recorded frames `range` keeps (File > Export > Run as ParaView series, the SeriesDialog: a
+  /// stretch, every n-th frame) as a ParaView series: `pvdPath` plus a folder of .vtp frames beside it, with
+  /// a progress dialog whose Cancel removes what it wrote (returns ExportController::cancelled()). Blocks
+  /// (processing events) until the worker has written it. @return empty or the error.
+  QString exportRun(const QString& pvdPath, const viz::SeriesRange& range = {});
   /// File > Export > Run as glTF: the recording as a .glb (morph weights and bone poses); "" on success.
   QString exportGltf(const QString& path);
   /// File > Export > Baked morph targets: the model's morph targets as a .glb; "" on success.
@@ -134,6 +136,8 @@ class MainWindow : public QMainWindow {
   QImage grabView();
 
   viz::ModelScene& scene() { return *m_scene; }
+  /// The worker running the simulation (null before a model is open).
+  SimWorker* worker() const { return m_worker; }
   LivePlots* plots() const { return m_plots; }
   ParameterPanel* parameters() const { return m_params; }
   /// The Breathing read-out's text: the last breaths' figures in people's units (Snapshot::breathing).

@@ -1,27 +1,23 @@
 #pragma once
 /// @file MovieDialog.h
-/// File > Export > Animation of the recording: where to write (the format by the suffix: .mp4, .ogv or a PNG
-/// sequence), the stretch of the recording (from, to [s]), the frame size (the 3D view as shown, 640 x 360,
+/// File > Export > Animation of the recording (a RangeDialog): the file (the format by the suffix: .mp4, .ogv
+/// or a PNG sequence), the stretch of the recording, the frame size (the 3D view as shown, 640 x 360,
 /// 1280 x 720 or 1920 x 1080), the overlays (time stamp; volume panel with a cursor), and a summary line with
 /// the frame count and the estimated size before anything is rendered. An MP4 without ffmpeg is refused in
 /// the dialog with the reason (viz::MovieWriter::ffmpegMissingMessage()); Ogg and PNG still work.
 
-#include <QDialog>
 #include <QSize>
 #include <vector>
 
 #include "gui/ExportController.h"
+#include "gui/RangeDialog.h"
 
 class QCheckBox;
 class QComboBox;
-class QDoubleSpinBox;
-class QLabel;
-class QLineEdit;
-class QPushButton;
 
 namespace pneuma::app {
 
-class MovieDialog : public QDialog {
+class MovieDialog : public RangeDialog {
   Q_OBJECT
 
  public:
@@ -29,33 +25,24 @@ class MovieDialog : public QDialog {
   /// @param shownSize the 3D view's size as shown [px]
   MovieDialog(double recordedFrom, double recordedTo, QSize shownSize, QWidget* parent = nullptr);
 
-  /// The file to write.
-  QString path() const;
-  void setPath(const QString& path);
   /// The range, size and overlays chosen (25 frames per second).
   ExportController::MovieOptions options() const;
-  /// "126 frames (5.00 s at 25 fps), 1280 x 720 px, MP4, about 2.8 MB", or why it cannot be written.
-  QString summary() const;
   /// The frame sizes offered after "as shown" [px].
   static const std::vector<QSize>& sizes();
 
-  QDoubleSpinBox* fromBox() const { return m_from; }
-  QDoubleSpinBox* toBox() const { return m_to; }
   QComboBox* sizeBox() const { return m_size; }
   QCheckBox* timeStampBox() const { return m_timeStamp; }
   QCheckBox* volumePanelBox() const { return m_volumePanel; }
 
+ protected:
+  /// "126 frames (5.00 s at 25 fps), 1280 x 720 px, MP4 (H.264), about 2.8 MB", or why it cannot be written.
+  void update() override;
+
  private:
-  void update();
   QSize m_shownSize;
-  QLineEdit* m_path = nullptr;
-  QDoubleSpinBox* m_from = nullptr;
-  QDoubleSpinBox* m_to = nullptr;
   QComboBox* m_size = nullptr;
   QCheckBox* m_timeStamp = nullptr;
   QCheckBox* m_volumePanel = nullptr;
-  QLabel* m_summary = nullptr;
-  QPushButton* m_ok = nullptr;
 };
 
 }  // namespace pneuma::app

@@ -107,9 +107,10 @@ std::shared_ptr<const sim::MorphTargets> SimWorker::morphTargets() const {
 }
 
 void SimWorker::requestExportRun(const std::string& modelDir, const std::string& outDir,
-                                 const std::string& baseName) {
+                                 const std::string& baseName, const viz::SeriesRange& range) {
   std::lock_guard lock(m_pendingMutex);
-  m_pending.exportRun = std::array<std::string, 3>{modelDir, outDir, baseName};
+  m_isExportCancelled = false;
+  m_pending.exportRun = SeriesRequest{modelDir, outDir, baseName, range};
 }
 
 Frame SimWorker::take() {
@@ -319,18 +320,27 @@ void SimWorker::restoreRecorded(std::size_t i, sim::State& state, sim::Metrics& 
   m_sim->recorder().restore(i, state, metrics);
 }
 
-void SimWorker::exportRun(const std::array<std::string, 3>& request) {
+void SimWorker::exportRun(const SeriesRequest& request) {
   QString error;
   try {
     const sim::Recorder& rec = m_sim->recorder();
     if (rec.empty()) throw std::runtime_error("nothing recorded yet: run the simulation first");
-    viz::VtkSeriesWriter writer(*m_model, request[0], request[1], request[2]);
+    const int total = request.range.count(rec.size(), rec.frame(0).time, rec.frame(rec.size() - 1).time);
+    if (total == 0) throw std::runtime_error("no recorded frame in the range asked for");
+    // destroyed unfinished (cancelled, failed), the writer removes what it wrote
+    viz::VtkSeriesWriter writer(*m_model, request.modelDir, request.outDir, request.baseName,
+                                viz::VtkSeriesWriter::Staging::TemporaryFolder);
+    viz::SeriesSelector selector(request.range);
     sim::State state;
     sim::Metrics metrics = m_sim->latestMetrics();
     for (std::size_t i = 0; i < rec.size(); ++i) {
+      if (!selector.take(rec.frame(i).time)) continue;
+      if (m_isExportCancelled) throw std::runtime_error(kCancelled);
       restoreRecorded(i, state, metrics);
       writer.writeFrame(state, metrics);
+      emit exportProgress(writer.frameCount(), total);
     }
+    if (m_isExportCancelled) throw std::runtime_error(kCancelled);
     writer.finish();
   } catch (const std::exception& e) {
     error = e.what();
@@ -433,6 +443,7 @@ void SimWorker::publish(bool isScrubbed) {
   if (!rec.empty()) {
     snap->recordedFrom = rec.frame(0).time;
     snap->recordedTo = rec.frame(rec.size() - 1).time;
+    snap->recordedFrames = rec.size();
   }
   snap->metrics = m_sim->latestMetrics();
   // the last breaths' figures, once per simulated second

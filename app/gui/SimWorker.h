@@ -6,6 +6,8 @@
 
 #include <QObject>
 #include <QString>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <limits>
 #include <memory>
@@ -20,6 +22,7 @@
 #include "pneuma/sim/Simulation.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/pattern/PatternController.h"
+#include "viz/VtkSeriesWriter.h"
 
 class QTimer;
 
@@ -86,10 +89,11 @@ struct Snapshot {
   sim::Metrics metrics;
   double realTimeFactor = 0.0;  ///< [-] simulated seconds per wall-clock second, last batch
   bool isRunning = false;
-  bool isScrubbed = false;    ///< the state was restored from the recording (timeline)
-  double recordedFrom = 0.0;  ///< [s] oldest recorded frame
-  double recordedTo = 0.0;    ///< [s] newest recorded frame
-  long long generation = 0;   ///< increments on reset and model change: plots restart
+  bool isScrubbed = false;         ///< the state was restored from the recording (timeline)
+  double recordedFrom = 0.0;       ///< [s] oldest recorded frame
+  double recordedTo = 0.0;         ///< [s] newest recorded frame
+  std::size_t recordedFrames = 0;  ///< frames recorded, evenly spaced from recordedFrom to recordedTo
+  long long generation = 0;        ///< increments on reset and model change: plots restart
   /// The breath's figures over the last kBreathingWindow simulated seconds after settling (sim::summarize:
   /// tidal volume, rate and the motion in anatomical axes), refreshed once per simulated second; null before
   /// the first full breath.
@@ -142,9 +146,15 @@ class SimWorker : public QObject {
   /// Drives the run with the affect or pattern of `scenario` (sim::makeController(): the muscle drive is
   /// calibrated first, a few simulated seconds in the worker thread).
   void requestScenario(std::shared_ptr<const sim::Scenario> scenario);
-  /// Writes the recorded frames as a ParaView series `outDir`/`baseName`.pvd (viz::VtkSeriesWriter),
-  /// then emits exportDone().
-  void requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName);
+  /// Writes the recorded frames that `range` keeps as a ParaView series `outDir`/`baseName`.pvd
+  /// (viz::VtkSeriesWriter), emitting exportProgress() after each frame, then exportDone(). cancelExport()
+  /// stops it between two frames; the writer then removes what it wrote and exportDone() says kCancelled.
+  void requestExportRun(const std::string& modelDir, const std::string& outDir, const std::string& baseName,
+                        const viz::SeriesRange& range = {});
+  /// Stops a running series export (thread-safe; any thread).
+  void cancelExport() { m_isExportCancelled = true; }
+  /// What exportDone() says when cancelExport() stopped the export.
+  static constexpr const char* kCancelled = "cancelled";
   /// Writes the recorded frames as a glTF 2.0 .glb at `path` (viz::writeGltf: skin morph weights fitted per
   /// frame, bone poses; bone meshes from `modelDir`), or with `isBakeOnly` the morph targets alone with a
   /// demo breath; then emits exportDone(). The morph targets are baked on the model once
@@ -170,8 +180,10 @@ class SimWorker : public QObject {
   /// The simulation threw (blow-up or bad parameter); the run is paused.
   void failed(const QString& message);
   void targetReached();
-  /// A run export finished; `error` is empty on success.
+  /// A run export finished; `error` is empty on success, kCancelled when cancelled.
   void exportDone(const QString& error);
+  /// A series export wrote `written` of its `total` frames.
+  void exportProgress(int written, int total);
   /// A requestMorphTargets() finished; `error` is empty on success (then morphTargets() has them).
   void morphTargetsReady(const QString& error);
   /// Progress worth showing in the status bar (e.g. calibration).
@@ -181,6 +193,10 @@ class SimWorker : public QObject {
   struct GltfRequest {
     std::string modelDir, path;
     bool isBakeOnly = false;
+  };
+  struct SeriesRequest {
+    std::string modelDir, outDir, baseName;
+    viz::SeriesRange range;
   };
   struct Pending {
     std::optional<bool> isRunning;
@@ -194,7 +210,7 @@ class SimWorker : public QObject {
     std::optional<double> runUntil;
     std::optional<std::pair<std::string, sim::pattern::SwitchMode>> affect;
     std::shared_ptr<const sim::Scenario> scenario;
-    std::optional<std::array<std::string, 3>> exportRun;  // model dir, out dir, base name
+    std::optional<SeriesRequest> exportRun;
     std::optional<GltfRequest> exportGltf;
     bool doBake = false;
   };
@@ -205,7 +221,7 @@ class SimWorker : public QObject {
   void collect(const sim::Simulation& simulation);
   void pushAffect(const std::string& name, sim::pattern::SwitchMode mode);
   void playScenario(const sim::Scenario& scenario);
-  void exportRun(const std::array<std::string, 3>& request);
+  void exportRun(const SeriesRequest& request);
   void exportGltf(const GltfRequest& request);
   /// Bakes m_morphs on m_model unless it is baked. @throws on a model without a skin or a failed run.
   void bake();
@@ -229,6 +245,7 @@ class SimWorker : public QObject {
 
   std::mutex m_pendingMutex;
   Pending m_pending;
+  std::atomic<bool> m_isExportCancelled{false};  // cancelExport(), read between the frames of an export
 
   // worker-thread state
   bool m_isRunning = false;

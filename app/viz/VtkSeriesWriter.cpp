@@ -14,6 +14,10 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -33,6 +37,19 @@ namespace {
 
 constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity", "lungs", "skin"};
 constexpr int kPartCount = 6;
+
+// true for a part file of a series ("gut_000012.vtp")
+bool isPartFile(const std::string& name) {
+  for (const char* part : kPartNames) {
+    const std::string prefix = std::string(part) + "_";
+    if (name.size() == prefix.size() + 10 && name.rfind(prefix, 0) == 0 &&
+        name.compare(name.size() - 4, 4, ".vtp") == 0 &&
+        std::all_of(name.begin() + static_cast<std::ptrdiff_t>(prefix.size()), name.end() - 4,
+                    [](unsigned char c) { return std::isdigit(c) != 0; }))
+      return true;
+  }
+  return false;
+}
 
 vtkSmartPointer<vtkDoubleArray> scalarArray(const char* name, int components, vtkIdType tuples) {
   auto a = vtkSmartPointer<vtkDoubleArray>::New();
@@ -67,6 +84,36 @@ void fieldValue(vtkPolyData* pd, const char* name, double v) {
 
 }  // namespace
 
+std::string SeriesRange::error(const std::string& fromName, const std::string& toName,
+                               const std::string& strideName) const {
+  if (!std::isfinite(from) || from < 0.0) return fromName + ": expected seconds >= 0";
+  if (std::isnan(to) || !(to >= from)) return toName + ": expected seconds at or after " + fromName;
+  if (stride < 1) return strideName + ": expected a whole number >= 1, got " + std::to_string(stride);
+  return {};
+}
+
+int SeriesRange::count(std::size_t frames, double first, double last) const {
+  if (frames == 0) return 0;
+  long long lo = 0, hi = static_cast<long long>(frames) - 1;  // the recording's frames inside [from, to]
+  if (frames == 1 || !(last > first)) {
+    if (first < from - kTimeTolerance || first > to + kTimeTolerance) return 0;
+    hi = 0;
+  } else {
+    const double dt = (last - first) / static_cast<double>(frames - 1);  // [s]
+    lo = std::max(lo, static_cast<long long>(std::ceil((from - kTimeTolerance - first) / dt)));
+    if (std::isfinite(to))
+      hi = std::min(hi, static_cast<long long>(std::floor((to + kTimeTolerance - first) / dt)));
+  }
+  const long long inRange = hi - lo + 1;
+  return inRange > 0 ? static_cast<int>((inRange + stride - 1) / stride) : 0;
+}
+
+bool SeriesSelector::take(double time) {
+  if (time < m_range.from - SeriesRange::kTimeTolerance || time > m_range.to + SeriesRange::kTimeTolerance)
+    return false;
+  return m_inRange++ % m_range.stride == 0;
+}
+
 struct VtkSeriesWriter::Impl {
   const sim::Model& model;
   std::string outDir;
@@ -80,13 +127,14 @@ struct VtkSeriesWriter::Impl {
   sim::PosedGeometry posed;                 // the frame being written (the one posing function)
   Eigen::Matrix3Xd skinRest;                // [m] skin vertices at the rest pose (3 x #V)
 
+  fs::path frameDir;              // the frames' temporary folder, renamed by finish()
+  std::vector<fs::path> written;  // the files written into it
+  std::size_t bytesWritten = 0;
+  bool isFinished = false;
+  bool isStaged = false;  // Staging::TemporaryFolder
+
   Impl(const sim::Model& m, const std::string& modelDir, std::string dir, std::string base)
       : model(m), outDir(std::move(dir)), baseName(std::move(base)) {
-    std::error_code ec;
-    fs::create_directories(fs::path(outDir) / baseName, ec);
-    if (ec)
-      throw std::runtime_error("cannot create " + (fs::path(outDir) / baseName).string() + ": " +
-                               ec.message());
     bonePolys = vtkSmartPointer<vtkCellArray>::New();
     boneVerts = vtkSmartPointer<vtkCellArray>::New();
     std::vector<int> vertBody, polyBody;
@@ -132,23 +180,47 @@ struct VtkSeriesWriter::Impl {
     skinRest = posed.skin;
   }
 
-  std::string partPath(int part, int frame) const {
+  static std::string partName(int part, int frame) {
     char name[64];
     std::snprintf(name, sizeof name, "%s_%06d.vtp", kPartNames[part], frame);
-    return baseName + "/" + name;
+    return name;
   }
+  // the part's file as the .pvd names it, relative to outDir
+  std::string partPath(int part, int frame) const { return baseName + "/" + partName(part, frame); }
 
-  // encoded in memory, then written through writeFileAtomically(), whose every write is checked: VTK's own
-  // file output can report success on a full disk and leave a truncated frame
-  void write(vtkPolyData* pd, const std::string& relative) const {
-    const std::string path = (fs::path(outDir) / relative).string();
+  // one part as VTK XML (appended data), encoded in memory
+  static std::string encode(vtkPolyData* pd) {
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(pd);
     writer->WriteToOutputStringOn();
     writer->SetDataModeToAppended();
-    if (writer->Write() != 1)
-      throw std::runtime_error("cannot write " + path + ": VTK could not encode the frame");
-    writeFileAtomically(path, writer->GetOutputString());
+    if (writer->Write() != 1) throw std::runtime_error("VTK could not encode the frame");
+    return writer->GetOutputString();
+  }
+
+  // the six parts of the posed frame, encoded
+  std::array<std::string, kPartCount> encodeFrame(const sim::Metrics& metrics) const {
+    return {encode(bones()),         encode(muscles(metrics)), encode(gut(metrics)),
+            encode(cavity(metrics)), encode(lungs(metrics)),   encode(skin())};
+  }
+
+  // written through writeFileAtomically(), whose every write is checked: VTK's own file output can report
+  // success on a full disk and leave a truncated frame
+  // an error names the file as it will be called once in place (<outDir>/<baseName>/<part>)
+  void write(const std::string& bytes, int part, int frame) {
+    const fs::path path = frameDir / partName(part, frame);
+    written.push_back(path);
+    try {
+      writeFileAtomically(path.string(), bytes);
+      bytesWritten += bytes.size();
+    } catch (const std::runtime_error& e) {
+      std::string message = e.what();
+      const std::string from = frameDir.string(), to = (fs::path(outDir) / baseName).string();
+      for (std::size_t at = 0; from != to && (at = message.find(from, at)) != std::string::npos;
+           at += to.size())
+        message.replace(at, from.size(), to);
+      throw std::runtime_error(message);
+    }
   }
 
   vtkSmartPointer<vtkPolyData> bones() const {
@@ -267,40 +339,82 @@ struct VtkSeriesWriter::Impl {
 };
 
 VtkSeriesWriter::VtkSeriesWriter(const sim::Model& model, const std::string& modelDir,
-                                 const std::string& outDir, const std::string& baseName)
-    : m_impl(std::make_unique<Impl>(model, modelDir, outDir, baseName)) {}
+                                 const std::string& outDir, const std::string& baseName, Staging staging)
+    : m_impl(std::make_unique<Impl>(model, modelDir, outDir, baseName)) {
+  // staged, the frames go to a folder of this process's own, renamed into place by finish()
+  m_impl->isStaged = staging == Staging::TemporaryFolder;
+  const std::string folder = (fs::path(outDir) / baseName).string();
+  m_impl->frameDir = fs::path(m_impl->isStaged ? temporaryPathFor(folder) : folder);
+  std::error_code ec;
+  fs::create_directories(m_impl->frameDir, ec);
+  if (ec) throw std::runtime_error("cannot create " + m_impl->frameDir.string() + ": " + ec.message());
+}
 
-VtkSeriesWriter::~VtkSeriesWriter() = default;
+VtkSeriesWriter::~VtkSeriesWriter() {
+  if (m_impl->isFinished || !m_impl->isStaged) return;
+  // unfinished (cancelled, failed): remove what this writer wrote, and its folder once empty
+  std::error_code ec;
+  for (const fs::path& f : m_impl->written) fs::remove(f, ec);
+  fs::remove(m_impl->frameDir, ec);  // only when empty
+}
+
+std::size_t VtkSeriesWriter::frameBytes(const sim::Model& model, const std::string& modelDir,
+                                        const sim::State& state, const sim::Metrics& metrics) {
+  Impl impl(model, modelDir, "", "");
+  sim::poseGeometry(model, state, impl.posed);
+  std::size_t bytes = 0;
+  for (const std::string& part : impl.encodeFrame(metrics)) bytes += part.size();
+  return bytes;
+}
 
 void VtkSeriesWriter::writeFrame(const sim::State& state, const sim::Metrics& metrics) {
   const int frame = static_cast<int>(m_impl->frameTimes.size());
   sim::poseGeometry(m_impl->model, state, m_impl->posed);
-  m_impl->write(m_impl->bones(), m_impl->partPath(0, frame));
-  m_impl->write(m_impl->muscles(metrics), m_impl->partPath(1, frame));
-  m_impl->write(m_impl->gut(metrics), m_impl->partPath(2, frame));
-  m_impl->write(m_impl->cavity(metrics), m_impl->partPath(3, frame));
-  m_impl->write(m_impl->lungs(metrics), m_impl->partPath(4, frame));
-  m_impl->write(m_impl->skin(), m_impl->partPath(5, frame));
+  const std::array<std::string, kPartCount> parts = m_impl->encodeFrame(metrics);
+  for (int part = 0; part < kPartCount; ++part)
+    m_impl->write(parts[static_cast<std::size_t>(part)], part, frame);
   m_impl->frameTimes.push_back(state.time);
 }
 
 std::string VtkSeriesWriter::finish() {
+  Impl& s = *m_impl;
+  // the frames' folder into place: an earlier series of the same name is replaced, a folder holding anything
+  // else is left alone and refused
+  const fs::path target = fs::path(s.outDir) / s.baseName;
+  std::error_code ec;
+  if (s.isStaged && fs::exists(target, ec)) {
+    for (const auto& entry : fs::directory_iterator(target, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (!entry.is_regular_file() || !isPartFile(name))
+        throw std::runtime_error("cannot write " + target.string() + ": the folder holds " + name +
+                                 ", which is not a frame of a series; choose another name");
+    }
+    fs::remove_all(target, ec);
+    if (ec) throw std::runtime_error("cannot replace " + target.string() + ": " + ec.message());
+  }
+  if (s.isStaged) fs::rename(s.frameDir, target, ec);
+  if (ec)
+    throw std::runtime_error("cannot rename " + s.frameDir.string() + " to " + target.string() + ": " +
+                             ec.message());
+  s.isFinished = true;
+
   std::ostringstream pvd;
   pvd.precision(9);
   pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
          "byte_order=\"LittleEndian\">\n"
       << "  <Collection>\n";
-  for (std::size_t f = 0; f < m_impl->frameTimes.size(); ++f)
+  for (std::size_t f = 0; f < s.frameTimes.size(); ++f)
     for (int part = 0; part < kPartCount; ++part)
-      pvd << "    <DataSet timestep=\"" << m_impl->frameTimes[f] << "\" group=\"\" part=\"" << part
-          << "\" name=\"" << kPartNames[part] << "\" file=\"" << m_impl->partPath(part, static_cast<int>(f))
-          << "\"/>\n";
+      pvd << "    <DataSet timestep=\"" << s.frameTimes[f] << "\" group=\"\" part=\"" << part << "\" name=\""
+          << kPartNames[part] << "\" file=\"" << s.partPath(part, static_cast<int>(f)) << "\"/>\n";
   pvd << "  </Collection>\n</VTKFile>\n";
-  const std::string name = m_impl->baseName + ".pvd";
-  writeFileAtomically((fs::path(m_impl->outDir) / name).string(), pvd.str());
+  const std::string name = s.baseName + ".pvd";
+  writeFileAtomically((fs::path(s.outDir) / name).string(), pvd.str());
   return name;
 }
 
 int VtkSeriesWriter::frameCount() const { return static_cast<int>(m_impl->frameTimes.size()); }
+
+std::size_t VtkSeriesWriter::bytesWritten() const { return m_impl->bytesWritten; }
 
 }  // namespace pneuma::viz

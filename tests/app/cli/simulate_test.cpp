@@ -196,6 +196,49 @@ TEST(CliSimulate, VtkSeriesListsFivePartsPerFrame) {
   EXPECT_EQ(reader->GetOutput()->GetNumberOfPolys(), toy.gut.triangles.cols());
 }
 
+// --vtk-from, --vtk-to and --vtk-stride keep one output frame in N over a stretch of the run, the count and
+// size said before the run; a bad stride or one without --vtk is refused by name
+TEST(CliSimulate, VtkSeriesOverARangeWithAStride) {
+  const std::string out = freshOutDir("vtk_range");
+  auto r = runCli({"simulate",   "--model", toyModelDir(),   "--style", "calm",         "--duration", "1.5",
+                   "--settle",   "0.5",     "--output-rate", "20",      "--dt",         "0.002",      "--vtk",
+                   "--vtk-from", "1",       "--vtk-to",      "1.6",     "--vtk-stride", "3",          "--out",
+                   out});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  // 1 s to 1.6 s at 20 Hz is 13 output frames; one in three: 1.0, 1.15, 1.3, 1.45, 1.6 s
+  EXPECT_NE(
+      r.out.find("ParaView series: 5 frames (one in 3 of the 20 output frames per second, 1 s to 1.6 s)"),
+      std::string::npos)
+      << r.out;
+  const std::string pvd = slurp(out + "/frames.pvd");
+  // the size said after the first frame is the size written, within 10 % (frames differ a little)
+  const std::size_t about = r.out.find("ParaView series: about ");
+  ASSERT_NE(about, std::string::npos) << r.out;
+  double written = 0.0;  // [bytes]
+  for (const auto& e : fs::directory_iterator(out + "/frames")) written += static_cast<double>(e.file_size());
+  EXPECT_NEAR(std::stod(r.out.substr(about + 23)) * 1e6, written, 0.1 * written + 0.05e6) << r.out;
+  std::vector<double> times;
+  for (std::size_t p = 0; (p = pvd.find("timestep=\"", p)) != std::string::npos; p += 10)
+    if (pvd.compare(pvd.find("part=\"", p), 8, "part=\"0\"") == 0)
+      times.push_back(std::stod(pvd.substr(p + 10)));
+  ASSERT_EQ(times.size(), 5u) << pvd;
+  for (std::size_t k = 0; k < times.size(); ++k)
+    EXPECT_NEAR(times[k], 1.0 + 0.15 * static_cast<double>(k), 1e-6);
+  EXPECT_EQ(std::distance(fs::directory_iterator(out + "/frames"), fs::directory_iterator{}), 30);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+
+  const auto zero = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "1",
+                            "--vtk", "--vtk-stride", "0", "--out", freshOutDir("vtk_stride0")});
+  EXPECT_EQ(zero.exitCode, 2);
+  EXPECT_NE(zero.err.find("--vtk-stride: expected a whole number >= 1, got 0"), std::string::npos)
+      << zero.err;
+  const auto alone = runCli({"simulate", "--model", toyModelDir(), "--style", "calm", "--duration", "1",
+                             "--vtk-stride", "2", "--out", freshOutDir("vtk_alone")});
+  EXPECT_EQ(alone.exitCode, 2);
+  EXPECT_NE(alone.err.find("--vtk"), std::string::npos) << alone.err;
+}
+
 TEST(CliSimulate, AffectAddsTargetAndMeasuredVolumeFraction) {
   const std::string out = freshOutDir("affect");
   auto r = runCli({"simulate", "--model", toyModelDir(), "--affect", "neutral", "--duration", "4", "--settle",

@@ -27,6 +27,7 @@
 #include <QProgressDialog>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QSpinBox>
 #include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTextStream>
@@ -34,6 +35,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <functional>
 #include <set>
 #include <tuple>
 
@@ -46,6 +48,8 @@
 #include "gui/MovieDialog.h"
 #include "gui/ParameterPanel.h"
 #include "gui/PlotView.h"
+#include "gui/SeriesDialog.h"
+#include "gui/SimWorker.h"
 #include "pneuma/sim/Metrics.h"
 #include "pneuma/sim/MorphTargets.h"
 #include "pneuma/sim/PosedGeometry.h"
@@ -835,6 +839,124 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
   EXPECT_NE(w.window.exportRun("/proc/pneuma-no-such-dir/run.pvd"), QString());
 }
 
+// triggers the window's menu action whose text starts with `action` and hands the modal dialog it opens, of
+// type Dialog, to `fill` (which accepts or rejects it); false when there is no such action or dialog
+template <class Dialog>
+bool runDialog(MainWindow& window, const QString& action, const std::function<void(Dialog*)>& fill) {
+  QAction* found = nullptr;
+  for (QAction* a : window.findChildren<QAction*>())
+    if (a->text().startsWith(action)) found = a;
+  if (!found) return false;
+  bool isShown = false;
+  QTimer::singleShot(0, [&] {
+    auto* d = qobject_cast<Dialog*>(QApplication::activeModalWidget());
+    if (!d) {
+      if (QApplication::activeModalWidget()) QApplication::activeModalWidget()->close();
+      return;
+    }
+    isShown = true;
+    fill(d);
+  });
+  found->trigger();
+  return isShown;
+}
+
+// the times [s] of the frames a .pvd lists (its bones part, one per frame)
+std::vector<double> seriesTimes(const QString& pvdPath) {
+  QFile pvd(pvdPath);
+  std::vector<double> times;
+  if (!pvd.open(QIODevice::ReadOnly)) return times;
+  const QRegularExpression entry("timestep=\"([^\"]+)\" group=\"\" part=\"0\"");
+  for (auto m = entry.globalMatch(QString::fromUtf8(pvd.readAll())); m.hasNext();)
+    times.push_back(m.next().captured(1).toDouble());
+  return times;
+}
+
+// File > Export > Run as ParaView series: the dialog announces the frames of the chosen range and stride and
+// their size before anything is written, and the export writes those frames, at those times, of that size
+TEST(MainWindow, SeriesDialogAnnouncesFramesAndSizeAndTheExportWritesThem) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(2.0));
+  QTemporaryDir out;
+  QString summary, emptyRange;
+  bool wasRefused = false;
+  int announced = 0;
+  ASSERT_TRUE(runDialog<app::SeriesDialog>(w.window, "Run as ParaView series", [&](app::SeriesDialog* d) {
+    d->setPath(out.filePath("run.pvd"));
+    d->fromBox()->setValue(1.5);
+    d->toBox()->setValue(0.5);
+    emptyRange = d->summary();
+    wasRefused = !d->canExport();
+    d->fromBox()->setValue(0.5);
+    d->toBox()->setValue(1.5);
+    d->strideBox()->setValue(3);
+    summary = d->summary();
+    announced = d->frameCount();
+    d->accept();
+  }));
+  EXPECT_TRUE(wasRefused) << emptyRange.toStdString();
+  // 0.5 s to 1.5 s of a 60 Hz recording is 61 frames; one in three is 21
+  EXPECT_EQ(announced, 21);
+  EXPECT_TRUE(summary.startsWith("21 frames (every 3rd recorded frame: 20 per second, 0.50 s to 1.50 s)"))
+      << summary.toStdString();
+  const std::vector<double> times = seriesTimes(out.filePath("run.pvd"));
+  ASSERT_EQ(times.size(), 21u);
+  EXPECT_NEAR(times.front(), 0.5, 1e-6);
+  EXPECT_NEAR(times.back(), 1.5, 1e-6);
+  for (std::size_t k = 1; k < times.size(); ++k) EXPECT_NEAR(times[k] - times[k - 1], 0.05, 1e-6);
+  // the size written is the size announced, within 10 % (the frames differ a little)
+  const QRegularExpressionMatch about = QRegularExpression("about ([0-9.]+) (kB|MB)").match(summary);
+  ASSERT_TRUE(about.hasMatch()) << summary.toStdString();
+  const double estimate = about.captured(1).toDouble() * (about.captured(2) == "MB" ? 1e6 : 1e3);  // [bytes]
+  double written = 0.0;
+  const QFileInfoList files = QDir(out.filePath("run")).entryInfoList(QDir::Files);
+  EXPECT_EQ(files.size(), 6 * 21);
+  for (const QFileInfo& f : files) written += static_cast<double>(f.size());
+  EXPECT_NEAR(written, estimate, 0.1 * estimate);
+}
+
+// Cancel during a series export removes the frames it wrote and nothing else: an earlier series of the same
+// name and another file stay as they were, and no error is reported
+TEST(MainWindow, CancelledSeriesExportRemovesOnlyItsOwnFiles) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(2.0));
+  QTemporaryDir out;
+  ASSERT_EQ(w.window.exportRun(out.filePath("run.pvd"), {0.0, 0.5, 1}), QString());  // the earlier series
+  {
+    QFile other(out.filePath("notes.txt"));
+    ASSERT_TRUE(other.open(QIODevice::WriteOnly));
+    other.write("the lecturer's notes");
+  }
+  const QStringList before =
+      QDir(out.path()).entryList(QDir::AllEntries | QDir::NoDotAndDotDot | QDir::Hidden);
+  const QStringList frames = QDir(out.filePath("run")).entryList(QDir::Files);
+  const std::size_t earlier = seriesTimes(out.filePath("run.pvd")).size();
+  EXPECT_GE(earlier, 30u) << "0 s to 0.5 s at 60 Hz";
+  // cancel from the progress dialog once three frames are written; the worker waits for the click
+  int cancelledAt = -1;
+  app::SimWorker* worker = w.window.worker();
+  ASSERT_NE(worker, nullptr);
+  auto connection = QObject::connect(
+      worker, &app::SimWorker::exportProgress, &w.window,
+      [&](int written, int) {
+        if (written < 3 || cancelledAt >= 0) return;
+        for (QProgressDialog* dialog : w.window.findChildren<QProgressDialog*>())
+          if (dialog->isVisible()) {
+            cancelledAt = written;
+            dialog->findChild<QPushButton*>()->click();  // as the user does
+          }
+      },
+      Qt::BlockingQueuedConnection);
+  const QString error = w.window.exportRun(out.filePath("run.pvd"), {0.0, 2.0, 1});
+  QObject::disconnect(connection);
+  EXPECT_EQ(error, app::ExportController::cancelled());
+  EXPECT_EQ(cancelledAt, 3) << "the progress dialog counted the frames";
+  EXPECT_EQ(QDir(out.path()).entryList(QDir::AllEntries | QDir::NoDotAndDotDot | QDir::Hidden), before);
+  EXPECT_EQ(QDir(out.filePath("run")).entryList(QDir::Files), frames) << "the earlier series is whole";
+  EXPECT_EQ(seriesTimes(out.filePath("run.pvd")).size(), earlier);
+  EXPECT_EQ(w.window.lastError(), QString()) << "a cancel is not an error";
+}
+
 // File > Export > Run as glTF and Baked morph targets: the recording's skin fitted onto targets baked from
 // the physics (docs/patterns.md), read back with the skin's vertex count; a bad folder is an error, not a
 // file
@@ -1033,26 +1155,16 @@ TEST(MainWindow, MovieDialogAnnouncesFramesAndSizeAndWritesThem) {
   ToyWindow w;
   ASSERT_TRUE(w.window.runUntil(1.5));
   QTemporaryDir out;
-  QAction* animation = nullptr;
-  for (QAction* a : w.window.findChildren<QAction*>())
-    if (a->text().startsWith("Animation of the recording")) animation = a;
-  ASSERT_NE(animation, nullptr);
   QString summary, emptyRange;
   bool wasRefused = false;
-  QTimer::singleShot(0, [&] {
-    auto* d = qobject_cast<app::MovieDialog*>(QApplication::activeModalWidget());
-    if (!d) {
-      ADD_FAILURE() << "no movie dialog";
-      if (QApplication::activeModalWidget()) QApplication::activeModalWidget()->close();
-      return;
-    }
+  ASSERT_TRUE(runDialog<app::MovieDialog>(w.window, "Animation of the recording", [&](app::MovieDialog* d) {
     EXPECT_NEAR(d->fromBox()->value(), w.window.shown()->recordedFrom, 0.01);
     EXPECT_NEAR(d->toBox()->value(), w.window.shown()->recordedTo, 0.01);
     d->setPath(out.filePath("dialog.mp4"));
     d->fromBox()->setValue(1.2);
     d->toBox()->setValue(0.4);
     emptyRange = d->summary();
-    wasRefused = !d->findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Ok)->isEnabled();
+    wasRefused = !d->canExport();
     d->fromBox()->setValue(0.4);
     d->toBox()->setValue(1.2);
     d->sizeBox()->setCurrentIndex(1);  // 640 x 360
@@ -1060,8 +1172,7 @@ TEST(MainWindow, MovieDialogAnnouncesFramesAndSizeAndWritesThem) {
     d->volumePanelBox()->setChecked(true);
     summary = d->summary();
     d->accept();
-  });
-  animation->trigger();
+  }));
   EXPECT_TRUE(wasRefused) << emptyRange.toStdString();
   EXPECT_TRUE(emptyRange.contains("From must come before To")) << emptyRange.toStdString();
   EXPECT_TRUE(summary.contains("21 frames (0.80 s at 25 fps), 640 x 360 px, MP4")) << summary.toStdString();
@@ -1130,7 +1241,7 @@ TEST(MainWindow, MissingFfmpegIsExplainedAndOggStillWorks) {
   app::MovieDialog dialog(0.0, 1.0, QSize(320, 240));
   dialog.setPath(out.filePath("breath.mp4"));
   const QString summary = dialog.summary();
-  const bool isEnabled = dialog.findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Ok)->isEnabled();
+  const bool isEnabled = dialog.canExport();
   const QString error = w.window.exportAnimation(out.filePath("breath.mp4"), movieOptions(0.4, 0.6));
   const QString ogg = w.window.exportAnimation(out.filePath("breath.ogv"), movieOptions(0.4, 0.6));
   unsetenv("PNEUMA_FFMPEG");

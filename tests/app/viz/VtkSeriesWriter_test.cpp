@@ -156,5 +156,120 @@ TEST(VtkSeriesWriter, FramesHoldThePosedGeometry) {
   fs::remove_all(dir);
 }
 
+// the dialog's and the CLI's frame count is the number of frames the selector keeps, for a 60 Hz recording
+// that starts late (a kept window of the last 60 s) and any range and stride
+TEST(SeriesRange, CountIsWhatTheSelectorKeeps) {
+  const double first = 2.5, rate = 60.0;  // [s], [1/s]
+  const std::size_t frames = 3601;        // 60 s
+  for (const viz::SeriesRange r :
+       {viz::SeriesRange{10.0, 20.0, 3}, viz::SeriesRange{0.0, 100.0, 1}, viz::SeriesRange{2.5, 2.5, 7},
+        viz::SeriesRange{30.01, 30.02, 1}, viz::SeriesRange{61.0, 70.0, 4}, viz::SeriesRange{}}) {
+    viz::SeriesSelector selector(r);
+    int kept = 0;
+    double previous = -1.0;
+    for (std::size_t i = 0; i < frames; ++i) {
+      const double t = first + static_cast<double>(i) / rate;
+      if (!selector.take(t)) continue;
+      EXPECT_GE(t, r.from - 1e-9);
+      EXPECT_LE(t, r.to + 1e-9);
+      if (kept > 0) EXPECT_NEAR(t - previous, r.stride / rate, 1e-9);  // every stride-th frame
+      previous = t;
+      ++kept;
+    }
+    EXPECT_EQ(r.count(frames, first, first + (frames - 1) / rate), kept) << r.from << " to " << r.to;
+  }
+  // 10 s to 20 s at 60 Hz is 601 frames; one in three of them is 201
+  EXPECT_EQ((viz::SeriesRange{10.0, 20.0, 3}).count(frames, first, first + 60.0), 201);
+  EXPECT_EQ((viz::SeriesRange{0.0, 1.0, 0}).error("from", "to", "stride"),
+            "stride: expected a whole number >= 1, got 0");
+  EXPECT_EQ((viz::SeriesRange{2.0, 1.0, 1}).error("--vtk-from", "--vtk-to", "s"),
+            "--vtk-to: expected seconds at or after --vtk-from");
+}
+
+constexpr auto kStaged = viz::VtkSeriesWriter::Staging::TemporaryFolder;  // the app's export
+
+// a toy model with its bodies drawn as vertices, a posed frame of it, and a fresh folder
+struct SeriesFixture {
+  sim::Model model = sim::test::makeToyTorso(2);
+  fs::path dir;
+  explicit SeriesFixture(const std::string& name)
+      : dir(fs::path(testing::TempDir()) / ("pneuma_series_" + name + "_" + std::to_string(getpid()))) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void writeFrames(viz::VtkSeriesWriter& writer, unsigned n) const {
+    for (unsigned f = 1; f <= n; ++f) {
+      const sim::State s = test::posedState(model, f);
+      writer.writeFrame(s, test::someMetrics(model, s, f));
+    }
+  }
+  std::size_t entries(const fs::path& folder) const {
+    return static_cast<std::size_t>(std::distance(fs::directory_iterator(folder), fs::directory_iterator{}));
+  }
+};
+
+// a writer destroyed unfinished (a cancelled export) removes what it wrote and its own folder, and nothing
+// else: an earlier series of the same name and another file stay as they were
+TEST(VtkSeriesWriter, UnfinishedWriterRemovesOnlyItsOwnFiles) {
+  SeriesFixture f("cancel");
+  fs::create_directories(f.dir / "run");
+  { std::ofstream(f.dir / "run" / "bones_000000.vtp") << "an earlier series"; }
+  { std::ofstream(f.dir / "notes.txt") << "the lecturer's notes"; }
+  {
+    viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
+    f.writeFrames(writer, 3);
+    EXPECT_EQ(f.entries(f.dir), 3u) << "run, notes.txt and the writer's own folder";
+  }
+  EXPECT_EQ(f.entries(f.dir), 2u);
+  EXPECT_EQ(f.entries(f.dir / "run"), 1u);
+  std::ifstream earlier(f.dir / "run" / "bones_000000.vtp");
+  std::string text;
+  std::getline(earlier, text);
+  EXPECT_EQ(text, "an earlier series");
+  EXPECT_TRUE(fs::exists(f.dir / "notes.txt"));
+
+  // finished, it replaces the earlier series whole
+  viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
+  f.writeFrames(writer, 2);
+  EXPECT_EQ(writer.finish(), "run.pvd");
+  EXPECT_EQ(f.entries(f.dir / "run"), 12u) << "two frames of six parts";
+  EXPECT_GT(fs::file_size(f.dir / "run" / "bones_000000.vtp"), 100u);
+  EXPECT_EQ(f.entries(f.dir), 3u) << "run, run.pvd and notes.txt";
+}
+
+// a folder of the series' name that holds anything else is not replaced: the export fails naming it and
+// removes its own frames
+TEST(VtkSeriesWriter, AFolderHoldingOtherFilesIsNotReplaced) {
+  SeriesFixture f("occupied");
+  fs::create_directories(f.dir / "run");
+  { std::ofstream(f.dir / "run" / "thesis.tex") << "months of work"; }
+  {
+    viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
+    f.writeFrames(writer, 2);
+    try {
+      writer.finish();
+      ADD_FAILURE() << "the folder was replaced";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("thesis.tex"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(f.entries(f.dir), 1u) << "only run/";
+  EXPECT_EQ(f.entries(f.dir / "run"), 1u) << "only thesis.tex";
+}
+
+// the size shown before an export is what a frame takes on disk: frameBytes() equals the six files' sizes
+TEST(VtkSeriesWriter, FrameBytesIsTheSizeOfAWrittenFrame) {
+  SeriesFixture f("bytes");
+  const sim::State s = test::posedState(f.model, 1);
+  const sim::Metrics m = test::someMetrics(f.model, s, 1);
+  viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
+  writer.writeFrame(s, m);
+  writer.finish();
+  std::size_t onDisk = 0;
+  for (const auto& e : fs::directory_iterator(f.dir / "run")) onDisk += fs::file_size(e.path());
+  EXPECT_EQ(viz::VtkSeriesWriter::frameBytes(f.model, f.dir.string(), s, m), onDisk);
+  EXPECT_GT(onDisk, 1000u);
+}
+
 }  // namespace
 }  // namespace pneuma
