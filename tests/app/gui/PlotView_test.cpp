@@ -90,8 +90,9 @@ TEST(PlotView, TicksLieInsideTheBoxAndLabelsDoNotOverlap) {
     EXPECT_LT(L.xTickLabels[i].box.right, L.xTickLabels[i + 1].box.left);
   // "time [s]" beside the first x tick's label, not under it
   ASSERT_FALSE(L.xTickLabels.empty());
-  if (L.xLabel.box.top < L.xTickLabels.front().box.bottom)
+  if (L.xLabel.box.top < L.xTickLabels.front().box.bottom) {
     EXPECT_LE(L.xLabel.box.right, L.xTickLabels.front().box.left + 1e-9);
+  }
   for (std::size_t i = 0; i + 1 < L.yTickLabels.size(); ++i)  // ascending values go up the screen
     EXPECT_GT(L.yTickLabels[i].box.top, L.yTickLabels[i + 1].box.bottom - 1e-9);
   for (const viz::PlotLayout::Text& t : L.yTickLabels) EXPECT_LE(t.box.right, L.area.left);
