@@ -1,6 +1,6 @@
 // What one frame of the app's 3D view costs (Google Benchmark, `pneuma-scene-bench`; run it under
-// `xvfb-run -a -s "-screen 0 1280x800x24"`, the software OpenGL the frame-rate target is stated for, issue 18):
-// the default model's scene (viz::ModelScene, default display options: translucent skin and lungs, gut,
+// `xvfb-run -a -s "-screen 0 1280x800x24"`, the software OpenGL the frame-rate target is stated for, issue
+// 18): the default model's scene (viz::ModelScene, default display options: translucent skin and lungs, gut,
 // bones, force-coloured muscles, landmarks, motion x5) posed and rendered in an off-screen window of the
 // 3D view's size in the 1280 x 800 window (575 x 683 px), then finished (glFinish). The time column is the
 // wall time of one frame, the CPU column the process's CPU time (every thread: the renderer's own and Mesa
@@ -43,8 +43,8 @@ void sceneFrame(benchmark::State& state, const DisplayOptions& options) {
   // uploads new points, as the live view does
   const sim::State rest = sim::makeInitialState(*model);
   sim::State moved = rest;
-  moved.bodyPosition.array() += 0.002;      // [m]
-  moved.nodePosition.array() += 0.002;      // [m]
+  moved.bodyPosition.array() += 0.002;  // [m]
+  moved.nodePosition.array() += 0.002;  // [m]
   sim::Metrics metrics;
   metrics.elementForce = Eigen::VectorXd::LinSpaced(model->elements.size(), -4.0, 0.0);  // [N] tension
   metrics.isSlack.assign(static_cast<std::size_t>(model->elements.size()), 0);
