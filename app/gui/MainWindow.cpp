@@ -39,6 +39,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "gui/CpuClock.h"
 #include "gui/DocumentController.h"
 #include "gui/ExportController.h"
 #include "gui/LivePlots.h"
@@ -58,7 +59,8 @@ constexpr int kRefreshMs = 33;  // [ms] display refresh: 30 Hz
 // [ms] a 3D render at most this long is drawn at every refresh: with the plots' few milliseconds both stay
 // above 20 Hz (50 ms per refresh); a slower one waits its turn so that it cannot starve the plots
 constexpr double kRenderEveryRefreshMs = 36.0;
-constexpr double kRecordSeconds = 60.0;  // [s] recorded for the timeline
+constexpr double kRecordSeconds = 60.0;                  // [s] recorded for the timeline
+constexpr const char* kSimulationThread = "pneuma-sim";  // the simulation thread's name (CpuClock.h)
 
 const std::vector<std::pair<QString, double>> kSpeeds{
     {"0.1\u00d7 real time", 0.1}, {"0.25\u00d7 real time", 0.25}, {"0.5\u00d7 real time", 0.5},
@@ -683,6 +685,7 @@ QString MainWindow::openModel(const QString& dir) {
     m_worker = new SimWorker(model, std::move(opened.simulation), m_settings);
     m_worker->setSpeed(m_speedCombo->currentData().toDouble());
     m_worker->moveToThread(&m_thread);
+    m_thread.setObjectName(kSimulationThread);  // the OS thread's name: pneuma --measure finds its CPU time
     connect(&m_thread, &QThread::started, m_worker, &SimWorker::start);
     connect(&m_thread, &QThread::finished, m_worker, &SimWorker::stop);
     connect(&m_thread, &QThread::finished, m_worker, &QObject::deleteLater);
@@ -1062,6 +1065,8 @@ void MainWindow::countRender(qint64 nanoseconds) {
 
 void MainWindow::restartRates() {
   m_ratesClock.start();
+  m_processCpuAtStart = processCpuSeconds();
+  m_simulationCpuAtStart = threadCpuSeconds(kSimulationThread);
   m_totalFrames = m_totalPlotFrames = 0;
   m_totalRenderMs = 0.0;
 }
@@ -1070,8 +1075,11 @@ MainWindow::Rates MainWindow::rates() const {
   const double seconds =
       m_ratesClock.isValid() ? static_cast<double>(m_ratesClock.nsecsElapsed()) * 1e-9 : 0.0;
   if (!(seconds > 0.0)) return {};
+  const double simulationCpu = threadCpuSeconds(kSimulationThread) - m_simulationCpuAtStart;  // [s]
+  const double displayCpu = processCpuSeconds() - m_processCpuAtStart - simulationCpu;        // [s]
   return {m_totalFrames / seconds, m_totalPlotFrames / seconds,
-          m_totalFrames > 0 ? m_totalRenderMs / m_totalFrames : 0.0};
+          m_totalFrames > 0 ? m_totalRenderMs / m_totalFrames : 0.0,
+          m_totalFrames > 0 ? 1e3 * displayCpu / m_totalFrames : 0.0, simulationCpu / seconds};
 }
 
 QString MainWindow::breathingReadout() const { return m_breathing->text(); }

@@ -157,10 +157,12 @@ class MainWindow : public QMainWindow {
   double renderMilliseconds() const { return m_renderMs; }
   /// The 3D view's size in pixels.
   QSize viewSize() const;
-  /// The rates averaged since restartRates() (pneuma --measure): 3D frames and plot refreshes per second, and
-  /// the mean wall time of one scene update and render [ms].
+  /// The rates averaged since restartRates() (pneuma --measure): 3D frames and plot refreshes per second, the
+  /// mean wall time of one scene update and render [ms], and the CPU time the display took per 3D frame [ms]
+  /// (every thread but the simulation's: the GUI's, with the plots, and the OpenGL driver's; CpuClock.h) and
+  /// the simulation thread's CPU as a share of one core [-].
   struct Rates {
-    double fps = 0.0, plotHz = 0.0, renderMs = 0.0;
+    double fps = 0.0, plotHz = 0.0, renderMs = 0.0, displayCpuMsPerFrame = 0.0, simulationCpuShare = 0.0;
   };
   void restartRates();
   Rates rates() const;
@@ -255,6 +257,7 @@ class MainWindow : public QMainWindow {
   QElapsedTimer m_ratesClock;
   int m_totalFrames = 0, m_totalPlotFrames = 0;
   double m_totalRenderMs = 0.0;
+  double m_processCpuAtStart = 0.0, m_simulationCpuAtStart = 0.0;  // [s] CPU clocks at restartRates()
   void countRender(qint64 nanoseconds);
   /// Moves the 3D scene to `s` (when it is of the open model), with the compared run's ghost at its time.
   void poseScene(const Snapshot& s);

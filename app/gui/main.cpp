@@ -377,10 +377,11 @@ int main(int argc, char** argv) {
       }
       std::printf(
           "3D view %.1f fps (%.1f ms per render, %dx%d px), plots %.1f Hz, real-time factor %.2f, simulated "
-          "%.2f "
-          "s\n",
+          "%.2f s\n"
+          "CPU: display %.1f ms per 3D frame (GUI, plots and OpenGL threads), simulation %.0f %% of a core\n",
           rates.fps, rates.renderMs, view.width(), view.height(), rates.plotHz,
-          shown ? shown->realTimeFactor : 0.0, shown ? shown->state.time : 0.0);
+          shown ? shown->realTimeFactor : 0.0, shown ? shown->state.time : 0.0, rates.displayCpuMsPerFrame,
+          100.0 * rates.simulationCpuShare);
       QApplication::exit(shown ? 0 : 1);
     });
   }
