@@ -21,7 +21,8 @@ namespace {
 
 using Eigen::Vector3d;
 
-constexpr double kVolumeTolerance = 0.01;  // [-] |V - V0| / V0 under the press (the gut's is 2 %, Section 6.2)
+constexpr double kVolumeTolerance =
+    0.01;  // [-] |V - V0| / V0 under the press (the gut's is 2 %, Section 6.2)
 
 // the toy torso with a tissue lens and three muscle strands (rectus group) from its apex to the rib behind
 // it: activating the rectus presses the lens against the rib
@@ -33,7 +34,8 @@ Model pressedLens(double kappa) {
     if (m.bodies.name[static_cast<std::size_t>(b)] == "rib3_right") rib = b;
   const Vector3d p = m.nodes.rest.col(apex);
   const Vector3d inward = -Vector3d(0.75, 0.66, 0.0).normalized();
-  for (const Vector3d& off : {Vector3d(0.0, 0.0, 0.01), Vector3d(0.0, 0.0, -0.01), Vector3d(0.01, -0.01, 0.0)})
+  for (const Vector3d& off :
+       {Vector3d(0.0, 0.0, 0.01), Vector3d(0.0, 0.0, -0.01), Vector3d(0.01, -0.01, 0.0)})
     test::addElement(m, ElementGroup::Rectus, test::End{-1, apex, {}},
                      test::End{rib, -1, Vector3d(p + 0.05 * inward + off)}, 600.0, 0.0, 0.5);
   return m;
@@ -147,15 +149,17 @@ TEST(VolumeBodies, BadValuesAreRefusedNamingTheField) {
             "model.json: volume_bodies[1].name: duplicate name 'toy_tissue_0'");
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["volume_bodies"][0]["triangles"][0][0] = 0; }),
             "model.json: volume_bodies[0].triangles[0]: node 0 is not a tissue node (region \"tissue\")");
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["volume_bodies"][0]["triangles"].erase(0); })
-                .rfind("model.json: volume_bodies[0].triangles[", 0),
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
+              j["volume_bodies"][0]["triangles"].erase(0);
+            }).rfind("model.json: volume_bodies[0].triangles[", 0),
             0u);
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
               for (auto& t : j["volume_bodies"][0]["triangles"]) std::swap(t[0], t[1]);
             }).rfind("model.json: volume_bodies[0].triangles: enclosed rest volume must be > 0", 0),
             0u);
-  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["volume_bodies"][0]["density"] = 1.0; })
-                .rfind("model.json: volume_bodies[0]", 0),
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
+              j["volume_bodies"][0]["density"] = 1.0;
+            }).rfind("model.json: volume_bodies[0]", 0),
             0u);
   EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["nodes"][0]["region"] = "bone"; }),
             "model.json: nodes[0].region: unknown region 'bone' (expected wall, diaphragm, fixed or tissue)");
