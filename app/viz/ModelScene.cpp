@@ -539,6 +539,11 @@ struct ModelScene::Impl {
         count += t.cols();
       }
       tissue = surface(model.nodes.size(), tissueTriangles);
+      vtkNew<vtkFloatArray> normals;  // smooth shading: setNormals() at every update
+      normals->SetNumberOfComponents(3);
+      normals->SetNumberOfTuples(tissue->GetNumberOfPoints());
+      normals->Fill(0.0f);
+      tissue->GetPointData()->SetNormals(normals);
       tissueActor = actorFor(tissue);
       tissueActor->GetProperty()->SetColor(0.74, 0.33, 0.31);
       tissueActor->PickableOff();

@@ -64,7 +64,8 @@ void addLens(const std::string& name, const DeepGrid& g, double thickness, const
       superficial[static_cast<std::size_t>(i)] = first + static_cast<int>(x.size());
       x.push_back(g.point[static_cast<std::size_t>(i)] + t * g.outward[static_cast<std::size_t>(i)]);
     }
-  // the surface: the deep face and the superficial one (the deep rim shared), as two triangulations of the grid
+  // the surface: the deep face and the superficial one (the deep rim shared), as two triangulations of the
+  // grid
   auto top = [&](int r, int c) {
     const int i = g.at(r, c);
     return g.isRim(r, c) ? deep[static_cast<std::size_t>(i)] : superficial[static_cast<std::size_t>(i)];
@@ -97,7 +98,8 @@ void addLens(const std::string& name, const DeepGrid& g, double thickness, const
     t.row(1).swap(t.row(2));
     v0 = -v0;
   }
-  if (!(v0 > 1e-7)) throw sim::Error(name + ": the tissue body encloses no volume (" + std::to_string(v0) + " m^3)");
+  if (!(v0 > 1e-7))
+    throw sim::Error(name + ": the tissue body encloses no volume (" + std::to_string(v0) + " m^3)");
   // nodes: equal shares of the body's mass
   m.nodes.mass.conservativeResize(first + n);
   for (int i = 0; i < n; ++i) {
@@ -164,14 +166,16 @@ DeepGrid pectoralGrid(const AnatomyParams& a, const Skeleton& sk, int side) {
       const int i = g.at(r, c);
       const Eigen::Vector3d inward = (rib.at(s, 1.0) - rib.at(s)).normalized();
       g.point[static_cast<std::size_t>(i)] = rib.at(s, -(0.5 * rib.thickness + kBoneGap));
-      g.bone[static_cast<std::size_t>(i)] = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      g.bone[static_cast<std::size_t>(i)] =
+          sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
       g.outward[static_cast<std::size_t>(i)] = -inward;
     }
   }
   // the rows between the ribs: midway, tied to the rib (or the sternum) above
   for (int r = 1; r < g.rows; r += 2)
     for (int c = 0; c < g.cols; ++c) {
-      const std::size_t i = static_cast<std::size_t>(g.at(r, c)), a = static_cast<std::size_t>(g.at(r - 1, c)),
+      const std::size_t i = static_cast<std::size_t>(g.at(r, c)),
+                        a = static_cast<std::size_t>(g.at(r - 1, c)),
                         b = static_cast<std::size_t>(g.at(r + 1, c));
       g.point[i] = 0.5 * (g.point[a] + g.point[b]);
       g.bone[i] = g.bone[a];
@@ -194,8 +198,8 @@ double humerusRadius(double along, double armLength) {
 }
 
 /// The deep face of the shoulder cap on `side`: round the upper arm's axis from the front over the lateral
-/// side to the back, from above the acromion down to the deltoid tuberosity; the top row is tied to the scapula
-/// (the acromion), the others to the humerus.
+/// side to the back, from above the acromion down to the deltoid tuberosity; the top row is tied to the
+/// scapula (the acromion), the others to the humerus.
 DeepGrid deltoidGrid(const Skeleton& sk, int side) {
   const GirdleSide& gs = sk.girdle[static_cast<std::size_t>(side)];
   const Eigen::Vector3d down = (gs.elbow - gs.glenohumeral).normalized();
@@ -238,12 +242,12 @@ void buildTissueBodies(const AnatomyParams& a, const Skeleton& sk, sim::Model& m
   if (!(tg.kappa > 0.0)) return;
   ElementSink sink(a.gains, model);
   for (int side : {kRight, kLeft})
-    addLens(side == kRight ? "pectoral_right" : "pectoral_left", pectoralGrid(a, sk, side), tg.pectoralThickness,
-            tg, sink, model);
+    addLens(side == kRight ? "pectoral_right" : "pectoral_left", pectoralGrid(a, sk, side),
+            tg.pectoralThickness, tg, sink, model);
   if (sk.hasGirdle)
     for (int side : {kRight, kLeft})
-      addLens(side == kRight ? "deltoid_right" : "deltoid_left", deltoidGrid(sk, side), tg.deltoidThickness, tg,
-              sink, model);
+      addLens(side == kRight ? "deltoid_right" : "deltoid_left", deltoidGrid(sk, side), tg.deltoidThickness,
+              tg, sink, model);
 }
 
 }  // namespace pneuma::meshing

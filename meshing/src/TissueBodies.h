@@ -1,8 +1,8 @@
 #pragma once
 /// @file TissueBodies.h
-/// The soft-tissue volume bodies (sim::VolumeBodies): the pectorals and, with the shoulder girdle, the bulk of
-/// the shoulders, "simulated as volume-preserving bodies and attached with a number of strategically placed,
-/// zero-length springs" (Zordan et al. 2004, Section 7).
+/// The soft-tissue volume bodies (sim::VolumeBodies): the pectorals and, with the shoulder girdle, the bulk
+/// of the shoulders, "simulated as volume-preserving bodies and attached with a number of strategically
+/// placed, zero-length springs" (Zordan et al. 2004, Section 7).
 ///
 /// Each body is a lens: a grid of deep nodes on the bones (each tied to one bone by three two-sided springs
 /// along the world axes, 20 mm long: for small motions the paper's zero-length spring, stiffness k I), and a
@@ -15,8 +15,8 @@
 ///   - pectoral_right, pectoral_left: over ribs 2-6 anteriorly, from the sternal border (deep nodes tied to
 ///     the sternum) to a third of the way from the costochondral junction to the rib's most lateral point.
 ///   - deltoid_right, deltoid_left (anatomy option `shoulder_girdle`): a cap over the glenohumeral joint,
-///     round the front, the side and the back of the humeral head and the upper humerus, its upper rows tied to
-///     the scapula (acromion), the rest to the humerus.
+///     round the front, the side and the back of the humeral head and the upper humerus, its upper rows tied
+///     to the scapula (acromion), the rest to the humerus.
 
 #include "Skeleton.h"
 #include "pneuma/sim/Model.h"

@@ -25,8 +25,8 @@ inline int volumeBody(const sim::Model& m, const std::string& name) {
   return -1;
 }
 
-/// Expects body `name` of `b` (built with a skin) to be a lens of [minVolume, maxVolume] m^3 between the bones
-/// and the skin, tied to the bones by some of its nodes and free in the others.
+/// Expects body `name` of `b` (built with a skin) to be a lens of [minVolume, maxVolume] m^3 between the
+/// bones and the skin, tied to the bones by some of its nodes and free in the others.
 inline void expectBetweenBonesAndSkin(const meshing::BuiltModel& b, const std::string& name, double minVolume,
                                       double maxVolume) {
   SCOPED_TRACE(name);
