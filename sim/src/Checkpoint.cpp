@@ -162,6 +162,9 @@ void solverFields(Archive& a, M& m, Eigen::Matrix<double, 9, Eigen::Dynamic>& va
   a.field("solver.rankTwo", m.rankTwo);
   a.field("solver.rankTwoSolve", m.rankTwoSolve);
   a.field("solver.rankTwoScale", m.rankTwoScale);
+  a.field("solver.volumeRank", m.volumeRank);
+  a.field("solver.volumeRankSolve", m.volumeRankSolve);
+  a.field("solver.volumeRankScale", m.volumeRankScale);
   a.field("solver.factorDt", m.factorDt);
   a.field("solver.factorAxial", m.factorAxial);
   a.field("solver.factorTransverse", m.factorTransverse);
@@ -177,6 +180,8 @@ void outputFields(Archive& a, O& o, Eigen::Index ne) {
   a.field("outputs.gutVolume", o.gutVolume);
   a.field("outputs.gutPressure", o.gutPressure);
   a.field("outputs.pleuralPressure", o.pleuralPressure);
+  a.field("outputs.volumeBodyVolume", o.volumeBodyVolume, o.volumeBodyVolume.size(), 1);
+  a.field("outputs.volumeBodyPressure", o.volumeBodyPressure, o.volumeBodyVolume.size(), 1);
   a.field("outputs.maxJointError", o.maxJointError);
 }
 
@@ -195,6 +200,7 @@ void metricsFields(Archive& a, M& m, MetricsParts& parts) {
   a.field("metrics.gutVolumeError", m.gutVolumeError);
   a.field("metrics.gutPressure", m.gutPressure);
   a.field("metrics.abdomenVolume", m.abdomenVolume);
+  a.field("metrics.volumeBodyError", m.volumeBodyError);
   a.field("metrics.elementForce", m.elementForce);
   a.field("metrics.isSlack", parts.isSlack);
   a.field("metrics.groupMeanTension", parts.groupMeanTension, kElementGroupCount, 1);
@@ -258,7 +264,10 @@ void readSolverMemory(CheckpointReader& in, SolverMemory& m) {
   }
   const Eigen::Index nf = 3 * static_cast<Eigen::Index>(m.system.blocks());
   const bool fits = m.rankOne.size() == nf && m.rankOneSolve.size() == nf &&
-                    (m.rankTwo.size() == 0 || (m.rankTwo.size() == nf && m.rankTwoSolve.size() == nf));
+                    (m.rankTwo.size() == 0 || (m.rankTwo.size() == nf && m.rankTwoSolve.size() == nf)) &&
+                    m.volumeRank.rows() == nf && m.volumeRankSolve.rows() == nf &&
+                    m.volumeRankSolve.cols() == m.volumeRank.cols() &&
+                    m.volumeRankScale.size() == m.volumeRank.cols();
   if (m.hasFactorization && !fits)
     in.fail("solver.rankOne", "sizes do not match the model's free coordinates");
 }

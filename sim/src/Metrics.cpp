@@ -248,6 +248,13 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
                         : 0.0;
   out.abdomenVolume =
       coneVolume(state.nodePosition, work.constants.wallTriangles, work.constants.restGutCentroid);
+  Eigen::VectorXd bodyVolume(model.volumes.size());
+  out.volumeBodyError.resize(model.volumes.size());
+  for (int k = 0; k < model.volumes.size(); ++k) {
+    bodyVolume(k) = enclosedVolume(state.nodePosition, model.volumes.triangles[at(k)]);
+    out.volumeBodyError(k) =
+        (bodyVolume(k) - work.constants.restBodyVolume(k)) / work.constants.restBodyVolume(k);
+  }
 
   // element forces of the last step, slack state and group tensions
   const Elements& el = model.elements;
@@ -290,6 +297,8 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
   }
   if (work.constants.restGutVolume > 0.0)
     elastic += gutEnergy(kappa, work.constants.restGutVolume, out.gutVolume);
+  for (int k = 0; k < model.volumes.size(); ++k)
+    elastic += gutEnergy(model.volumes.kappa(k), work.constants.restBodyVolume(k), bodyVolume(k));
   // lung recoil: E = P0 dV + dV^2 / (2 C) while Ppl < 0, the potential of the pleural pressure
   if (model.cavity.compliance > 0.0) {
     const double dv = out.thoracicCavityVolume - work.constants.restCavityVolume;

@@ -31,6 +31,8 @@ const char* regionName(NodeRegion r) {
       return "diaphragm";
     case NodeRegion::Fixed:
       return "fixed";
+    case NodeRegion::Tissue:
+      return "tissue";
   }
   return "wall";
 }
@@ -120,6 +122,22 @@ void readSkin(const Reader& r, Skin& out) {
   out.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
   for (std::size_t i = 0; i < tris.size(); ++i)
     out.triangles.col(static_cast<Eigen::Index>(i)) = tris[i].index3();
+}
+
+// volume bodies: [{"name": s, "kappa": k, "triangles": [[a, b, c], ...]}, ...]
+void readVolumeBodies(const Reader& r, VolumeBodies& out) {
+  const auto n = static_cast<Eigen::Index>(r.size());
+  out.kappa.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Reader b = r[static_cast<std::size_t>(k)];
+    b.allowKeys({"name", "kappa", "triangles"});
+    out.name.push_back(b.at("name").string());
+    out.kappa(k) = b.at("kappa").number();
+    const Reader tris = b.at("triangles");
+    Eigen::Matrix3Xi t(3, static_cast<Eigen::Index>(tris.size()));
+    for (std::size_t i = 0; i < tris.size(); ++i) t.col(static_cast<Eigen::Index>(i)) = tris[i].index3();
+    out.triangles.push_back(std::move(t));
+  }
 }
 
 // lung surface: {"vertices": [{"cavity_vertices": [i, ...], "weights": [w, ...]}, ...], "triangles": [[a, b,
@@ -417,6 +435,36 @@ void validateModel(const Model& m) {
               "enclosed rest volume must be > 0 (outward orientation), got " + num(v0) + " m^3");
   }
 
+  // volume bodies: closed surfaces over tissue nodes, which the gut does not use
+  const VolumeBodies& vb = m.volumes;
+  if (static_cast<int>(vb.triangles.size()) != vb.size() || vb.kappa.size() != vb.size())
+    invalid("volume_bodies", "inconsistent array sizes");
+  std::set<std::string> bodyNames;
+  for (int k = 0; k < vb.size(); ++k) {
+    const std::string f = "volume_bodies[" + std::to_string(k) + "]";
+    const std::string& name = vb.name[static_cast<std::size_t>(k)];
+    if (name.empty()) invalid(f + ".name", "must not be empty");
+    if (!bodyNames.insert(name).second) invalid(f + ".name", "duplicate name '" + name + "'");
+    requirePositive(vb.kappa(k), f + ".kappa");
+    const Eigen::Matrix3Xi& t = vb.triangles[static_cast<std::size_t>(k)];
+    validateTriangles(t, f + ".triangles", nN);
+    for (int i = 0; i < t.cols(); ++i)
+      for (int c = 0; c < 3; ++c)
+        if (m.nodes.region[static_cast<std::size_t>(t(c, i))] != NodeRegion::Tissue)
+          invalid(f + ".triangles[" + std::to_string(i) + "]",
+                  "node " + std::to_string(t(c, i)) + " is not a tissue node (region \"tissue\")");
+    validateClosedSurface(t, f + ".triangles");
+    const double v0 = enclosedVolume(m.nodes.rest, t);
+    if (v0 <= 0.0)
+      invalid(f + ".triangles",
+              "enclosed rest volume must be > 0 (outward orientation), got " + num(v0) + " m^3");
+  }
+  for (int i = 0; i < m.gut.triangles.cols(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (m.nodes.region[static_cast<std::size_t>(m.gut.triangles(c, i))] == NodeRegion::Tissue)
+        invalid("gut.triangles[" + std::to_string(i) + "]",
+                "node " + std::to_string(m.gut.triangles(c, i)) + " is a tissue node (a volume body's)");
+
   // elements
   const int nE = m.elements.size();
   if (m.elements.endA.size() != nE || m.elements.endB.size() != nE || m.elements.restLength.size() != nE ||
@@ -527,7 +575,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   const JsonDocument doc = JsonDocument::parse(jsonText, sourceName);
   const Reader root = doc.root();
   root.allowKeys({"format", "version", "name", "anatomy", "units", "frame", "gravity", "bodies", "joints",
-                  "nodes", "gut", "elements", "cavity", "lungs", "landmarks", "skin"});
+                  "nodes", "gut", "volume_bodies", "elements", "cavity", "lungs", "landmarks", "skin"});
 
   // header
   if (root.at("format").string() != kFormatName)
@@ -607,8 +655,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
       m.nodes.region.push_back(NodeRegion::Diaphragm);
     else if (region == "fixed")
       m.nodes.region.push_back(NodeRegion::Fixed);
+    else if (region == "tissue")
+      m.nodes.region.push_back(NodeRegion::Tissue);
     else
-      n.at("region").fail("unknown region '" + excerptOf(region) + "' (expected wall, diaphragm or fixed)");
+      n.at("region").fail("unknown region '" + excerptOf(region) +
+                          "' (expected wall, diaphragm, fixed or tissue)");
   }
 
   // gut
@@ -622,6 +673,9 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.gut.triangles.resize(3, static_cast<Eigen::Index>(gutTris.size()));
   for (std::size_t i = 0; i < gutTris.size(); ++i)
     m.gut.triangles.col(static_cast<Eigen::Index>(i)) = gutTris[i].index3();
+
+  // volume bodies: optional; a model written before them has none (docs/model-format.md)
+  if (root.has("volume_bodies")) readVolumeBodies(root.at("volume_bodies"), m.volumes);
 
   // elements
   const Reader elements = root.at("elements");
@@ -760,6 +814,15 @@ std::string serializeModel(const Model& m) {
                 {"drag", m.gut.drag},
                 {"wall_tone_upright", m.gut.wallToneUpright},
                 {"triangles", triangles(m.gut.triangles)}};
+
+  if (m.volumes.size() > 0) {
+    json bodies = json::array();
+    for (int k = 0; k < m.volumes.size(); ++k)
+      bodies.push_back({{"name", m.volumes.name[static_cast<std::size_t>(k)]},
+                        {"kappa", m.volumes.kappa(k)},
+                        {"triangles", triangles(m.volumes.triangles[static_cast<std::size_t>(k)])}});
+    doc["volume_bodies"] = std::move(bodies);
+  }
 
   json elements = json::array();
   for (int i = 0; i < m.elements.size(); ++i) {

@@ -13,7 +13,7 @@
 namespace pneuma::sim {
 
 namespace {
-constexpr long long kCheckpointVersion = 2;  // 2 adds simulation.posture
+constexpr long long kCheckpointVersion = 3;  // 2 adds simulation.posture, 3 the volume bodies
 }  // namespace
 
 void validateSimulationOptions(const SimulationOptions& o) {

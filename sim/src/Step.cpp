@@ -84,7 +84,21 @@ StepWork makeStepWork(const Model& model) {
   w.constants.restGutVolume =
       model.gut.triangles.cols() > 0 ? enclosedVolume(model.nodes.rest, model.gut.triangles) : 0.0;
   w.outputs.gutVolume = w.constants.restGutVolume;
-  if (model.nodes.size() > 0) w.constants.restGutCentroid = model.nodes.rest.rowwise().mean();
+  {
+    // the gut's nodes: all but the volume bodies' (region Tissue)
+    std::vector<int> gutNodes;
+    for (int n = 0; n < nn; ++n)
+      if (model.nodes.region[at(n)] != NodeRegion::Tissue) gutNodes.push_back(n);
+    if (static_cast<int>(gutNodes.size()) == nn && nn > 0)
+      w.constants.restGutCentroid = model.nodes.rest.rowwise().mean();
+    else if (!gutNodes.empty())
+      w.constants.restGutCentroid = model.nodes.rest(Eigen::all, gutNodes).rowwise().mean();
+  }
+  w.constants.restBodyVolume.resize(model.volumes.size());
+  for (int k = 0; k < model.volumes.size(); ++k)
+    w.constants.restBodyVolume(k) = enclosedVolume(model.nodes.rest, model.volumes.triangles[at(k)]);
+  w.outputs.volumeBodyVolume = w.constants.restBodyVolume;
+  w.outputs.volumeBodyPressure = Eigen::VectorXd::Zero(model.volumes.size());
   const State rest = makeInitialState(model);
   if (model.cavity.triangles.cols() > 0) {
     anchorPositions(model.cavity.vertices, rest, w.scratch.cavityPosition);
@@ -178,6 +192,7 @@ StepWork makeStepWork(const Model& model) {
   w.scratch.bodyTorque = Eigen::Matrix3Xd::Zero(3, nb);
   w.scratch.nodeForce = Eigen::Matrix3Xd::Zero(3, nn);
   w.scratch.gutGradient = Eigen::Matrix3Xd::Zero(3, nn);
+  w.scratch.volumeGradient.assign(at(model.volumes.size()), Eigen::Matrix3Xd::Zero(3, nn));
   const Eigen::Index n = 6 * static_cast<Eigen::Index>(nb) + 3 * static_cast<Eigen::Index>(nn);
   w.scratch.cavityGeneralized = Eigen::VectorXd::Zero(n);
   w.scratch.bodyBlock = Eigen::MatrixXd::Zero(6 * nb, 6 * nb);
@@ -214,7 +229,7 @@ void step(const Model& model, State& state, double dt, const Activations& act, c
   if (options.integrator == IntegratorKind::ImplicitEulerJoints)
     solveJointVelocities(model, state, options, work);
 
-  // forces: muscles, cartilage, gut pressure, joint friction and stiffness, gravity
+  // forces: muscles, cartilage, gut and volume-body pressure, joint friction and stiffness, gravity
   computeForces(model, state, act, options, work);
 
   // integrate velocities
@@ -259,10 +274,10 @@ void checkState(const Model& model, const State& state, const StepWork& work, do
   for (int n = 0; n < model.nodes.size(); ++n) {
     const double v = state.nodeVelocity.col(n).norm();
     if (!std::isfinite(v) || !state.nodePosition.col(n).allFinite())
-      fail("gut node " + std::to_string(n) + " has a non-finite position or velocity");
+      fail("node " + std::to_string(n) + " has a non-finite position or velocity");
     if (v > kMaxSpeed) {
       std::ostringstream os;
-      os << "gut node " << n << " speed " << v << " m/s";
+      os << "node " << n << " speed " << v << " m/s";
       fail(os.str());
     }
   }

@@ -1,6 +1,6 @@
-// Stage 1 of step(), forces: muscles (Eq. 2) and structural springs with their linearisation, gut pressure
-// (Eq. 4, 5), pleural pressure (Cavity), joint friction (Eq. 3) and stiffness, visceral drag, gravity and the
-// gyroscopic torque (docs/integrator.md).
+// Stage 1 of step(), forces: muscles (Eq. 2) and structural springs with their linearisation, gut and
+// volume-body pressure (Eq. 4, 5), pleural pressure (Cavity), joint friction (Eq. 3) and stiffness, visceral
+// drag, gravity and the gyroscopic torque (docs/integrator.md).
 #include <algorithm>
 #include <cmath>
 
@@ -107,15 +107,27 @@ void accumulateElementForces(const Model& model, const State& s, const Activatio
   }
 }
 
-// gut pressure: P = kappa (V0/V - 1) (Eq. 4), force max(0, P) A n / 3 per face and vertex (Eq. 5)
+// pressure of one sealed node surface (the gut, a volume body): its volume V, P = kappa (V0/V - 1) (Eq. 4),
+// the gradient dV/dx, and the force max(0, P) A n / 3 per face and vertex (Eq. 5) = max(0, P) dV/dx
+void accumulateVolumePressure(const Eigen::Matrix3Xi& triangles, double kappa, double restVolume,
+                              const State& s, Eigen::Matrix3Xd& gradient, double& volume, double& pressure,
+                              StepWork& w) {
+  volume = enclosedVolume(s.nodePosition, triangles);
+  pressure = gutPressure(kappa, restVolume, volume);
+  gradient.setZero();
+  addVolumeGradient(s.nodePosition, triangles, 1.0, gradient);
+  if (pressure > 0.0) w.scratch.nodeForce += pressure * gradient;
+}
+
+// gut pressure (Gut) and the soft-tissue volume bodies' (VolumeBodies), Eq. 4 and 5
 void accumulateGutPressure(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
-  if (model.gut.triangles.cols() == 0) return;
-  w.outputs.gutVolume = enclosedVolume(s.nodePosition, model.gut.triangles);
-  w.outputs.gutPressure =
-      gutPressure(effectiveKappa(model, o), w.constants.restGutVolume, w.outputs.gutVolume);
-  w.scratch.gutGradient.setZero();
-  addVolumeGradient(s.nodePosition, model.gut.triangles, 1.0, w.scratch.gutGradient);
-  if (w.outputs.gutPressure > 0.0) w.scratch.nodeForce += w.outputs.gutPressure * w.scratch.gutGradient;
+  if (model.gut.triangles.cols() > 0)
+    accumulateVolumePressure(model.gut.triangles, effectiveKappa(model, o), w.constants.restGutVolume, s,
+                             w.scratch.gutGradient, w.outputs.gutVolume, w.outputs.gutPressure, w);
+  for (int k = 0; k < model.volumes.size(); ++k)
+    accumulateVolumePressure(model.volumes.triangles[at(k)], model.volumes.kappa(k),
+                             w.constants.restBodyVolume(k), s, w.scratch.volumeGradient[at(k)],
+                             w.outputs.volumeBodyVolume(k), w.outputs.volumeBodyPressure(k), w);
 }
 
 // [Pa] pleural pressure Ppl = min(0, -(P0 + (V - Vr) / C)) of Cavity, 0 when it has no compliance

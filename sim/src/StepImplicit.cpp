@@ -179,6 +179,14 @@ void applyStiffnessDamping(const Model& model, const StepOptions& o, const StepW
     const double gu = g.dot(u.tail(nodes));
     out.tail(nodes) += (kp * gu) * g;
   }
+  // and each volume body's, kappa_k V0_k / V_k^2 g_k g_k^T, likewise
+  for (int k = 0; k < model.volumes.size() && kScale != 0.0; ++k) {
+    const double v = w.outputs.volumeBodyVolume(k);
+    const double kp = kScale * model.volumes.kappa(k) * w.constants.restBodyVolume(k) / (v * v);
+    const Eigen::Index nodes = 3 * static_cast<Eigen::Index>(model.nodes.size());
+    const Eigen::Map<const Eigen::VectorXd> g(w.scratch.volumeGradient[at(k)].data(), nodes);
+    out.tail(nodes) += (kp * g.dot(u.tail(nodes))) * g;
+  }
   // rank-one pleural stiffness g_c g_c^T / C while the lungs pull (Ppl < 0), g_c = dV/dq of the cavity (its
   // geometric part -Ppl A^T H A, like the gut pressure's, is left out: it changed no energy figure
   // measurably)
@@ -342,6 +350,13 @@ void streamSystem(const Model& model, const StepOptions& o, const StepWork& w, d
   }
 }
 
+// the volume bodies' Sherman-Morrison corrections j < n, in order: z = (A0 + u u^T)^-1 r (the gut's term
+// applied) becomes (A0 + u u^T + sum_{j<n} u_j u_j^T)^-1 r
+void applyVolumeCorrections(const StepWork& w, int n, Eigen::VectorXd& z) {
+  for (int j = 0; j < n; ++j)
+    z -= (w.memory.volumeRankScale(j) * w.memory.volumeRank.col(j).dot(z)) * w.memory.volumeRankSolve.col(j);
+}
+
 // the preconditioner: a sparse LDLT factorization of the reduced system without the gut's rank-one term,
 // kept for several steps, plus that term by Sherman-Morrison; u = sqrt(kp) g over the free coordinates
 void factorSystem(const Model& model, const StepOptions& o, const std::vector<int>& tree, StepWork& w,
@@ -374,6 +389,27 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
   w.memory.rankOneSolve = w.memory.rankOne;
   w.memory.system.solve(w.memory.rankOneSolve);
   w.memory.rankOneScale = 1.0 / (1.0 + w.memory.rankOne.dot(w.memory.rankOneSolve));
+  // each volume body's u_k u_k^T likewise, on top of the gut's and the bodies' before it
+  const int nk = model.volumes.size();
+  w.memory.volumeRank.setZero(nf, nk);
+  w.memory.volumeRankSolve.setZero(nf, nk);
+  w.memory.volumeRankScale.setZero(nk);
+  for (int b = 0; b < nk; ++b) {
+    const double su = dt * std::sqrt(model.volumes.kappa(b) * w.constants.restBodyVolume(b)) /
+                      w.outputs.volumeBodyVolume(b);
+    for (Eigen::Index k = 0; k < nf; ++k) {
+      const Eigen::Index i =
+          w.constants.freeCoordinates(k) - 6 * static_cast<Eigen::Index>(model.bodies.size());
+      if (i >= 0) w.memory.volumeRank(k, b) = su * w.scratch.volumeGradient[at(b)](i % 3, i / 3);
+    }
+    w.scratch.compactZ = w.memory.volumeRank.col(b);
+    w.memory.system.solve(w.scratch.compactZ);
+    w.scratch.compactZ -=
+        (w.memory.rankOneScale * w.memory.rankOne.dot(w.scratch.compactZ)) * w.memory.rankOneSolve;
+    applyVolumeCorrections(w, b, w.scratch.compactZ);
+    w.memory.volumeRankSolve.col(b) = w.scratch.compactZ;
+    w.memory.volumeRankScale(b) = 1.0 / (1.0 + w.memory.volumeRank.col(b).dot(w.scratch.compactZ));
+  }
   // and the pleural one, v v^T with v = dt J^T g_c / sqrt(C), on top: (A1 + v v^T)^-1 = A1^-1 - A1^-1 v v^T
   // A1^-1 / (1 + v^T A1^-1 v), A1 = A0 + u u^T
   w.memory.rankTwo.resize(0);
@@ -389,6 +425,7 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     w.memory.system.solve(w.memory.rankTwoSolve);
     w.memory.rankTwoSolve -=
         (w.memory.rankOneScale * w.memory.rankOne.dot(w.memory.rankTwoSolve)) * w.memory.rankOneSolve;
+    applyVolumeCorrections(w, nk, w.memory.rankTwoSolve);
     w.memory.rankTwoScale = 1.0 / (1.0 + w.memory.rankTwo.dot(w.memory.rankTwoSolve));
   }
   w.memory.hasFactorization = true;
@@ -407,6 +444,7 @@ void applyPreconditioner(StepWork& w, const Eigen::VectorXd& r, Eigen::VectorXd&
   w.memory.system.solve(w.scratch.compactZ);
   w.scratch.compactZ -=
       (w.memory.rankOneScale * w.memory.rankOne.dot(w.scratch.compactZ)) * w.memory.rankOneSolve;
+  applyVolumeCorrections(w, static_cast<int>(w.memory.volumeRankScale.size()), w.scratch.compactZ);
   if (w.memory.rankTwo.size() > 0)
     w.scratch.compactZ -=
         (w.memory.rankTwoScale * w.memory.rankTwo.dot(w.scratch.compactZ)) * w.memory.rankTwoSolve;

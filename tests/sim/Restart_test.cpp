@@ -17,6 +17,7 @@
 #include <string>
 
 #include "DefaultModel.h"
+#include "ToyTorso.h"
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Recorder.h"
@@ -104,10 +105,12 @@ SimulationCheckpoint runToCheckpoint(Simulation& sim, std::string& text) {
 }
 
 // the uninterrupted run against three restarts from the checkpoint: a copy in a new Simulation, the same
-// Simulation sent back, and a file written, read back and loaded into a new Simulation
+// Simulation sent back, and a file written, read back and loaded into a new Simulation (the default model
+// unless `model` is given)
 void expectExactRestarts(const ControllerFactory& makeController, const std::string& name,
-                         const SimulationOptions& options = runOptions()) {
-  const auto model = defaultModel();
+                         const SimulationOptions& options = runOptions(),
+                         std::shared_ptr<const Model> model = nullptr) {
+  if (!model) model = defaultModel();
   Simulation whole(model, makeController(), options);
   std::string text;
   const SimulationCheckpoint checkpoint = runToCheckpoint(whole, text);
@@ -160,6 +163,17 @@ INSTANTIATE_TEST_SUITE_P(EveryStyle, BreathStyleRestart,
                              if (c == '-') c = '_';
                            return n;
                          });
+
+// the toy torso with two soft-tissue volume bodies (VolumeBodies): their rank-one terms in the solver memory
+// and their volumes in the step outputs travel with the checkpoint
+TEST(ExactRestart, VolumeBodiesContinueBitIdentically) {
+  Model toy = test::makeToyTorso(1);
+  test::addToyTissueBody(toy);
+  test::addToyTissueBody(toy, 5e4);
+  const BreathStyle calm = loadBreathStyle("calm");
+  expectExactRestarts([&] { return std::make_unique<BreathStyleController>(calm); }, "volume_bodies",
+                      runOptions(), std::make_shared<const Model>(std::move(toy)));
+}
 
 // lying on the back (gravity posterior, StepOptions::posture): the file carries the posture and the run goes
 // on bit-identically

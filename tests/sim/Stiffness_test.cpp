@@ -3,8 +3,10 @@
 // for the matrix-free product CG applies and for the matrix the preconditioner factors. q = [x_b, theta_b]_b
 // ++ [x_n]_n; a body turns by the rotation vector h theta about its com. K is exact but for two terms the
 // step leaves out on purpose (docs/integrator.md): the turning of a lever under a body-end force, d(r x f) =
-// (dtheta x r) x f, and the gut pressure's geometric part P d(grad V); the test adds both from the kernels,
-// so everything else must agree to rounding.
+// (dtheta x r) x f, and the gut pressure's geometric part P d(grad V) (and each volume body's); and the
+// negative transverse stiffness of a compressed two-sided spring. The test adds them from the kernels, so
+// everything else must agree to rounding. Each test runs on the toy torso and on the toy torso with a
+// soft-tissue volume body (VolumeBodies), squeezed like the gut.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -23,7 +25,8 @@ using Eigen::VectorXd;
 // the toy torso at a loaded configuration: mid-inhale activations (muscles in tension at rest length), the
 // gut squeezed by 3 % toward its centroid so its pressure pushes (P > 0) and every node nudged off the rest
 // pose, bodies at rest orientation (joint springs unloaded, where their linearisation is exact); at rest (no
-// velocity), no gravity, no pleural recoil (its own rank-one term is tested in Step_test)
+// velocity), no gravity, no pleural recoil (its own rank-one term is tested in Step_test); `withTissue` adds
+// a volume body (addToyTissueBody()), squeezed with the rest
 struct Loaded {
   Model model;
   State state;
@@ -31,9 +34,10 @@ struct Loaded {
   StepOptions options;
 };
 
-Loaded loaded() {
+Loaded loaded(bool withTissue = false) {
   Loaded l;
   l.model = test::makeToyTorso(2);
+  if (withTissue) test::addToyTissueBody(l.model);
   l.model.cavity.compliance = 0.0;
   l.options.gravity = false;
   for (int g = 0; g < kElementGroupCount; ++g) l.act[static_cast<std::size_t>(g)] = {0.8, 0.6};
@@ -87,9 +91,10 @@ VectorXd forceDerivative(const Loaded& l, const VectorXd& u) {
   return -(forces(l, displaced(l, u, h)) - forces(l, displaced(l, u, -h))) / (2.0 * h);
 }
 
-// the two terms the step leaves out of K, times u: the lever's turn under each body-end force, -(dtheta x r)
-// x f, and the gut pressure's geometric part, -P d(grad V)/dx u (grad V is quadratic in x: its central
-// difference is exact)
+// the terms the step leaves out of K, times u: the lever's turn under each body-end force, -(dtheta x r) x f,
+// the gut's and the volume bodies' pressure's geometric part, -P d(grad V)/dx u (grad V is quadratic in x:
+// its central difference is exact), and the negative transverse stiffness -F/l (I - d d^T) of a compressed
+// two-sided spring (F > 0; the squeezed volume body's springs)
 VectorXd omitted(const Loaded& l, const StepWork& w, const VectorXd& u) {
   VectorXd out = VectorXd::Zero(u.size());
   const Elements& el = l.model.elements;
@@ -103,15 +108,51 @@ VectorXd omitted(const Loaded& l, const StepWork& w, const VectorXd& u) {
       const Vector3d fe = side == 0 ? Vector3d(-f) : f;
       out.segment<3>(6 * b + 3) -= u.segment<3>(6 * b + 3).cross(r).cross(fe);
     }
+    if (w.outputs.elementForce(e) <= 0.0 || isMuscleGroup(el.group[static_cast<std::size_t>(e)])) continue;
+    // compressed spring: y = -F/l (I - d d^T) (du_B - du_A) on end B, -y on end A
+    Vector3d du[2];
+    for (int side = 0; side < 2; ++side) {
+      const AnchorSet& a = side == 0 ? el.endA : el.endB;
+      const int b = a.body[static_cast<std::size_t>(e)];
+      const Vector3d r = side == 0 ? w.scratch.leverA.col(e) : w.scratch.leverB.col(e);
+      du[side].setZero();
+      if (b >= 0)
+        du[side] = u.segment<3>(6 * b) + u.segment<3>(6 * b + 3).cross(r);
+      else
+        for (int k = 0; k < 3; ++k)
+          if (a.nodes(k, e) >= 0)
+            du[side] += a.weights(k, e) * u.segment<3>(detail::nodeOffset(l.model, a.nodes(k, e)));
+    }
+    const Vector3d d = w.scratch.elementDirection.col(e);
+    const Vector3d rel = du[1] - du[0];
+    const Vector3d y = -w.outputs.elementForce(e) / w.outputs.elementLength(e) * (rel - d.dot(rel) * d);
+    for (int side = 0; side < 2; ++side) {
+      const AnchorSet& a = side == 0 ? el.endA : el.endB;
+      const int b = a.body[static_cast<std::size_t>(e)];
+      const Vector3d ys = side == 0 ? Vector3d(-y) : y;
+      const Vector3d r = side == 0 ? w.scratch.leverA.col(e) : w.scratch.leverB.col(e);
+      if (b >= 0) {
+        out.segment<3>(6 * b) += ys;
+        out.segment<3>(6 * b + 3) += r.cross(ys);
+      } else
+        for (int k = 0; k < 3; ++k)
+          if (a.nodes(k, e) >= 0)
+            out.segment<3>(detail::nodeOffset(l.model, a.nodes(k, e))) += a.weights(k, e) * ys;
+    }
   }
-  const double p = std::max(w.outputs.gutPressure, 0.0);
   Eigen::Matrix3Xd x = l.state.nodePosition, du(3, l.model.nodes.size());
   for (int n = 0; n < l.model.nodes.size(); ++n) du.col(n) = u.segment<3>(detail::nodeOffset(l.model, n));
-  Eigen::Matrix3Xd gp = Eigen::Matrix3Xd::Zero(3, x.cols()), gm = gp;
-  addVolumeGradient(x + du, l.model.gut.triangles, 1.0, gp);
-  addVolumeGradient(x - du, l.model.gut.triangles, 1.0, gm);
-  for (int n = 0; n < l.model.nodes.size(); ++n)
-    out.segment<3>(detail::nodeOffset(l.model, n)) -= 0.5 * p * (gp.col(n) - gm.col(n));
+  auto geometric = [&](const Eigen::Matrix3Xi& triangles, double pressure) {
+    const double p = std::max(pressure, 0.0);
+    Eigen::Matrix3Xd gp = Eigen::Matrix3Xd::Zero(3, x.cols()), gm = gp;
+    addVolumeGradient(x + du, triangles, 1.0, gp);
+    addVolumeGradient(x - du, triangles, 1.0, gm);
+    for (int n = 0; n < l.model.nodes.size(); ++n)
+      out.segment<3>(detail::nodeOffset(l.model, n)) -= 0.5 * p * (gp.col(n) - gm.col(n));
+  };
+  geometric(l.model.gut.triangles, w.outputs.gutPressure);
+  for (int k = 0; k < l.model.volumes.size(); ++k)
+    geometric(l.model.volumes.triangles[static_cast<std::size_t>(k)], w.outputs.volumeBodyPressure(k));
   return out;
 }
 
@@ -137,11 +178,12 @@ VectorXd randomDirection(const StepWork& w, unsigned seed) {
 }
 
 // the matrix-free product that CG applies, in full coordinates
-TEST(Stiffness, ProductIsMinusTheForceDerivative) {
-  const Loaded l = loaded();
+void expectProductIsMinusTheForceDerivative(const Loaded& l) {
   StepWork w = makeStepWork(l.model);
   computeForces(l.model, l.state, l.act, l.options, w);
   ASSERT_GT(w.outputs.gutPressure, 100.0) << "the squeezed gut pushes";
+  for (int k = 0; k < l.model.volumes.size(); ++k)
+    ASSERT_GT(w.outputs.volumeBodyPressure(k), 100.0) << "the squeezed volume body pushes";
   ASSERT_GT((w.outputs.elementForce.array() < 0.0).count(), l.model.elements.size() / 4)
       << "muscles in tension";
   for (unsigned seed : {1u, 2u, 3u}) {
@@ -156,11 +198,17 @@ TEST(Stiffness, ProductIsMinusTheForceDerivative) {
   }
 }
 
+TEST(Stiffness, ProductIsMinusTheForceDerivative) { expectProductIsMinusTheForceDerivative(loaded()); }
+
+TEST(Stiffness, ProductWithAVolumeBodyIsMinusTheForceDerivative) {
+  expectProductIsMinusTheForceDerivative(loaded(true));
+}
+
 // the matrix the preconditioner factors, J^T (M + dt D + dt^2 K) J over the free coordinates of the joint
 // tree: quadratic in dt, so (A(1) + A(-1)) / 2 - A(0) is J^T K J exactly; with the gut's rank-one term that
-// the solver adds by Sherman-Morrison, J^T K J u equals J^T of the force derivative along J u
-TEST(Stiffness, AssembledMatrixIsMinusTheForceDerivativeInTheJointTreesCoordinates) {
-  const Loaded l = loaded();
+// the solver adds by Sherman-Morrison (and the volume bodies'), J^T K J u equals J^T of the force derivative
+// along J u
+void expectAssembledMatrixIsMinusTheForceDerivative(const Loaded& l) {
   StepWork w = makeStepWork(l.model);
   computeForces(l.model, l.state, l.act, l.options, w);
   const Eigen::MatrixXd k = 0.5 * (detail::assembledSystem(l.model, l.options, w, 1.0) +
@@ -181,6 +229,13 @@ TEST(Stiffness, AssembledMatrixIsMinusTheForceDerivativeInTheJointTreesCoordinat
     VectorXd expected = forceDerivative(l, ju) - omitted(l, w, ju);
     const Eigen::Map<const VectorXd> g(w.scratch.gutGradient.data(), nodes);
     expected.tail(nodes) -= kp * g.dot(ju.tail(nodes)) * g;
+    for (int b = 0; b < l.model.volumes.size(); ++b) {
+      const double v = w.outputs.volumeBodyVolume(b);
+      const double kb = l.model.volumes.kappa(b) * w.constants.restBodyVolume(b) / (v * v);  // [Pa/m^3]
+      const Eigen::Map<const VectorXd> gb(w.scratch.volumeGradient[static_cast<std::size_t>(b)].data(),
+                                          nodes);
+      expected.tail(nodes) -= kb * gb.dot(ju.tail(nodes)) * gb;
+    }
     detail::gatherJointForces(l.model.joints, w, tree, expected);  // J^T
     detail::maskReduced(l.model.joints, w, tree, expected);
     VectorXd uFree(free.size()), expectedFree(free.size());
@@ -190,6 +245,14 @@ TEST(Stiffness, AssembledMatrixIsMinusTheForceDerivativeInTheJointTreesCoordinat
     expectClose(k * uFree, expectedFree, bodyEntries, 1e-6, "seed " + std::to_string(seed));
   }
   EXPECT_LT((k - k.transpose()).norm(), 1e-9 * k.norm()) << "the factored stiffness is symmetric";
+}
+
+TEST(Stiffness, AssembledMatrixIsMinusTheForceDerivativeInTheJointTreesCoordinates) {
+  expectAssembledMatrixIsMinusTheForceDerivative(loaded());
+}
+
+TEST(Stiffness, AssembledMatrixWithAVolumeBodyIsMinusTheForceDerivative) {
+  expectAssembledMatrixIsMinusTheForceDerivative(loaded(true));
 }
 
 }  // namespace

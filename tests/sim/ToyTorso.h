@@ -320,6 +320,58 @@ inline Model makeToyTorso(int gutSubdivisions = 2) {
   return m;
 }
 
+/// Appends a soft-tissue volume body (VolumeBodies) to a toy torso: a flattened icosphere lens (one
+/// subdivision: 42 Tissue nodes, 0.2 kg) over rib 3 right's front, its faces' edges two-sided Cartilage
+/// springs, and each node on its deep face (toward the rib) tied to the rib by three Cartilage springs along
+/// the world axes (zero-length-spring stiffness k I for small motions, Zordan et al. 2004, Section 7).
+/// `kappa` [Pa] is its bulk modulus; returns the index of its outermost node (the lens's apex).
+inline int addToyTissueBody(Model& m, double kappa = 2e4) {
+  using Eigen::Vector3d;
+  int rib = -1;
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies.name[static_cast<std::size_t>(b)] == "rib3_right") rib = b;
+  const Vector3d normal = Vector3d(0.75, 0.66, 0.0).normalized();  // [-] outward, anterolateral
+  const Vector3d centre(0.115, 0.075, 0.34);                       // [m] just outside the rib's front
+  const Vector3d side = Vector3d::UnitZ().cross(normal);
+  Eigen::Matrix3Xd unit;
+  Eigen::Matrix3Xi faces;
+  icosphere(1, unit, faces);
+  const int first = m.nodes.size(), n = static_cast<int>(unit.cols());
+  m.nodes.rest.conservativeResize(3, first + n);
+  m.nodes.mass.conservativeResize(first + n);
+  int apex = first;
+  for (int i = 0; i < n; ++i) {
+    const Vector3d u = unit.col(i);
+    m.nodes.rest.col(first + i) = centre + 0.035 * u.x() * side + 0.03 * u.z() * Vector3d::UnitZ() +
+                                  0.012 * u.y() * normal;  // [m] a lens 70 x 60 x 24 mm
+    m.nodes.mass(first + i) = 0.2 / n;                     // [kg]
+    m.nodes.region.push_back(NodeRegion::Tissue);
+    if (u.y() > unit.col(apex - first).y()) apex = first + i;
+  }
+  faces.array() += first;
+  // the map above may mirror the icosphere: outward normals again
+  if (enclosedVolume(m.nodes.rest, faces) < 0.0) faces.row(1).swap(faces.row(2));
+  m.volumes.name.push_back("toy_tissue_" + std::to_string(m.volumes.size()));
+  m.volumes.triangles.push_back(faces);
+  m.volumes.kappa.conservativeResize(m.volumes.size());
+  m.volumes.kappa(m.volumes.size() - 1) = kappa;
+  std::map<std::pair<int, int>, bool> edges;
+  for (Eigen::Index f = 0; f < faces.cols(); ++f)
+    for (int k = 0; k < 3; ++k) edges[std::minmax(faces(k, f), faces((k + 1) % 3, f))] = true;
+  for (const auto& [e, unused] : edges) {
+    (void)unused;
+    addElement(m, ElementGroup::Cartilage, End{-1, e.first, {}}, End{-1, e.second, {}}, 0.0, 200.0, 0.2);
+  }
+  for (int i = first; i < first + n; ++i) {
+    if ((m.nodes.rest.col(i) - centre).dot(normal) > 0.0) continue;
+    for (int k = 0; k < 3; ++k)
+      addElement(m, ElementGroup::Cartilage,
+                 End{rib, -1, Vector3d(m.nodes.rest.col(i)) + 0.02 * Vector3d::Unit(k)}, End{-1, i, {}}, 0.0,
+                 500.0, 0.5);
+  }
+  return apex;
+}
+
 /// The rest state with random velocities: N(0, nodeSpeed^2) [m/s] per moving node axis and N(0, spin^2)
 /// [rad/s] per moving body axis, from a fixed seed (the energy tests' initial condition).
 inline State randomVelocityState(const Model& m, double nodeSpeed, double spin, unsigned seed = 3) {

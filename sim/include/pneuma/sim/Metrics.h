@@ -32,6 +32,9 @@ struct Metrics {
   /// [m^3] coneVolume() from the gut's rest centroid over its abdominal-wall faces (at least two Wall nodes):
   /// its change is the volume the abdominal wall displaces, the abdomen compartment of Konno & Mead (1967)
   double abdomenVolume = 0.0;
+  /// [-] signed relative volume error (V_k - V0_k) / V0_k of each soft-tissue volume body (Model::volumes)
+  /// (#K)
+  Eigen::VectorXd volumeBodyError;
   Eigen::VectorXd elementForce;       ///< [N] signed scalar force per element, <= 0 is tension (#E)
   std::vector<std::uint8_t> isSlack;  ///< 1 when a muscle element carries no force (#E)
   /// [N] mean over each group's elements of their tension max(0, -F) (slack ones count 0): a per-element
@@ -41,7 +44,7 @@ struct Metrics {
   Activations activations{};   ///< control input in effect at this frame
   double kineticEnergy = 0.0;  ///< [J] sum of 1/2 m v^2 + 1/2 w^T I w over bodies and nodes
   double elasticEnergy =
-      0.0;  ///< [J] springs (one-sided muscles, two-sided cartilage), gut pressure, spine joints
+      0.0;  ///< [J] springs (one-sided muscles, two-sided cartilage), gut and volume-body pressure, joints
   double gravityEnergy = 0.0;  ///< [J] -m g . x summed with the posture's g (postureGravity()), relative to
                                ///< the rest pose (0 when gravity is off)
   double maxJointError = 0.0;  ///< [m] largest ball-joint separation after the step

@@ -105,10 +105,12 @@ struct Joints {
 enum class NodeRegion : std::uint8_t {
   Wall = 0,       ///< anterior and lateral abdominal wall (moving)
   Diaphragm = 1,  ///< the diaphragm dome (moving)
-  Fixed = 2       ///< the fixed back and bottom, and the dome rim's posterior (crural) arc
+  Fixed = 2,      ///< the fixed back and bottom, and the dome rim's posterior (crural) arc
+  Tissue = 3      ///< a node of a soft-tissue volume body (VolumeBodies: pectoral, shoulder), not of the gut
 };
 
-/// Point masses of the deformable gut surface (Section 6.1).
+/// Point masses of the deformable bodies: the gut surface (Section 6.1) and the soft-tissue volume bodies
+/// (VolumeBodies, region Tissue), which share these arrays.
 struct Nodes {
   Eigen::Matrix3Xd rest;           ///< [m] rest positions, world   (3 x #N)
   Eigen::VectorXd mass;            ///< [kg] point masses; moving wall masses add up to 8 kg (#N)
@@ -134,6 +136,23 @@ struct Gut {
   /// tonically active upright (De Troyer 1983, Respir Physiol 53:341; Loring & Mead 1982, J Appl Physiol
   /// 52:700), which stiffens the wall and shifts breathing toward the rib cage. Our addition, in [0, 0.5].
   double wallToneUpright = 0.0;
+};
+
+/// Further sealed deformable bodies that keep their volume as the gut does (Section 6.2, Eq. 4, 5): the soft
+/// tissue of the pectorals and the shoulders (Zordan et al. 2004, Section 7: "volume-preserving bodies ...
+/// attached with a number of strategically placed, zero-length springs"). Each body k is a closed surface
+/// over the shared Nodes (region Tissue) with
+///   P_k = kappa_k (V0_k / V_k - 1)  (Eq. 4),  f_j = sum_i max[0, P_k A_i n_i / 3]  (Eq. 5),
+/// V0_k the volume its triangles enclose at the nodes' rest positions. The springs that shape and carry it
+/// (Cartilage elements between its nodes, and from its deep nodes to the bones) are ordinary Elements. The
+/// gut is not in this list: it keeps its own block (Gut), and the step treats it by the same kernel. An empty
+/// list is a model without them (models written before them).
+struct VolumeBodies {
+  std::vector<std::string> name;            ///< unique names, e.g. "pectoral_left" (#K)
+  std::vector<Eigen::Matrix3Xi> triangles;  ///< node indices, outward normals, one closed surface each (#K)
+  Eigen::VectorXd kappa;                    ///< [Pa] bulk modulus kappa_k of Eq. 4, > 0 (#K)
+
+  int size() const { return static_cast<int>(name.size()); }
 };
 
 /// Spring elements: muscles (Eq. 2) and structural springs (cartilage).
@@ -256,6 +275,7 @@ struct Model {
   Joints joints;
   Nodes nodes;
   Gut gut;
+  VolumeBodies volumes;  ///< may be empty (models written before the soft-tissue volume bodies)
   Elements elements;
   Cavity cavity;
   Lungs lungs;

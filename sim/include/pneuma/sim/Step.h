@@ -2,7 +2,8 @@
 /// @file Step.h
 /// One simulation step, written as a pipeline of named stages (as MuJoCo's mj_step); docs/integrator.md has
 /// the design, the integrators, the linear solve and the reasons for them.
-///   1. forces      muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), pleural pressure (Cavity),
+///   1. forces      muscles (Eq. 2), cartilage springs, gut and volume-body pressure (Eq. 4, 5; Gut,
+///                  VolumeBodies), pleural pressure (Cavity),
 ///                  joint friction (Eq. 3), joint stiffness (spine; rib-neck hinges, Joints), visceral drag
 ///                  (Gut::drag), gravity                                            (StepForces.cpp)
 ///   2. integrate   velocities: SymplecticEuler, the paper's explicit scheme (Step.cpp), or the default
@@ -146,7 +147,8 @@ struct StepConstants {
   Eigen::Vector3d restGutCentroid = Eigen::Vector3d::Zero();  ///< [m] centroid of the gut nodes at rest
   /// gut faces with at least two Wall nodes (the abdominal wall) (3 x #F')
   Eigen::Matrix3Xi wallTriangles;
-  double restCavityVolume = 0.0;  ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
+  double restCavityVolume = 0.0;   ///< [m^3] Vr, the cavity's volume at the rest pose (Cavity)
+  Eigen::VectorXd restBodyVolume;  ///< [m^3] V0_k of each soft-tissue volume body (Model::volumes) (#K)
   /// [-] each element's share in the body's right half, rightShare() of the x of its rest midpoint (#E)
   Eigen::VectorXd elementRightShare;
   /// body of endpoint A (row 0) / B (row 1), -1 for node endpoints (2 x #E)
@@ -192,8 +194,14 @@ struct SolverMemory {
   /// [kg^1/2] v = dt J^T g_c / sqrt(C) over the free coordinates, the pleural stiffness at the factorization;
   /// empty when it had none
   Eigen::VectorXd rankTwo;
-  Eigen::VectorXd rankTwoSolve;      ///< [1/kg^1/2] (A0 + u u^T)^-1 v (#free)
-  double rankTwoScale = 1.0;         ///< [-] 1 / (1 + v^T (A0 + u u^T)^-1 v)
+  Eigen::VectorXd rankTwoSolve;  ///< [1/kg^1/2] (A0 + u u^T)^-1 v (#free)
+  double rankTwoScale = 1.0;     ///< [-] 1 / (1 + v^T (A0 + u u^T)^-1 v)
+  /// [kg^1/2] u_k = dt sqrt(kappa_k V0_k) / V_k g_k of each volume body k (Model::volumes), the rank-one
+  /// pressure stiffness like the gut's, over the free coordinates (#free x #K); added after the gut's and
+  /// before the pleural term by Sherman-Morrison, in order
+  Eigen::MatrixXd volumeRank;
+  Eigen::MatrixXd volumeRankSolve;   ///< [1/kg^1/2] (A0 + u u^T + sum_{j<k} u_j u_j^T)^-1 u_k (#free x #K)
+  Eigen::VectorXd volumeRankScale;   ///< [-] 1 / (1 + u_k^T volumeRankSolve_k) (#K)
   double factorDt = 0.0;             ///< [s] dt of the factorization
   Eigen::VectorXd factorAxial;       ///< [kg] dt^2 k + dt b of every element at the factorization (#E)
   Eigen::VectorXd factorTransverse;  ///< [kg] dt^2 |F| / l at the factorization (#E)
@@ -212,8 +220,10 @@ struct StepScratch {
   Eigen::Matrix3Xd bodyForce, bodyTorque;  ///< [N], [N m] world, stage 1's sums (3 x #B)
   Eigen::Matrix3Xd nodeForce;              ///< [N] stage 1's sums (3 x #N)
   Eigen::Matrix3Xd gutGradient;            ///< [m^2] dV/dx per node (3 x #N)
-  Eigen::Matrix3Xd cavityPosition;         ///< [m] cavity vertices at the start of the step (3 x #C)
-  Eigen::Matrix3Xd cavityGradient;         ///< [m^2] dV/dx per cavity vertex (3 x #C)
+  /// [m^2] dV_k/dx per node of each volume body k (Model::volumes) (#K of 3 x #N)
+  std::vector<Eigen::Matrix3Xd> volumeGradient;
+  Eigen::Matrix3Xd cavityPosition;  ///< [m] cavity vertices at the start of the step (3 x #C)
+  Eigen::Matrix3Xd cavityGradient;  ///< [m^2] dV/dx per cavity vertex (3 x #C)
   /// [m^2, m^3] dV/dq of the cavity over the implicit solver's entries (6 #B + 3 #N) at the start of the
   /// step, filled while Ppl < 0
   Eigen::VectorXd cavityGeneralized;
@@ -256,12 +266,14 @@ struct StepScratch {
 
 /// By-products of the last step that the metrics, the blow-up check and the views read.
 struct StepOutputs {
-  Eigen::VectorXd elementForce;   ///< [N] scalar force per element of the last step (#E)
-  Eigen::VectorXd elementLength;  ///< [m] length per element at the start of the last step (#E)
-  double gutVolume = 0.0;         ///< [m^3] V at the start of the last step
-  double gutPressure = 0.0;       ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
-  double pleuralPressure = 0.0;   ///< [Pa] Ppl of Cavity at the start of the last step (<= 0)
-  double maxJointError = 0.0;     ///< [m] largest joint separation after the last step
+  Eigen::VectorXd elementForce;        ///< [N] scalar force per element of the last step (#E)
+  Eigen::VectorXd elementLength;       ///< [m] length per element at the start of the last step (#E)
+  double gutVolume = 0.0;              ///< [m^3] V at the start of the last step
+  double gutPressure = 0.0;            ///< [Pa] P of Eq. 4 at the start of the last step (unclamped)
+  double pleuralPressure = 0.0;        ///< [Pa] Ppl of Cavity at the start of the last step (<= 0)
+  Eigen::VectorXd volumeBodyVolume;    ///< [m^3] V_k of each volume body at the start of the last step (#K)
+  Eigen::VectorXd volumeBodyPressure;  ///< [Pa] P_k of Eq. 4 of each volume body, unclamped (#K)
+  double maxJointError = 0.0;          ///< [m] largest joint separation after the last step
 };
 
 /// Everything step() works with besides the Model and the State, split as MuJoCo splits mjModel from mjData:
