@@ -17,8 +17,6 @@ using sim::ElementGroup;
 
 constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib that makes intercostals oblique
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
-constexpr double kAppositionReach = 0.04;    // [m] farthest rib point an apposed dome node is tied to
-constexpr std::size_t kAppositionRings = 3;  // [-] dome rings inside the rim that lie on the rib cage
 // [m] how far beyond the rib point an apposition spring is anchored (in the rib's frame), along the line from
 // the dome node: a spring this long holds the node at its distance from the rib face and lets it slide along
 // the face
@@ -154,15 +152,18 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
 /// there by the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs
 /// rather than bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer &
 /// Wilson 2016, J Appl Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide
-/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. Each node of
-/// the first kAppositionRings rings inside the rim gets a two-sided spring (Cartilage group) toward the
-/// nearest point of the inner face of ribs 6-12, or of the front of the vertebral bodies T10-L1 beside the
-/// crura (where the dome lies on the spine; without it the dome's rings over the spine fold backward on
-/// themselves while the model settles), within kAppositionReach, anchored kAppositionSlide beyond
-/// that point on the same line: a long spring resists a change of the node's distance to the face and hardly
-/// a slide across it (a slide s lengthens it by about s^2 / 2 l). Its stiffness and damping along the line
-/// are those of a spring reaching only the rib point, the cartilage group's times `fraction`.
-void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, ElementSink& sink) {
+/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. The dome
+/// rings inside the rim whose rise above the costal margin's mean level (GutSurface::domeRingRise) is at most
+/// the zone's height `a.abdomen.appositionHeight` lie in the zone. Each of their nodes gets a
+/// two-sided spring (Cartilage group) toward the nearest point of the inner face of ribs 6-12, or of the
+/// front of the vertebral bodies T10-L1 beside the crura (where the dome lies on the spine; without it the
+/// dome's rings over the spine fold backward on themselves while the model settles), within
+/// `a.abdomen.appositionReach`, anchored kAppositionSlide beyond that point on the same line: a long spring
+/// resists a change of the node's distance to the face and hardly a slide across it (a slide s lengthens it
+/// by about s^2 / 2 l). Its stiffness and damping along the line are those of a spring reaching only the rib
+/// point, the cartilage group's times `a.gains.appositionFraction`.
+void addApposition(const AnatomyParams& a, const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
+  const double fraction = a.gains.appositionFraction;
   if (fraction <= 0.0) return;
   std::vector<Endpoint> face;
   for (int level = 6; level <= 12; ++level) {
@@ -181,12 +182,13 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
   for (const Eigen::Vector3d& c : spineFront)
     for (double x : {-kVertebralFrontHalfWidth, 0.0, kVertebralFrontHalfWidth})
       face.push_back(Endpoint::onBody(sk.lumbar, c + Eigen::Vector3d(x, 0, 0)));
-  for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
+  for (std::size_t ring = 1; ring < gut.domeRing.size(); ++ring) {
+    if (gut.domeRingRise[ring] > a.abdomen.appositionHeight) break;
     for (int node : gut.domeRing[ring]) {
       const Eigen::Vector3d p = gut.rest.col(node);
       const Endpoint& rib = nearest(face, p);
       const double reach = (rib.world - p).norm();
-      if (reach > kAppositionReach || reach < 1e-6) continue;
+      if (reach > a.abdomen.appositionReach || reach < 1e-6) continue;
       const Endpoint anchor =
           Endpoint::onBody(rib.body, rib.world + kAppositionSlide * (rib.world - p) / reach);
       sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), anchor, 0.0,
@@ -427,7 +429,7 @@ void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   ElementSink sink(a.gains, model);
   addIntercostals(a, sk, sink);
   addDiaphragm(sk, gut, sink);
-  addApposition(sk, gut, a.gains.appositionFraction, sink);
+  addApposition(a, sk, gut, sink);
   addRectus(sk, gut, sink);
   addTransversusObliques(gut, sink);
   addCartilage(sk, sink);
