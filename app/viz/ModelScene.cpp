@@ -993,11 +993,12 @@ void ModelScene::setOptions(const DisplayOptions& options) {
 const DisplayOptions& ModelScene::options() const { return m_impl->options; }
 
 const std::vector<std::pair<std::string, CameraPreset>>& cameraPresets() {
-  static const std::vector<std::pair<std::string, CameraPreset>> presets{{"anterior", CameraPreset::Anterior},
-                                                                          {"lateral", CameraPreset::Lateral},
-                                                                          {"superior", CameraPreset::Superior},
-                                                                          {"posterior", CameraPreset::Posterior},
-                                                                          {"oblique", CameraPreset::Oblique}};
+  static const std::vector<std::pair<std::string, CameraPreset>> presets{
+      {"anterior", CameraPreset::Anterior},
+      {"lateral", CameraPreset::Lateral},
+      {"superior", CameraPreset::Superior},
+      {"posterior", CameraPreset::Posterior},
+      {"oblique", CameraPreset::Oblique}};
   return presets;
 }
 
