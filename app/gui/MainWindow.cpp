@@ -29,6 +29,7 @@
 #include <QPushButton>
 #include <QScrollArea>
 #include <QSlider>
+#include <QStandardItemModel>
 #include <QStatusBar>
 #include <QStyle>
 #include <QTabWidget>
@@ -59,7 +60,8 @@ constexpr int kRefreshMs = 33;  // [ms] display refresh: 30 Hz
 // [ms] a 3D render at most this long is drawn at every refresh: with the plots' few milliseconds both stay
 // above 20 Hz (50 ms per refresh); a slower one waits its turn so that it cannot starve the plots
 constexpr double kRenderEveryRefreshMs = 36.0;
-constexpr double kRecordSeconds = 60.0;                  // [s] recorded for the timeline
+constexpr double kRecordSeconds = 60.0;        // [s] recorded for the timeline
+constexpr const char* kDriverItem = "driver";  // item data of the style box's entry for an affect or pattern
 constexpr const char* kSimulationThread = "pneuma-sim";  // the simulation thread's name (CpuClock.h)
 
 const std::vector<std::pair<QString, double>> kSpeeds{
@@ -400,6 +402,45 @@ void MainWindow::buildActions() {
   simMenu->addAction(m_playAction);
   simMenu->addAction(step);
   simMenu->addAction(reset);
+
+  // help: a lecturer's quick guide with the shortcuts, and where the model comes from
+  QMenu* help = menuBar()->addMenu("&Help");
+  QAction* guide = help->addAction("&Quick guide", this, [this] {
+    QMessageBox box(QMessageBox::Information, "Pneuma quick guide", quickGuide(), QMessageBox::Close, this);
+    box.setTextFormat(Qt::RichText);
+    box.exec();
+  });
+  guide->setShortcut(QKeySequence::HelpContents);
+  help->addAction("&About Pneuma", this, [this] { QMessageBox::about(this, "About Pneuma", aboutText()); });
+}
+
+QString MainWindow::quickGuide() {
+  return "<p><b>Show the breath.</b> The view magnifies every motion from end-expiration (<i>Parameters</i> "
+         "&gt; "
+         "<i>Motion magnification</i>, 5x by default; the view says so). Plots and read-outs stay real.</p>"
+         "<p><b>Name the parts.</b> <i>Display</i>: structures, <i>Anatomical labels</i>, cameras (anterior, "
+         "lateral, superior, posterior, oblique). Click a muscle element to plot its tension.</p>"
+         "<p><b>Change the breathing.</b> The toolbar's breath style; push an affect (fear, relief, ...); "
+         "<i>Scenarios</i> &gt; <i>Teaching</i> for the presets (paralysed hemidiaphragm, stiff chest wall, "
+         "...) and <i>Compare with</i> to draw a second run dashed over the plots.</p>"
+         "<p><b>Export.</b> <i>File</i> &gt; <i>Export</i>: the plots, a screenshot, a movie (Ogg or MP4), a "
+         "ParaView series, glTF for animation tools.</p>"
+         "<p><b>Keys.</b> Space: play or pause. M: morph playback. F1: this guide. Drag: rotate; wheel: "
+         "zoom; "
+         "the timeline scrubs back through the last 60 s.</p>"
+         "<p>The user guide is docs/app.md in the source tree.</p>";
+}
+
+QString MainWindow::aboutText() {
+  return QString(
+             "<p><b>Pneuma %1</b>: human breathing simulated from the inside out.</p>"
+             "<p>The mechanics follow Zordan, Celly, Chiu and DiLorenzo, <i>Breathe Easy: Model and Control "
+             "of Simulated Respiration for Animation</i> (SCA 2004); the respiration patterns and affects "
+             "de Melo, Kenny and Gratch, <i>Real-Time Expression of Affect through Respiration</i> (CAVW "
+             "2010).</p>"
+             "<p>Licence: GNU AGPL 3.0 or later (it links TetGen, AGPL, and CGAL, GPL). The body surface is "
+             "the MakeHuman base mesh shipped in Debian's assimp-testmodels.</p>")
+      .arg(QApplication::applicationVersion());
 }
 
 void MainWindow::buildDocks() {
@@ -437,12 +478,10 @@ void MainWindow::buildDocks() {
 
   auto* camera = new QGroupBox("Camera", display);
   auto* cameraLayout = new QGridLayout(camera);
-  const std::vector<std::pair<QString, viz::CameraPreset>> presets{{"Anterior", viz::CameraPreset::Anterior},
-                                                                   {"Lateral", viz::CameraPreset::Lateral},
-                                                                   {"Superior", viz::CameraPreset::Superior},
-                                                                   {"Oblique", viz::CameraPreset::Oblique}};
-  for (const auto& [name, preset] : presets) {
-    auto* button = new QPushButton(name, camera);
+  for (const auto& [name, preset] : viz::cameraPresets()) {
+    QString label = QString::fromStdString(name);
+    label[0] = label[0].toUpper();
+    auto* button = new QPushButton(label, camera);
     connect(button, &QPushButton::clicked, this, [this, preset = preset] {
       m_scene->setCamera(preset);
       m_view->renderWindow()->Render();
@@ -668,6 +707,7 @@ QString MainWindow::openModel(const QString& dir) {
   m_morphs.reset();
   updatePlaybackAction();
   m_drive = nullptr;  // a new model starts with the breath style
+  showDriver();
   const std::shared_ptr<const sim::Model>& model = opened.model;
   m_selected = {};
   m_plots->clearTraces();
@@ -727,8 +767,7 @@ QString MainWindow::openScenario(const QString& path) {
       m_affectCombo->setCurrentText(QString::fromStdString(m_drive->controllerName));
     }
   }
-  const QSignalBlocker block(m_styleCombo);
-  m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
+  showDriver();
   m_scenarioNote->setText(scenario.description.isEmpty() ? scenario.name
                                                          : scenario.name + "\n\n" + scenario.description);
   m_scenarioDock->show();
@@ -809,6 +848,7 @@ QString MainWindow::openTrace(const QString& path) {
   }
   m_drive = std::move(drive);
   m_worker->requestScenario(m_drive);
+  showDriver();
   showMessage(QString("Following trace '%1'").arg(QFileInfo(path).fileName()), 5000);
   return {};
 }
@@ -833,9 +873,8 @@ QString MainWindow::setBreathStyle(const QString& name) {
     return e.what();
   }
   m_drive = nullptr;
-  const QSignalBlocker block(m_styleCombo);
-  m_styleCombo->setCurrentText(name);
   m_params->setSettings(m_settings, m_document.model());
+  showDriver();
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
   if (m_worker) m_worker->requestSettings(m_settings);
   return {};
@@ -872,6 +911,7 @@ QString MainWindow::pushAffect(const QString& name, bool isImmediate) {
   drive->controller = sim::ControllerKind::Affect;
   drive->controllerName = name.toStdString();
   m_drive = std::move(drive);
+  showDriver();
   showMessage(
       QString("Affect '%1' pushed %2").arg(name, isImmediate ? "immediately" : "for the end of the cycle"),
       5000);
@@ -888,6 +928,29 @@ QString MainWindow::setMagnification(double factor) {
   o.magnification = factor;
   setDisplayOptions(o);
   return {};
+}
+
+void MainWindow::showDriver() {
+  QString driver;
+  if (m_drive && m_drive->controller != sim::ControllerKind::Style) {
+    const std::string& name = m_drive->controllerName.empty() ? m_drive->name : m_drive->controllerName;
+    driver = QString("%1 '%2'").arg(sim::controllerKindName(m_drive->controller),
+                                    QFileInfo(QString::fromStdString(name)).completeBaseName());
+  }
+  // the style box: the style in play, or a disabled entry naming what drives instead of it
+  const QSignalBlocker block(m_styleCombo);
+  const int previous = m_styleCombo->findData(kDriverItem);
+  if (previous >= 0) m_styleCombo->removeItem(previous);
+  if (driver.isEmpty()) {
+    m_styleCombo->setCurrentText(QString::fromStdString(m_settings.style.name));
+  } else {
+    m_styleCombo->addItem(driver, kDriverItem);
+    const int index = m_styleCombo->count() - 1;
+    if (auto* items = qobject_cast<QStandardItemModel*>(m_styleCombo->model()))
+      items->item(index)->setEnabled(false);
+    m_styleCombo->setCurrentIndex(index);
+  }
+  m_params->setDriver(driver);
 }
 
 void MainWindow::play() { m_playAction->setChecked(true); }

@@ -140,6 +140,8 @@ class MainWindow : public QMainWindow {
   SimWorker* worker() const { return m_worker; }
   LivePlots* plots() const { return m_plots; }
   ParameterPanel* parameters() const { return m_params; }
+  /// The toolbar's breath-style box (it names the affect, pattern or trace while one drives).
+  QComboBox* styleBox() const { return m_styleCombo; }
   /// The Breathing read-out's text: the last breaths' figures in people's units (Snapshot::breathing).
   QString breathingReadout() const;
   /// The snapshot on screen (null before the first one).
@@ -168,6 +170,10 @@ class MainWindow : public QMainWindow {
   Rates rates() const;
   /// Sets the simulation speed: simulated seconds per wall second, 0 = as fast as possible.
   void setSpeed(double speed);
+  /// Help > Quick guide: a lecturer's tasks and the keys, as rich text.
+  static QString quickGuide();
+  /// Help > About: version, sources, licence, as rich text.
+  static QString aboutText();
   /// The last error reported to the user (model, scenario, export or simulation).
   QString lastError() const { return m_lastError; }
 
@@ -194,6 +200,9 @@ class MainWindow : public QMainWindow {
   void select(const viz::Pick& pick);
   void exportPlotInteractive(const PlotView* plot);
   void updateTimeline();
+  /// The style box and the parameter panel show what drives the breathing: the breath style, or the affect,
+  /// pattern or trace of m_drive (a disabled entry in the style box; the style's fields disabled).
+  void showDriver();
   /// Enables View > Morph playback for a model with a skin, else disables it with the reason as tooltip.
   void updatePlaybackAction();
 
@@ -234,7 +243,7 @@ class MainWindow : public QMainWindow {
   QComboBox* m_skinColour = nullptr;   // the skin: plain or displacement
   std::vector<std::pair<QCheckBox*, bool viz::DisplayOptions::*>> m_structureChecks;  // each with its option
   std::vector<QCheckBox*> m_groupChecks;
-  std::vector<QPushButton*> m_cameraButtons;  // anterior, lateral, superior, oblique
+  std::vector<QPushButton*> m_cameraButtons;  // viz::cameraPresets(), in order
   QLabel* m_selection = nullptr;
   QLabel* m_breathing = nullptr;          // Snapshot::breathing, in people's units
   QLabel* m_scenarioNote = nullptr;       // the opened scenario's name and description

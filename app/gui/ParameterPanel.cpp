@@ -6,6 +6,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QVBoxLayout>
+#include <algorithm>
 
 #include "pneuma/sim/Error.h"
 #include "viz/ModelScene.h"
@@ -21,10 +22,25 @@ void setMuscleScale(std::array<double, sim::kElementGroupCount>& scales, double 
     if (sim::isMuscleGroup(static_cast<sim::ElementGroup>(g))) scales[static_cast<std::size_t>(g)] = v;
 }
 
+// a validator's message in a reader's words: without the style's name in front (the panel edits the style in
+// play) and with the file format's snake_case keys as words ("breaths_per_minute" -> "breaths per minute")
+QString plainReason(const std::string& message) {
+  QString text = QString::fromStdString(message);
+  if (text.startsWith("breath style '")) {
+    const int end = text.indexOf("': ");
+    if (end > 0) text = text.mid(end + 3);
+  }
+  return text.replace('_', ' ');
+}
+
 }  // namespace
 
 ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
   auto* layout = new QVBoxLayout(this);
+  m_driver = new QLabel;
+  m_driver->setWordWrap(true);
+  m_driver->hide();
+  layout->addWidget(m_driver);
   auto* form = new QFormLayout;
   form->setFieldGrowthPolicy(QFormLayout::ExpandingFieldsGrow);
   layout->addLayout(form);
@@ -45,6 +61,7 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
       "Intercostal r \u00b1", "-", "Amplitude of the intercostal sinusoids (Table 2)",
       [](const RunSettings& s) { return s.style.intercostalAmplitude; },
       [](RunSettings& s, double v) { s.style.intercostalAmplitude = v; });
+  m_styleFieldCount = m_fields.size();
   addField(
       "Active gain k_ac \u00d7", "-", "Scale of every muscle's active gain",
       [](const RunSettings& s) { return muscleScale(s.options.step.activeGainScale); },
@@ -112,8 +129,7 @@ ParameterPanel::ParameterPanel(QWidget* parent) : QWidget(parent) {
         isNumber ? viz::magnificationError(factor)
                  : "motion magnification: '" + m_magnification->text().toStdString() + "' is not a number";
     if (!error.empty()) return refuse(m_magnification, QString::fromStdString(error));
-    m_magnification->setStyleSheet(QString());
-    m_reason->clear();
+    accept(m_magnification);
     emit magnificationEdited(factor);
   });
   auto* magnificationLabel = new QLabel("Motion magnification \u00d7");
@@ -152,8 +168,21 @@ void ParameterPanel::setSettings(const RunSettings& settings, std::shared_ptr<co
   m_gravity->setChecked(m_settings.options.step.gravity);
   const QSignalBlocker blockPosture(m_posture);
   m_posture->setCurrentText(sim::postureName(m_settings.options.step.posture));
-  m_reason->clear();
+  m_refused.clear();
+  showReasons();
 }
+
+void ParameterPanel::setDriver(const QString& driver) {
+  for (std::size_t i = 0; i < m_styleFieldCount; ++i) m_fields[i].edit->setEnabled(driver.isEmpty());
+  m_driver->setText(driver.isEmpty()
+                        ? QString()
+                        : QString("The %1 drives the breathing: its pattern sets the rate and depth, "
+                                  "so the breath style's fields are off until a style is chosen.")
+                              .arg(driver));
+  m_driver->setVisible(!driver.isEmpty());
+}
+
+QString ParameterPanel::driverText() const { return m_driver->text(); }
 
 void ParameterPanel::setMagnification(double factor) {
   m_magnification->setText(QString::number(factor, 'g', 6));
@@ -164,7 +193,27 @@ QString ParameterPanel::refusal() const { return m_reason->text(); }
 
 void ParameterPanel::refuse(QLineEdit* edit, const QString& reason) {
   edit->setStyleSheet("background: #ffd9dc;");
-  m_reason->setText(reason);
+  const auto it =
+      std::find_if(m_refused.begin(), m_refused.end(), [edit](const auto& r) { return r.first == edit; });
+  if (it != m_refused.end())
+    it->second = reason;
+  else
+    m_refused.emplace_back(edit, reason);
+  showReasons();
+}
+
+void ParameterPanel::accept(QLineEdit* edit) {
+  edit->setStyleSheet(QString());
+  m_refused.erase(
+      std::remove_if(m_refused.begin(), m_refused.end(), [edit](const auto& r) { return r.first == edit; }),
+      m_refused.end());
+  showReasons();
+}
+
+void ParameterPanel::showReasons() {
+  QStringList lines;
+  for (const auto& [edit, reason] : m_refused) lines << reason;
+  m_reason->setText(lines.join('\n'));
 }
 
 void ParameterPanel::edited(const Field& field) {
@@ -172,10 +221,7 @@ void ParameterPanel::edited(const Field& field) {
   const double value = field.edit->text().trimmed().toDouble(&isNumber);
   const QString name = field.edit->property("label").toString();
   if (!isNumber) return refuse(field.edit, QString("%1: '%2' is not a number").arg(name, field.edit->text()));
-  if (value == field.get(m_settings)) {
-    field.edit->setStyleSheet(QString());
-    return;
-  }
+  if (value == field.get(m_settings)) return accept(field.edit);
 
   // check the candidate with the sim's validators; apply nothing unless it passes
   RunSettings candidate = m_settings;
@@ -184,10 +230,10 @@ void ParameterPanel::edited(const Field& field) {
     sim::validateBreathStyle(candidate.style);
     sim::validateSimulationOptions(candidate.options);
   } catch (const sim::Error& e) {
-    return refuse(field.edit, QString("%1 = %2 refused: %3").arg(name, field.edit->text(), e.what()));
+    return refuse(field.edit,
+                  QString("%1: %2 refused: %3").arg(name, field.edit->text(), plainReason(e.what())));
   }
-  field.edit->setStyleSheet(QString());
-  m_reason->clear();
+  accept(field.edit);
   m_settings = candidate;
   emit settingsEdited(m_settings);
 }

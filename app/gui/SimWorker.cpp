@@ -17,8 +17,9 @@ namespace pneuma::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kWallBudget = 0.030;  // [s] longest stepping batch between two sync points
-constexpr int kTickMs = 8;             // [ms] worker tick
+constexpr double kWallBudget = 0.030;          // [s] longest stepping batch between two sync points
+constexpr int kTickMs = 8;                     // [ms] worker tick
+constexpr double kRealTimeFactorWindow = 2.0;  // [s] wall time the real-time factor is measured over
 // [-] rise of the lung volume above its running minimum, as a fraction of it, that confirms an
 // end-expiration (0.5 %: 29 mL of a 5.8 L chest, well under a calm breath's 500 mL, well over the rib
 // cage's few-hertz wobble)
@@ -149,6 +150,7 @@ void SimWorker::sync() {
     }
     m_pattern = nullptr;
     m_rtf = 0.0;
+    m_rtfWindow.clear();
     m_samples.clear();
     ++m_generation;
     m_breathing = nullptr;
@@ -172,7 +174,10 @@ void SimWorker::sync() {
     m_breathingAt = -1.0;
     clearEndExpirations();
   }
-  if (p.speed) m_speed = *p.speed;
+  if (p.speed) {
+    m_speed = *p.speed;
+    m_rtfWindow.clear();  // measured at the new speed only
+  }
   if (p.runUntil) {
     m_runUntil = *p.runUntil;
     m_speed = 0.0;
@@ -391,7 +396,10 @@ void SimWorker::tick() {
   m_lastTick = Clock::now();
   try {
     sync();
-    if (!m_isRunning) return;
+    if (!m_isRunning) {
+      m_rtfWindow.clear();
+      return;
+    }
 
     // how much simulated time this batch owes: real-time pacing, or as much as fits the budget
     const double t0 = m_sim->state().time;
@@ -414,9 +422,15 @@ void SimWorker::tick() {
     const double advanced = m_sim->state().time - t0;
     if (m_speed > 0.0) m_debt = std::max(0.0, m_debt - advanced);
 
-    // real-time factor: simulated seconds per wall second over this tick, smoothed
-    const double rtf = advanced / std::max(wall, 1e-3);
-    m_rtf = m_rtf > 0.0 ? 0.8 * m_rtf + 0.2 * rtf : rtf;
+    // real-time factor: simulated seconds per wall second over the last ticks (one tick's ratio swings with
+    // the batch's whole steps and the timer's jitter)
+    const auto now = Clock::now();
+    m_rtfWindow.emplace_back(now, m_sim->state().time);
+    while (m_rtfWindow.size() > 2 &&
+           std::chrono::duration<double>(now - m_rtfWindow.front().first).count() > kRealTimeFactorWindow)
+      m_rtfWindow.pop_front();
+    const double span = std::chrono::duration<double>(now - m_rtfWindow.front().first).count();
+    if (span > 0.0) m_rtf = (m_rtfWindow.back().second - m_rtfWindow.front().second) / span;
 
     const bool reached = m_runUntil >= 0.0 && m_sim->state().time >= m_runUntil - 1e-9;
     if (reached) {

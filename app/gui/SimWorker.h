@@ -9,6 +9,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -254,6 +255,9 @@ class SimWorker : public QObject {
   double m_scrubTime = 0.0;  // [s] time of the shown recorded frame
   double m_debt = 0.0;       // [s] simulated time owed to real-time pacing
   double m_rtf = 0.0;        // [-]
+  // (wall clock, simulated time [s]) at the ticks of the last kRealTimeFactorWindow seconds while running:
+  // the real-time factor is the simulated time over the wall time across them
+  std::deque<std::pair<std::chrono::steady_clock::time_point, double>> m_rtfWindow;
   long long m_generation = 0;
   std::shared_ptr<const sim::Summary> m_breathing;  // Snapshot::breathing
   double m_breathingAt = -1.0;                      // [s] simulated time it was measured at

@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
       "export-gltf", "With --screenshot: export the recording as a glTF 2.0 .glb to FILE before the grab.",
       "FILE");
   const QCommandLineOption camera(
-      "camera", "Camera preset: anterior, lateral, superior or oblique (default).", "NAME", "oblique");
+      "camera", "Camera preset: anterior, lateral, superior, posterior or oblique (default).", "NAME",
+      "oblique");
   const QCommandLineOption labels("labels",
                                   "Show the anatomical labels and the lung cavity (teaching view).");
   const QCommandLineOption skin("skin", "The skin: translucent (default), opaque or hidden.", "MODE",
@@ -239,16 +240,15 @@ int main(int argc, char** argv) {
       }
   }
 
-  const std::map<QString, pneuma::viz::CameraPreset> presets{
-      {"anterior", pneuma::viz::CameraPreset::Anterior},
-      {"lateral", pneuma::viz::CameraPreset::Lateral},
-      {"superior", pneuma::viz::CameraPreset::Superior},
-      {"oblique", pneuma::viz::CameraPreset::Oblique}};
-  const auto preset = presets.find(parser.value(camera));
+  const auto& presets = pneuma::viz::cameraPresets();
+  const auto preset = std::find_if(presets.begin(), presets.end(), [&](const auto& p) {
+    return QString::fromStdString(p.first) == parser.value(camera);
+  });
   if (preset == presets.end()) {
-    std::fprintf(stderr,
-                 "pneuma: --camera: unknown preset '%s' (valid: anterior, lateral, superior, oblique)\n",
-                 qPrintable(parser.value(camera)));
+    QStringList valid;
+    for (const auto& p : presets) valid << QString::fromStdString(p.first);
+    std::fprintf(stderr, "pneuma: --camera: unknown preset '%s' (valid: %s)\n",
+                 qPrintable(parser.value(camera)), qPrintable(valid.join(", ")));
     return 2;
   }
 

@@ -992,6 +992,16 @@ void ModelScene::setOptions(const DisplayOptions& options) {
 
 const DisplayOptions& ModelScene::options() const { return m_impl->options; }
 
+const std::vector<std::pair<std::string, CameraPreset>>& cameraPresets() {
+  static const std::vector<std::pair<std::string, CameraPreset>> presets{
+      {"anterior", CameraPreset::Anterior},
+      {"lateral", CameraPreset::Lateral},
+      {"superior", CameraPreset::Superior},
+      {"posterior", CameraPreset::Posterior},
+      {"oblique", CameraPreset::Oblique}};
+  return presets;
+}
+
 void ModelScene::setCamera(CameraPreset preset) {
   Eigen::Vector3d dir(0.0, 1.0, 0.0);  // from the camera's side toward... the camera (RAS)
   Eigen::Vector3d up(0.0, 0.0, 1.0);
@@ -1005,6 +1015,9 @@ void ModelScene::setCamera(CameraPreset preset) {
     case CameraPreset::Superior:
       dir = {0.0, 0.0, 1.0};
       up = {0.0, 1.0, 0.0};
+      break;
+    case CameraPreset::Posterior:
+      dir = {0.0, -1.0, 0.0};
       break;
     case CameraPreset::Oblique:
       dir = Eigen::Vector3d(0.8, 1.0, 0.45).normalized();

@@ -68,8 +68,11 @@ constexpr double kDefaultMagnification = 5.0;  ///< [-] makes a calm breath visi
 /// outside [1, 20]").
 std::string magnificationError(double factor);
 
-/// Camera presets, looking at the whole model.
-enum class CameraPreset { Anterior, Lateral, Superior, Oblique };
+/// Camera presets, looking at the whole model: from the front, the left side, above, behind, and obliquely
+/// from the front left.
+enum class CameraPreset { Anterior, Lateral, Superior, Posterior, Oblique };
+/// Every camera preset with its lowercase name ("anterior", ...), in the order the app lists them.
+const std::vector<std::pair<std::string, CameraPreset>>& cameraPresets();
 
 /// Human-readable name of an element group for legends and labels ("External intercostals", ...).
 const char* groupLabel(sim::ElementGroup g);

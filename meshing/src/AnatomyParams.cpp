@@ -113,14 +113,16 @@ PelvisParams readPelvis(const Reader& r) {
 
 AbdomenParams readAbdomen(const Reader& r) {
   r.allowKeys({"pelvic_floor_z_mm", "inner_width_mm", "anterior_depth_mm", "posterior_depth_mm",
-               "dome_height_mm", "central_tendon_fraction", "umbilicus_z_mm"});
+               "dome_height_mm", "apposition_height_mm", "apposition_reach_mm", "umbilicus_z_mm"});
   AbdomenParams a;
   a.floorLevel = r.at("pelvic_floor_z_mm").numberIn(-300.0, 0.0) * kMm;
   a.width = mm(r.at("inner_width_mm"), 60.0, 600.0);
   a.anteriorDepth = mm(r.at("anterior_depth_mm"), 30.0, 400.0);
   a.posteriorDepth = mm(r.at("posterior_depth_mm"), 15.0, 200.0);
   a.domeHeight = mm(r.at("dome_height_mm"), 20.0, 200.0);
-  a.tendonFraction = r.at("central_tendon_fraction").numberIn(0.05, 0.8);
+  a.appositionHeight = mm(r.at("apposition_height_mm"), 0.0, 200.0);
+  if (a.appositionHeight >= a.domeHeight) r.at("apposition_height_mm").fail("must be below dome_height_mm");
+  a.appositionReach = mm(r.at("apposition_reach_mm"), 1.0, 200.0);
   a.umbilicusLevel = r.at("umbilicus_z_mm").numberIn(0.0, 400.0) * kMm;
   return a;
 }

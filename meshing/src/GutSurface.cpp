@@ -186,6 +186,7 @@ GutSurface buildGut(const AnatomyParams& a, const Skeleton& sk) {
       ring.push_back(addNode(p, isCrural ? sim::NodeRegion::Fixed : sim::NodeRegion::Diaphragm));
     }
     g.domeRing.push_back(ring);
+    g.domeRingRise.push_back(a.abdomen.domeHeight * (1.0 - s * s));
     rings.push_back(ring);
   }
   g.apex = addNode(Eigen::Vector3d(centre.x(), centre.y(), apexZ), sim::NodeRegion::Diaphragm);

@@ -21,7 +21,10 @@ struct GutSurface {
   std::vector<std::vector<int>>
       wallRing;  ///< node indices of the wall rings, floor (0) to just below the rim
   std::vector<std::vector<int>> domeRing;  ///< node indices of the dome rings, rim (0) to the innermost ring
-  int apex = -1;                           ///< the dome's apex node
+  /// [m] rise of each dome ring above the costal margin's mean level, h_dome (1 - s^2) at radius fraction s
+  /// (the dome's profile, buildGut()); 0 for the rim (#domeRing)
+  std::vector<double> domeRingRise;
+  int apex = -1;  ///< the dome's apex node
 };
 
 /// Builds the gut surface of `a` fitted to the skeleton `sk`.

@@ -17,8 +17,6 @@ using sim::ElementGroup;
 
 constexpr double kObliqueShift = 0.018;  // [m] arc offset along the lower rib that makes intercostals oblique
 constexpr double kMaxIntercostalGap = 0.06;  // [m] no intercostal where neighbouring ribs are farther apart
-constexpr double kAppositionReach = 0.04;    // [m] farthest rib point an apposed dome node is tied to
-constexpr std::size_t kAppositionRings = 3;  // [-] dome rings inside the rim that lie on the rib cage
 // [m] how far beyond the rib point an apposition spring is anchored (in the rib's frame), along the line from
 // the dome node: a spring this long holds the node at its distance from the rib face and lets it slide along
 // the face
@@ -29,9 +27,11 @@ constexpr double kAppositionSlide = 0.2;
 constexpr double kAppositionStiffReach = 0.015;
 constexpr double kVertebralFrontHalfWidth =
     0.015;  // [m] lateral reach of the apposition points on a vertebral body's front
-constexpr double kCostalSample = 0.01;   // [m] spacing of candidate costal-margin points on the lower ribs
-constexpr int kRectusHalfColumns = 4;    // rectus columns on each side of the linea alba
-constexpr double kScaleneLength = 0.06;  // [m] rib 1 to the scalene anchors above it (cervical spine)
+constexpr double kCostalSample = 0.01;     // [m] spacing of candidate costal-margin points on the lower ribs
+constexpr int kRectusHalfColumns = 4;      // rectus columns on each side of the linea alba
+constexpr double kScaleneLength = 0.06;    // [m] rib 1 to the scalene anchors above it (no cervical spine)
+constexpr double kScaleneNeckRise = 0.10;  // [m] rib 1 to the scalenes' cervical anchors, craniocaudal
+constexpr double kScaleneNeckOffset = 0.035;  // [m] the scalenes' cervical anchors off the midline
 
 /// Appends elements to a model, converting endpoints and scaling the group gains by rest length.
 class ElementSink {
@@ -185,15 +185,18 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
 /// there by the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs
 /// rather than bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer &
 /// Wilson 2016, J Appl Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide
-/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. Each node of
-/// the first kAppositionRings rings inside the rim gets a two-sided spring (Cartilage group) toward the
-/// nearest point of the inner face of ribs 6-12, or of the front of the vertebral bodies T10-L1 beside the
-/// crura (where the dome lies on the spine; without it the dome's rings over the spine fold backward on
-/// themselves while the model settles), within kAppositionReach, anchored kAppositionSlide beyond
-/// that point on the same line: a long spring resists a change of the node's distance to the face and hardly
-/// a slide across it (a slide s lengthens it by about s^2 / 2 l). Its stiffness and damping along the line
-/// are those of a spring reaching only the rib point, the cartilage group's times `fraction`.
-void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, ElementSink& sink) {
+/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. The dome
+/// rings inside the rim whose rise above the costal margin's mean level (GutSurface::domeRingRise) is at most
+/// the zone's height `a.abdomen.appositionHeight` lie in the zone. Each of their nodes gets a
+/// two-sided spring (Cartilage group) toward the nearest point of the inner face of ribs 6-12, or of the
+/// front of the vertebral bodies T10-L1 beside the crura (where the dome lies on the spine; without it the
+/// dome's rings over the spine fold backward on themselves while the model settles), within
+/// `a.abdomen.appositionReach`, anchored kAppositionSlide beyond that point on the same line: a long spring
+/// resists a change of the node's distance to the face and hardly a slide across it (a slide s lengthens it
+/// by about s^2 / 2 l). Its stiffness and damping along the line are those of a spring reaching only the rib
+/// point, the cartilage group's times `a.gains.appositionFraction`.
+void addApposition(const AnatomyParams& a, const Skeleton& sk, const GutSurface& gut, ElementSink& sink) {
+  const double fraction = a.gains.appositionFraction;
   if (fraction <= 0.0) return;
   std::vector<Endpoint> face;
   for (int level = 6; level <= 12; ++level) {
@@ -212,12 +215,13 @@ void addApposition(const Skeleton& sk, const GutSurface& gut, double fraction, E
   for (const Eigen::Vector3d& c : spineFront)
     for (double x : {-kVertebralFrontHalfWidth, 0.0, kVertebralFrontHalfWidth})
       face.push_back(Endpoint::onBody(sk.lumbar, c + Eigen::Vector3d(x, 0, 0)));
-  for (std::size_t ring = 1; ring <= kAppositionRings && ring < gut.domeRing.size(); ++ring) {
+  for (std::size_t ring = 1; ring < gut.domeRing.size(); ++ring) {
+    if (gut.domeRingRise[ring] > a.abdomen.appositionHeight) break;
     for (int node : gut.domeRing[ring]) {
       const Eigen::Vector3d p = gut.rest.col(node);
       const Endpoint& rib = nearest(face, p);
       const double reach = (rib.world - p).norm();
-      if (reach > kAppositionReach || reach < 1e-6) continue;
+      if (reach > a.abdomen.appositionReach || reach < 1e-6) continue;
       const Endpoint anchor =
           Endpoint::onBody(rib.body, rib.world + kAppositionSlide * (rib.world - p) / reach);
       sink.add(ElementGroup::Cartilage, Endpoint::atNode(node, gut.rest), anchor, 0.0,
@@ -346,10 +350,16 @@ void addScalenes(const Skeleton& sk, ElementSink& sink) {
 }
 
 /// The neck and the shoulder girdle (AnatomyParams::hasShoulderGirdle), per side:
-///  - scalenes: from the transverse processes of C3-C5 on the fixed cervical spine to the front half of rib 1
-///    (scalenus anterior, medius; the posterior to rib 2 is folded into them), structural springs with the
-///    cartilage group's gains like the model's scalenes without a neck (addScalenes()). On the back half of
-///    rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale;
+///  - scalenes: from the cervical transverse processes (kScaleneNeckOffset off the midline, kScaleneNeckRise
+///    above rib 1, C3-C4) to the front half of rib 1 (scalenus anterior, medius; the posterior to rib 2 is
+///    folded into them), structural springs with the cartilage group's gains like the model's scalenes
+///    without a neck (addScalenes()). Each runs in its rib point's sagittal plane, tilted inwards only: a
+///    fore-aft tilt braces rib 1, and with it the upper thoracic spine, against the fixed neck. From C3-C5
+///    (2.8 cm off the midline, level with the vertebral bodies, up to 12 deg forward) the backward sway of
+///    the spine in a deep inhale was -0.10 mm (validate's sway.backward, male, --quick; -0.71 mm without the
+///    girdle, -0.14 mm without scalenes), in the sagittal plane -0.15 mm. Vertical springs on the middle of
+///    rib 1 (the model without the girdle) give -0.73 mm but leave the skin at the base of the neck. On the
+///    back half of rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale;
 ///  - sternocleidomastoid: from the mastoid process to the manubrium (sternal head) and the medial clavicle
 ///    (clavicular head), passive at the shoulder gains;
 ///  - Breathe Easy's 26 shoulder elements (Zordan et al. 2004, Table 1: 52 in all), passive at the shoulder
@@ -399,9 +409,14 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
       sink.add(ElementGroup::Cartilage, p, q, shoulder, 0.0);
     };
 
-    // scalenes and sternocleidomastoid
-    for (const auto& [c, f] : {std::pair{3, 0.8}, std::pair{4, 0.88}, std::pair{5, 0.96}})
-      sink.add(ElementGroup::Cartilage, cervical(c, sx * 0.028), ribAt(1, side, f));
+    // scalenes, each in its rib point's sagittal plane, and sternocleidomastoid
+    for (double f : {0.8, 0.88, 0.96}) {
+      const Endpoint rib = ribAt(1, side, f);
+      sink.add(ElementGroup::Cartilage,
+               Endpoint::onBody(sk.cervical, Eigen::Vector3d(sx * kScaleneNeckOffset, rib.world.y(),
+                                                             rib.world.z() + kScaleneNeckRise)),
+               rib);
+    }
     const Endpoint mastoid = Endpoint::onBody(sk.head, s.mastoid);
     spring(mastoid, Endpoint::onBody(sk.sternum, sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) +
                                                      0.01 * sk.sternumAxis));
@@ -447,7 +462,7 @@ void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   ElementSink sink(a.gains, model);
   addIntercostals(a, sk, sink);
   addDiaphragm(sk, gut, sink);
-  addApposition(sk, gut, a.gains.appositionFraction, sink);
+  addApposition(a, sk, gut, sink);
   addRectus(sk, gut, sink);
   addTransversusObliques(gut, sink);
   addCartilage(sk, sink);

@@ -66,6 +66,30 @@ TEST(AnatomyParams, MissingFieldIsNamed) {
   EXPECT_NE(e.find("male.json: sternum.body_length_mm: missing"), std::string::npos) << e;
 }
 
+TEST(AnatomyParams, ZoneOfAppositionAboveTheApexIsRejected) {
+  const std::string e = errorOf([](nlohmann::json& j) { j["abdomen"]["apposition_height_mm"] = 100; });
+  EXPECT_NE(e.find("male.json: abdomen.apposition_height_mm: must be below dome_height_mm"),
+            std::string::npos)
+      << e;
+}
+
+// the zone of apposition is the dome's outer band up to apposition_height_mm above the costal margin: none
+// below the first ring's rise (23 mm in the man), more of the dome tied to the ribs the taller the zone
+TEST(AnatomyParams, ZoneOfAppositionGrowsWithItsHeight) {
+  auto apposed = [](double heightMm) {
+    nlohmann::json j = nlohmann::json::parse(read(kDir + "male.json"));
+    j["abdomen"]["apposition_height_mm"] = heightMm;
+    const sim::Model m = buildModel(parseAnatomy(j.dump(), read(kDir + "muscle_gains.json")), "").model;
+    int n = 0;
+    for (int e = 0; e < m.elements.size(); ++e) n += sim::isApposition(m.elements, e) ? 1 : 0;
+    return n;
+  };
+  const int none = apposed(20), preset = apposed(65), tall = apposed(90);
+  EXPECT_EQ(none, 0);
+  EXPECT_GT(preset, 48);  // more than the rim's 48 nodes: at least two rings
+  EXPECT_GT(tall, preset);
+}
+
 TEST(AnatomyParams, TooFewSpineSegmentsAreRejected) {
   const std::string e = errorOf([](nlohmann::json& j) {
     j["spine"]["thoracic_segments"] = {{1, 6}, {7, 12}};

@@ -312,6 +312,9 @@ TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
   emit panel->frequencyField()->editingFinished();
   EXPECT_TRUE(panel->refusal().contains("-4")) << panel->refusal().toStdString();
   EXPECT_EQ(panel->settings().style.breathsPerMinute, before);
+  // in the reader's words: the field's label, no style name or file key in front
+  EXPECT_TRUE(panel->refusal().startsWith("Frequency [breaths/min]: -4 refused: breaths per minute"))
+      << panel->refusal().toStdString();
   panel->frequencyField()->setText("fast");
   emit panel->frequencyField()->editingFinished();
   EXPECT_TRUE(panel->refusal().contains("not a number"));
@@ -327,11 +330,20 @@ TEST(MainWindow, InvalidParameterIsRefusedWithTheReason) {
   EXPECT_EQ(kappa->text().toDouble(), 1e-3 * w.window.model()->gut.kappa);
   kappa->setText("-1");
   emit kappa->editingFinished();
-  EXPECT_TRUE(panel->refusal().contains("kappa: must be finite and > 0")) << panel->refusal().toStdString();
+  // two bad fields: both reasons are shown, one line each; fixing one leaves the other's
+  const QStringList both = panel->refusal().split('\n');
+  ASSERT_EQ(both.size(), 2) << panel->refusal().toStdString();
+  EXPECT_TRUE(both[0].contains("not a number")) << both[0].toStdString();
+  EXPECT_TRUE(both[1].contains("kappa: must be finite and > 0")) << both[1].toStdString();
   EXPECT_FALSE(panel->settings().options.step.kappa.has_value());
+  panel->frequencyField()->setText("12");
+  emit panel->frequencyField()->editingFinished();
+  EXPECT_FALSE(panel->refusal().contains("not a number")) << panel->refusal().toStdString();
+  EXPECT_TRUE(panel->refusal().contains("kappa")) << panel->refusal().toStdString();
   kappa->setText("150");
   emit kappa->editingFinished();
   EXPECT_EQ(panel->settings().options.step.kappa, 150e3);
+  EXPECT_TRUE(panel->refusal().isEmpty()) << panel->refusal().toStdString();
 }
 
 // the toy torso is not calibrated to breathe cleanly, so the rate is measured on the default model
@@ -602,6 +614,11 @@ TEST_F(DefaultModelWindow, FlowVolumeLoopClosesEachBreath) {
 TEST_F(DefaultModelWindow, AffectAndPatternScenariosOpenPlayAndSaveWhatDrivesTheRun) {
   const QString startle = QString::fromStdString(sim::resourceDir()) + "/scenarios/startle-at-10s.json";
   ASSERT_EQ(window.openScenario(startle), QString());
+  // the style box and the parameter panel say that the pattern drives, not the calm style
+  EXPECT_EQ(window.styleBox()->currentText().toStdString(), "pattern 'startle-at-10s'");
+  EXPECT_FALSE(window.parameters()->frequencyField()->isEnabled());
+  EXPECT_TRUE(window.parameters()->driverText().contains("pattern"))
+      << window.parameters()->driverText().toStdString();
   ASSERT_TRUE(window.runUntil(5.0, 120000)) << window.lastError().toStdString();
   const app::PlotView* plot = window.plots()->volumePlot();
   ASSERT_EQ(plot->series().size(), 2u) << "simulated and target volume";
@@ -620,12 +637,19 @@ TEST_F(DefaultModelWindow, AffectAndPatternScenariosOpenPlayAndSaveWhatDrivesThe
   ASSERT_EQ(window.openScenario(saved), QString()) << "the saved scenario reopens";
 
   ASSERT_EQ(window.setBreathStyle("calm"), QString());
+  EXPECT_EQ(window.styleBox()->currentText().toStdString(), "calm");
+  EXPECT_TRUE(window.parameters()->frequencyField()->isEnabled());
   ASSERT_EQ(window.pushAffect("panic", true), QString());
+  EXPECT_EQ(window.styleBox()->currentText().toStdString(), "affect 'panic'");
+  EXPECT_FALSE(window.parameters()->frequencyField()->isEnabled());
   ASSERT_EQ(window.saveScenario(saved), QString());
   const sim::Scenario affect = sim::loadScenario(saved.toStdString());
   EXPECT_EQ(affect.controller, sim::ControllerKind::Affect);
   EXPECT_EQ(affect.controllerName, "panic");
   ASSERT_EQ(window.setBreathStyle("deep"), QString());
+  EXPECT_EQ(window.styleBox()->currentText().toStdString(), "deep");
+  EXPECT_EQ(window.styleBox()->findData("driver"), -1) << "the affect's entry is gone";
+  EXPECT_TRUE(window.parameters()->frequencyField()->isEnabled());
   ASSERT_EQ(window.saveScenario(saved), QString());
   EXPECT_EQ(sim::loadScenario(saved.toStdString()).controllerName, "deep");
 }
@@ -996,8 +1020,7 @@ TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
   o.showLandmarks = true;
   window.setDisplayOptions(o);
   vtkRenderer* renderer = window.scene().renderer();
-  for (const viz::CameraPreset preset : {viz::CameraPreset::Anterior, viz::CameraPreset::Lateral,
-                                         viz::CameraPreset::Superior, viz::CameraPreset::Oblique}) {
+  for (const auto& [name, preset] : viz::cameraPresets()) {
     window.scene().setCamera(preset);
     window.grabView();  // renders
     struct Box {
@@ -1021,8 +1044,7 @@ TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
       for (std::size_t j = 0; j < boxes.size(); ++j) {
         if (j == i) continue;
         EXPECT_FALSE(boxes[i].rect.intersects(boxes[j].rect))
-            << "camera " << static_cast<int>(preset) << ": '" << boxes[i].text << "' covers '"
-            << boxes[j].text << "'";
+            << "camera " << name << ": '" << boxes[i].text << "' covers '" << boxes[j].text << "'";
       }
     }
     EXPECT_EQ(groups, 6);

@@ -78,7 +78,13 @@ struct AbdomenParams {
   double anteriorDepth = 0.0;   ///< [m] reach of the anterior wall in front of the lumbar body centre
   double posteriorDepth = 0.0;  ///< [m] reach of the posterior wall (beside the spine) behind it
   double domeHeight = 0.0;      ///< [m] rise of the diaphragm apex above the costal margin's mean level
-  double tendonFraction = 0.0;  ///< [-] radius fraction of the dome covered by the central tendon
+  /// [m] craniocaudal extent of the zone of apposition: a dome node at most this far above the costal margin
+  /// below it (the dome rim at the same angle) lies on the inner face of the lower rib cage and is held there
+  /// (MuscleNetwork's apposition springs). Mead 1979: a quarter to a third of the rib cage's inner surface in
+  /// quiet upright breathing; resources/anatomy/README.md has the values and their derivation.
+  double appositionHeight = 0.0;
+  /// [m] farthest a dome node in the zone of apposition may lie from the rib face it is held on
+  double appositionReach = 0.0;
   double umbilicusLevel = 0.0;  ///< [m] z of the umbilicus
 };
 
