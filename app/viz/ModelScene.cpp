@@ -318,6 +318,11 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkPolyData> cavity;
   vtkSmartPointer<vtkActor> cavityActor;
 
+  // the soft-tissue volume bodies, one surface of all their triangles over the nodes
+  vtkSmartPointer<vtkPolyData> tissue;
+  Eigen::Matrix3Xi tissueTriangles;
+  vtkSmartPointer<vtkActor> tissueActor;
+
   std::array<vtkSmartPointer<vtkPolyData>, 2> lungs;  // right, left
   std::array<vtkSmartPointer<vtkActor>, 2> lungActors;
 
@@ -351,7 +356,8 @@ struct ModelScene::Impl {
     bodies.clear();
     bodyPose.clear();
     labels.clear();
-    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = nullptr;
+    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = tissueActor = nullptr;
+    tissue = nullptr;
     ghost.clear();
     hasGhost = false;
     lungs = {};
@@ -371,7 +377,8 @@ struct ModelScene::Impl {
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
                        static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
-                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
+                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor),
+                       static_cast<vtkProp*>(tissueActor)})
       if (p) props.push_back(p);
     for (const auto& g : ghost) props.push_back(g.second);
     if (skinActor) props.push_back(skinActor);
@@ -521,6 +528,27 @@ struct ModelScene::Impl {
     gut = surface(model.nodes.size(), model.gut.triangles);
     gutActor = scalarSurfaceActor(gut, gutScalar, gutTable);
 
+    // the volume bodies: muscle-red, opaque, under the skin
+    if (model.volumes.size() > 0) {
+      Eigen::Index count = 0;
+      for (const Eigen::Matrix3Xi& t : model.volumes.triangles) count += t.cols();
+      tissueTriangles.resize(3, count);
+      count = 0;
+      for (const Eigen::Matrix3Xi& t : model.volumes.triangles) {
+        tissueTriangles.middleCols(count, t.cols()) = t;
+        count += t.cols();
+      }
+      tissue = surface(model.nodes.size(), tissueTriangles);
+      vtkNew<vtkFloatArray> normals;  // smooth shading: setNormals() at every update
+      normals->SetNumberOfComponents(3);
+      normals->SetNumberOfTuples(tissue->GetNumberOfPoints());
+      normals->Fill(0.0f);
+      tissue->GetPointData()->SetNormals(normals);
+      tissueActor = actorFor(tissue);
+      tissueActor->GetProperty()->SetColor(0.74, 0.33, 0.31);
+      tissueActor->PickableOff();
+    }
+
     cavity = surface(model.cavity.vertices.size(), model.cavity.triangles);
     cavityActor = actorFor(cavity);
     cavityActor->GetProperty()->SetColor(0.55, 0.78, 0.98);
@@ -616,7 +644,7 @@ struct ModelScene::Impl {
     // the closed surfaces (outward triangles, sim/Model.h) draw their front faces only: a translucent one
     // blends one layer instead of two, which halves its fragments under software OpenGL
     for (vtkActor* a : {gutActor.GetPointer(), cavityActor.GetPointer(), lungActors[0].GetPointer(),
-                        lungActors[1].GetPointer(), skinActor.GetPointer()})
+                        lungActors[1].GetPointer(), skinActor.GetPointer(), tissueActor.GetPointer()})
       if (a) a->GetProperty()->BackfaceCullingOn();
 
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
@@ -664,6 +692,7 @@ struct ModelScene::Impl {
                                                                       : "Gut\ndisplacement\n[mm]");
       gutBar->SetVisibility(options.showGut && coloured);
     }
+    if (tissueActor) tissueActor->SetVisibility(options.showTissue);
     if (cavityActor) cavityActor->SetVisibility(options.showCavity);
     for (const auto& a : lungActors)
       if (a) a->SetVisibility(options.showLungs);
@@ -858,6 +887,12 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
       if (isAuto) s.gutDisplacementTop = autoTop(s.values, s.gutDisplacementTop);
       setScale(s.gutBar, s.gutTable, 0.0, isAuto ? std::max(s.gutDisplacementTop, 1.0) : kGutDisplacementTop);
     }
+  }
+
+  // the volume bodies: their nodes
+  if (s.tissue) {
+    Impl::setPoints(s.tissue, s.posed.gut);
+    Impl::setNormals(s.tissue, s.posed.gut, s.tissueTriangles, s.normalScratch);
   }
 
   // cavity and landmarks
