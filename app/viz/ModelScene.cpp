@@ -43,6 +43,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Ties.h"
 #include "viz/PlotLayout.h"
 
 namespace pneuma::viz {
@@ -494,7 +495,7 @@ struct ModelScene::Impl {
 
     // muscle elements by group; the apposition springs (the pleural fluid's hold) are not drawn
     for (int e = 0; e < model.elements.size(); ++e)
-      if (!sim::isApposition(model.elements, e))
+      if (!sim::isApposition(model, e))
         groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(
             e);
     for (int gi = 0; gi < kGroups; ++gi) {

@@ -26,6 +26,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Ties.h"
 #include "viz/AtomicFile.h"
 #include "viz/ModelScene.h"
 
@@ -259,7 +260,7 @@ struct VtkSeriesWriter::Impl {
       force->SetValue(e, f);
       tension->SetValue(e, f < 0.0 ? -f : 0.0);
       group->InsertNextValue(static_cast<int>(el.group[static_cast<std::size_t>(e)]));
-      apposition->InsertNextValue(sim::isApposition(el, e) ? 1 : 0);
+      apposition->InsertNextValue(sim::isApposition(model, e) ? 1 : 0);
       slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size()
                                  ? metrics.isSlack[static_cast<std::size_t>(e)]
                                  : 0);

@@ -15,6 +15,7 @@
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/meshing/Tetrahedralizer.h"
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Ties.h"
 
 namespace pneuma::meshing {
 
@@ -678,9 +679,7 @@ Obstacles obstaclesOf(const BuiltModel& built) {
   const Eigen::Matrix3Xd n = vertexNormals(m.nodes.rest, surfaces);
   std::vector<char> isTied(static_cast<std::size_t>(m.nodes.size()), 0);
   for (int e = 0; e < m.elements.size(); ++e)
-    if (sim::isApposition(m.elements, e))
-      for (const sim::AnchorSet* a : {&m.elements.endA, &m.elements.endB})
-        if (a->body[static_cast<std::size_t>(e)] < 0) isTied[static_cast<std::size_t>(a->nodes(0, e))] = 1;
+    if (sim::isApposition(m.elements, e)) isTied[static_cast<std::size_t>(sim::tiedNode(m.elements, e))] = 1;
   for (int i = 0; i < m.nodes.size(); ++i) {
     const bool isTissue = m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Tissue;
     if (isTissue && isTied[static_cast<std::size_t>(i)]) continue;

@@ -142,7 +142,9 @@ TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   for (int e = 0; e < m.elements.size(); ++e) {
     const int a = m.elements.endA.body[static_cast<std::size_t>(e)],
               b = m.elements.endB.body[static_cast<std::size_t>(e)];
-    const bool onGirdle = girdle.count(a) || girdle.count(b);
+    // springs between bones only: the deltoid volume bodies' ties (a node to the humerus or scapula) are not
+    // muscles
+    const bool onGirdle = a >= 0 && b >= 0 && (girdle.count(a) || girdle.count(b));
     if (onGirdle && a != head && b != head) ++shoulder;
     if (a == cervical && (b == body(m, "rib1_right") || b == body(m, "rib1_left"))) {
       ++scalenes;

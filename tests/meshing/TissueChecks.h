@@ -15,6 +15,7 @@
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/Elements.h"
 #include "pneuma/sim/State.h"
+#include "pneuma/sim/Ties.h"
 
 namespace pneuma::test {
 
@@ -38,9 +39,7 @@ inline void expectBetweenBonesAndSkin(const meshing::BuiltModel& b, const std::s
   sim::skinPositions(m.skin, meshing::restPoints(m.skin.anchors, m), skin);
   std::vector<char> isTied(static_cast<std::size_t>(m.nodes.size()), 0);
   for (int e = 0; e < m.elements.size(); ++e)
-    if (sim::isApposition(m.elements, e))
-      for (const sim::AnchorSet* a : {&m.elements.endA, &m.elements.endB})
-        if (a->body[static_cast<std::size_t>(e)] < 0) isTied[static_cast<std::size_t>(a->nodes(0, e))] = 1;
+    if (sim::isApposition(m.elements, e)) isTied[static_cast<std::size_t>(sim::tiedNode(m.elements, e))] = 1;
   const Eigen::Matrix3Xi& t = m.volumes.triangles[static_cast<std::size_t>(k)];
   const double volume = sim::enclosedVolume(m.nodes.rest, t);
   ::testing::Test::RecordProperty(name + "_volume_mL", std::to_string(volume * 1e6));
