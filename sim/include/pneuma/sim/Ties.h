@@ -16,8 +16,8 @@ inline int tiedNode(const Elements& e, int i) {
   return e.endA.body[static_cast<std::size_t>(i)] < 0 ? e.endA.nodes(0, i) : e.endB.nodes(0, i);
 }
 
-/// True for an apposition spring proper: a tie whose node is the gut's, not a volume body's (docs/model-format.md;
-/// views draw no line for it).
+/// True for an apposition spring proper: a tie whose node is the gut's, not a volume body's
+/// (docs/model-format.md; views draw no line for it).
 inline bool isApposition(const Model& m, int i) {
   return isApposition(m.elements, i) &&
          m.nodes.region[static_cast<std::size_t>(tiedNode(m.elements, i))] != NodeRegion::Tissue;
