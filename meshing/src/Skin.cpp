@@ -669,8 +669,8 @@ Obstacles obstaclesOf(const BuiltModel& built) {
     }
   }
   // the nodes: the gut's, and the volume bodies' superficial ones (the skin lies over the pectorals and
-  // shoulders and follows them); their deep nodes, tied to a bone (a spring from the node to a body), lie
-  // under them
+  // shoulders; bind() takes no anchor from them); their deep nodes, tied to a bone (a spring from the node to
+  // a body), lie under them
   Eigen::Matrix3Xi surfaces = m.gut.triangles;
   for (const Eigen::Matrix3Xi& t : m.volumes.triangles) {
     surfaces.conservativeResize(3, surfaces.cols() + t.cols());
@@ -746,6 +746,11 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
   {
     std::map<std::array<long long, 4>, int> seen;
     for (std::size_t i = 0; i < o.point.size(); ++i) {
+      // a volume body's node is an obstacle only: the skin slides over the pectorals and shoulders as they
+      // slide over the ribs (bound to them, the skin at the inframammary fold, between the lens and the skin
+      // bound to the dome, crossed itself in a deep breath)
+      if (o.node[i] >= 0 && m.nodes.region[static_cast<std::size_t>(o.node[i])] == sim::NodeRegion::Tissue)
+        continue;
       const Eigen::Vector3d& p = o.point[i];
       const std::array<long long, 4> key{o.body[i],
                                          static_cast<long long>(std::floor(p.x() / kAnchorSpacing)),

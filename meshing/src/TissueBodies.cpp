@@ -18,8 +18,11 @@ namespace pneuma::meshing {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kBoneGap = 0.003;     // [m] deep face to the bone surface
-constexpr double kTieArm = 0.02;       // [m] length of a deep node's three tie springs
+constexpr double kBoneGap = 0.003;  // [m] deep face to the bone surface
+constexpr double kTieArm = 0.02;    // [m] length of a deep node's three tie springs
+// [m] a sliding deep node's tie: anchored this far inside the bone along the inward normal, so that it holds
+// the node's distance to the bone and hardly a slide along it (a slide s lengthens it by about s^2 / 2 l)
+constexpr double kSlideArm = 0.1;
 constexpr double kProfilePower = 0.6;  // [-] fullness of the thickness profile sin^p (1: a plain sine)
 constexpr int kPectoralColumns = 7;    // [-] sternal border, costochondral junction, then five along the rib
 // [-] the pectoral's lateral edge: this share of the way from the costochondral junction back to the rib's
@@ -33,13 +36,14 @@ constexpr double kDeltoidSweep = 200.0 * kPi / 180.0;
 constexpr double kDeltoidReach = 0.45;
 constexpr double kDeltoidDepth = 0.012;  // [m] deep face off the humerus (the rotator cuff between)
 
-/// A lens's deep face: an R x C grid of points on the bones (row-major), the bone each is tied to and the
-/// outward unit normal there.
+/// A lens's deep face: an R x C grid of points on the bones (row-major), the bone each is tied to, the
+/// outward unit normal there, and whether the node slides on the bone (held along the normal only).
 struct DeepGrid {
   int rows = 0, cols = 0;
   std::vector<Eigen::Vector3d> point;
   std::vector<int> bone;
   std::vector<Eigen::Vector3d> outward;
+  std::vector<bool> slides;
 
   int at(int r, int c) const { return r * cols + c; }
   bool isRim(int r, int c) const { return r == 0 || c == 0 || r == rows - 1 || c == cols - 1; }
@@ -126,12 +130,20 @@ void addLens(const std::string& name, const DeepGrid& g, double thickness, const
     (void)unused;
     sink.add(sim::ElementGroup::Cartilage, node(e.first), node(e.second), tg.surface, 0.0);
   }
-  // ties: each deep node to its bone by three springs along the world axes
-  for (std::size_t i = 0; i < g.point.size(); ++i)
+  // ties: a fixed deep node to its bone by three springs along the world axes; a sliding one by one long
+  // spring along the normal, as stiff along it as a tie
+  for (std::size_t i = 0; i < g.point.size(); ++i) {
+    if (g.slides[i]) {
+      sink.add(sim::ElementGroup::Cartilage,
+               Endpoint::onBody(g.bone[i], g.point[i] - kSlideArm * g.outward[i]), node(deep[i]), tg.tie, 0.0,
+               kSlideArm / kTieArm);
+      continue;
+    }
     for (int k = 0; k < 3; ++k)
       sink.add(sim::ElementGroup::Cartilage,
                Endpoint::onBody(g.bone[i], g.point[i] + kTieArm * Eigen::Vector3d::Unit(k)), node(deep[i]),
                tg.tie, 0.0);
+  }
 }
 
 /// The deep face of the pectoral on `side`: rows at ribs 2-6 and midway between them, columns from the
@@ -145,6 +157,9 @@ DeepGrid pectoralGrid(const AnatomyParams& a, const Skeleton& sk, int side) {
   g.point.resize(static_cast<std::size_t>(g.rows * g.cols));
   g.bone.resize(g.point.size());
   g.outward.resize(g.point.size());
+  g.slides.resize(g.point.size());
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) g.slides[static_cast<std::size_t>(g.at(r, c))] = r > 0 && c > 0;
   const Eigen::Vector3d front = -sk.sternumAxis.cross(Eigen::Vector3d::UnitX()).normalized();
   const double sternumHalf = 0.5 * a.sternum.thickness;  // [m]
   for (int l = 0; l < levels; ++l) {
@@ -216,6 +231,7 @@ DeepGrid deltoidGrid(const Skeleton& sk, int side) {
   g.point.resize(static_cast<std::size_t>(g.rows * g.cols));
   g.bone.resize(g.point.size());
   g.outward.resize(g.point.size());
+  g.slides.assign(g.point.size(), false);
   // the top row rises over the humeral head to the acromion's height
   const double top = std::max(0.0, (gs.acromion - gs.glenohumeral).dot(-down)) + kBoneGap;
   for (int r = 0; r < g.rows; ++r) {

@@ -513,7 +513,7 @@ TEST_P(BuiltPresets, SkinIsAClosedBodySurfaceOutsideEveryBone) {
 
 // the pectoral volume bodies (meshing/src/TissueBodies.h): closed lenses of a plausible volume on the chest
 // wall, between the bones and the skin, their deep face tied to the bones and their superficial face free
-// (TissueChecks.h); the skin over them binds to their superficial nodes, so it follows them
+// (TissueChecks.h)
 TEST_P(BuiltPresets, PectoralVolumesLieBetweenTheBonesAndTheSkin) {
   const sim::Model& m = model();
   ASSERT_GE(m.volumes.size(), 2);
@@ -522,14 +522,6 @@ TEST_P(BuiltPresets, PectoralVolumesLieBetweenTheBonesAndTheSkin) {
   // [m^3] pectoralis major with its fascia: 100-400 mL
   for (const char* name : {"pectoral_right", "pectoral_left"})
     pneuma::test::expectBetweenBonesAndSkin(built(), name, 50e-6, 600e-6);
-  // the skin binds to the volume bodies' superficial nodes where it lies over them
-  int skinOnTissue = 0;
-  for (int a = 0; a < m.skin.anchors.size(); ++a)
-    if (m.skin.anchors.body[static_cast<std::size_t>(a)] < 0 &&
-        m.nodes.region[static_cast<std::size_t>(m.skin.anchors.nodes(0, a))] == sim::NodeRegion::Tissue)
-      ++skinOnTissue;
-  EXPECT_GT(skinOnTissue, 10);
-  RecordProperty("skin_anchors_on_tissue", std::to_string(skinOnTissue));
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, BuiltPresets, ::testing::Values("male", "female"));
