@@ -60,7 +60,7 @@ constexpr int kRefreshMs = 33;  // [ms] display refresh: 30 Hz
 // [ms] a 3D render at most this long is drawn at every refresh: with the plots' few milliseconds both stay
 // above 20 Hz (50 ms per refresh); a slower one waits its turn so that it cannot starve the plots
 constexpr double kRenderEveryRefreshMs = 36.0;
-constexpr double kRecordSeconds = 60.0;                  // [s] recorded for the timeline
+constexpr double kRecordSeconds = 60.0;        // [s] recorded for the timeline
 constexpr const char* kDriverItem = "driver";  // item data of the style box's entry for an affect or pattern
 constexpr const char* kSimulationThread = "pneuma-sim";  // the simulation thread's name (CpuClock.h)
 
@@ -74,7 +74,6 @@ const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructur
     {"Bones", &viz::DisplayOptions::showBones},
     {"Gut", &viz::DisplayOptions::showGut},
     {"Translucent gut", &viz::DisplayOptions::isGutTranslucent},
-    {"Pectorals and shoulders", &viz::DisplayOptions::showTissue},
     {"Lung cavity", &viz::DisplayOptions::showCavity},
     {"Lungs", &viz::DisplayOptions::showLungs},
     {"Landmarks", &viz::DisplayOptions::showLandmarks},
@@ -412,13 +411,12 @@ void MainWindow::buildActions() {
     box.exec();
   });
   guide->setShortcut(QKeySequence::HelpContents);
-  help->addAction("&About Pneuma", this, [this] {
-    QMessageBox::about(this, "About Pneuma", aboutText());
-  });
+  help->addAction("&About Pneuma", this, [this] { QMessageBox::about(this, "About Pneuma", aboutText()); });
 }
 
 QString MainWindow::quickGuide() {
-  return "<p><b>Show the breath.</b> The view magnifies every motion from end-expiration (<i>Parameters</i> &gt; "
+  return "<p><b>Show the breath.</b> The view magnifies every motion from end-expiration (<i>Parameters</i> "
+         "&gt; "
          "<i>Motion magnification</i>, 5x by default; the view says so). Plots and read-outs stay real.</p>"
          "<p><b>Name the parts.</b> <i>Display</i>: structures, <i>Anatomical labels</i>, cameras (anterior, "
          "lateral, superior, posterior, oblique). Click a muscle element to plot its tension.</p>"
@@ -427,19 +425,21 @@ QString MainWindow::quickGuide() {
          "...) and <i>Compare with</i> to draw a second run dashed over the plots.</p>"
          "<p><b>Export.</b> <i>File</i> &gt; <i>Export</i>: the plots, a screenshot, a movie (Ogg or MP4), a "
          "ParaView series, glTF for animation tools.</p>"
-         "<p><b>Keys.</b> Space: play or pause. M: morph playback. F1: this guide. Drag: rotate; wheel: zoom; "
+         "<p><b>Keys.</b> Space: play or pause. M: morph playback. F1: this guide. Drag: rotate; wheel: "
+         "zoom; "
          "the timeline scrubs back through the last 60 s.</p>"
          "<p>The user guide is docs/app.md in the source tree.</p>";
 }
 
 QString MainWindow::aboutText() {
-  return QString("<p><b>Pneuma %1</b>: human breathing simulated from the inside out.</p>"
-                 "<p>The mechanics follow Zordan, Celly, Chiu and DiLorenzo, <i>Breathe Easy: Model and Control "
-                 "of Simulated Respiration for Animation</i> (SCA 2004); the respiration patterns and affects "
-                 "de Melo, Kenny and Gratch, <i>Real-Time Expression of Affect through Respiration</i> (CAVW "
-                 "2010).</p>"
-                 "<p>Licence: GNU AGPL 3.0 or later (it links TetGen, AGPL, and CGAL, GPL). The body surface is "
-                 "the MakeHuman base mesh shipped in Debian's assimp-testmodels.</p>")
+  return QString(
+             "<p><b>Pneuma %1</b>: human breathing simulated from the inside out.</p>"
+             "<p>The mechanics follow Zordan, Celly, Chiu and DiLorenzo, <i>Breathe Easy: Model and Control "
+             "of Simulated Respiration for Animation</i> (SCA 2004); the respiration patterns and affects "
+             "de Melo, Kenny and Gratch, <i>Real-Time Expression of Affect through Respiration</i> (CAVW "
+             "2010).</p>"
+             "<p>Licence: GNU AGPL 3.0 or later (it links TetGen, AGPL, and CGAL, GPL). The body surface is "
+             "the MakeHuman base mesh shipped in Debian's assimp-testmodels.</p>")
       .arg(QApplication::applicationVersion());
 }
 

@@ -174,10 +174,11 @@ void ParameterPanel::setSettings(const RunSettings& settings, std::shared_ptr<co
 
 void ParameterPanel::setDriver(const QString& driver) {
   for (std::size_t i = 0; i < m_styleFieldCount; ++i) m_fields[i].edit->setEnabled(driver.isEmpty());
-  m_driver->setText(driver.isEmpty() ? QString()
-                                     : QString("The %1 drives the breathing: its pattern sets the rate and depth, "
-                                               "so the breath style's fields are off until a style is chosen.")
-                                           .arg(driver));
+  m_driver->setText(driver.isEmpty()
+                        ? QString()
+                        : QString("The %1 drives the breathing: its pattern sets the rate and depth, "
+                                  "so the breath style's fields are off until a style is chosen.")
+                              .arg(driver));
   m_driver->setVisible(!driver.isEmpty());
 }
 
@@ -192,7 +193,8 @@ QString ParameterPanel::refusal() const { return m_reason->text(); }
 
 void ParameterPanel::refuse(QLineEdit* edit, const QString& reason) {
   edit->setStyleSheet("background: #ffd9dc;");
-  const auto it = std::find_if(m_refused.begin(), m_refused.end(), [edit](const auto& r) { return r.first == edit; });
+  const auto it =
+      std::find_if(m_refused.begin(), m_refused.end(), [edit](const auto& r) { return r.first == edit; });
   if (it != m_refused.end())
     it->second = reason;
   else
@@ -228,7 +230,8 @@ void ParameterPanel::edited(const Field& field) {
     sim::validateBreathStyle(candidate.style);
     sim::validateSimulationOptions(candidate.options);
   } catch (const sim::Error& e) {
-    return refuse(field.edit, QString("%1: %2 refused: %3").arg(name, field.edit->text(), plainReason(e.what())));
+    return refuse(field.edit,
+                  QString("%1: %2 refused: %3").arg(name, field.edit->text(), plainReason(e.what())));
   }
   accept(field.edit);
   m_settings = candidate;

@@ -3,8 +3,8 @@
 /// The parameter panel: breathing frequency, contraction ratios r, gain scales, gut kappa, joint
 /// friction, gravity and the posture (a combo box of sim::postureNames()). Each edit is checked with the
 /// sim's own validators before anything is applied; an invalid value stays in its field, marked red, with the
-/// validator's reason shown under the panel, one line per refused field. While an affect or a pattern drives the
-/// breathing, the breath-style fields are disabled and the panel says what drives it.
+/// validator's reason shown under the panel, one line per refused field. While an affect or a pattern drives
+/// the breathing, the breath-style fields are disabled and the panel says what drives it.
 
 #include <QWidget>
 #include <functional>
@@ -31,10 +31,11 @@ class ParameterPanel : public QWidget {
   void setSettings(const RunSettings& settings, std::shared_ptr<const sim::Model> model);
   const RunSettings& settings() const { return m_settings; }
 
-  /// Every refused field's reason, one line each in field order ("<field>: <value> refused: <why>"), or empty.
+  /// Every refused field's reason, one line each in field order ("<field>: <value> refused: <why>"), or
+  /// empty.
   QString refusal() const;
-  /// Shows that `driver` (for example "affect 'fear'") drives the breathing instead of the breath style, whose
-  /// fields are then disabled; empty: the breath style drives, its fields are editable.
+  /// Shows that `driver` (for example "affect 'fear'") drives the breathing instead of the breath style,
+  /// whose fields are then disabled; empty: the breath style drives, its fields are editable.
   void setDriver(const QString& driver);
   /// What the panel says drives the breathing (empty: the breath style).
   QString driverText() const;
@@ -70,7 +71,7 @@ class ParameterPanel : public QWidget {
   RunSettings m_settings;
   std::shared_ptr<const sim::Model> m_model;
   std::vector<Field> m_fields;
-  std::size_t m_styleFieldCount = 0;  // the first fields edit the breath style
+  std::size_t m_styleFieldCount = 0;                      // the first fields edit the breath style
   std::vector<std::pair<QLineEdit*, QString>> m_refused;  // each refused field's reason, in the order refused
   QCheckBox* m_gravity = nullptr;
   QComboBox* m_posture = nullptr;

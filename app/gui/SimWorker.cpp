@@ -17,8 +17,8 @@ namespace pneuma::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kWallBudget = 0.030;  // [s] longest stepping batch between two sync points
-constexpr int kTickMs = 8;             // [ms] worker tick
+constexpr double kWallBudget = 0.030;          // [s] longest stepping batch between two sync points
+constexpr int kTickMs = 8;                     // [ms] worker tick
 constexpr double kRealTimeFactorWindow = 2.0;  // [s] wall time the real-time factor is measured over
 // [-] rise of the lung volume above its running minimum, as a fraction of it, that confirms an
 // end-expiration (0.5 %: 29 mL of a 5.8 L chest, well under a calm breath's 500 mL, well over the rib

@@ -9,8 +9,8 @@
 #include <array>
 #include <atomic>
 #include <chrono>
-#include <limits>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>

@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
       "export-gltf", "With --screenshot: export the recording as a glTF 2.0 .glb to FILE before the grab.",
       "FILE");
   const QCommandLineOption camera(
-      "camera", "Camera preset: anterior, lateral, superior, posterior or oblique (default).", "NAME", "oblique");
+      "camera", "Camera preset: anterior, lateral, superior, posterior or oblique (default).", "NAME",
+      "oblique");
   const QCommandLineOption labels("labels",
                                   "Show the anatomical labels and the lung cavity (teaching view).");
   const QCommandLineOption skin("skin", "The skin: translucent (default), opaque or hidden.", "MODE",
@@ -246,8 +247,8 @@ int main(int argc, char** argv) {
   if (preset == presets.end()) {
     QStringList valid;
     for (const auto& p : presets) valid << QString::fromStdString(p.first);
-    std::fprintf(stderr, "pneuma: --camera: unknown preset '%s' (valid: %s)\n", qPrintable(parser.value(camera)),
-                 qPrintable(valid.join(", ")));
+    std::fprintf(stderr, "pneuma: --camera: unknown preset '%s' (valid: %s)\n",
+                 qPrintable(parser.value(camera)), qPrintable(valid.join(", ")));
     return 2;
   }
 

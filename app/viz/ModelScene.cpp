@@ -318,11 +318,6 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkPolyData> cavity;
   vtkSmartPointer<vtkActor> cavityActor;
 
-  // the soft-tissue volume bodies, one surface of all their triangles over the nodes
-  vtkSmartPointer<vtkPolyData> tissue;
-  Eigen::Matrix3Xi tissueTriangles;
-  vtkSmartPointer<vtkActor> tissueActor;
-
   std::array<vtkSmartPointer<vtkPolyData>, 2> lungs;  // right, left
   std::array<vtkSmartPointer<vtkActor>, 2> lungActors;
 
@@ -356,8 +351,7 @@ struct ModelScene::Impl {
     bodies.clear();
     bodyPose.clear();
     labels.clear();
-    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = tissueActor = nullptr;
-    tissue = nullptr;
+    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = nullptr;
     ghost.clear();
     hasGhost = false;
     lungs = {};
@@ -377,8 +371,7 @@ struct ModelScene::Impl {
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
                        static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
-                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor),
-                       static_cast<vtkProp*>(tissueActor)})
+                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
       if (p) props.push_back(p);
     for (const auto& g : ghost) props.push_back(g.second);
     if (skinActor) props.push_back(skinActor);
@@ -528,27 +521,6 @@ struct ModelScene::Impl {
     gut = surface(model.nodes.size(), model.gut.triangles);
     gutActor = scalarSurfaceActor(gut, gutScalar, gutTable);
 
-    // the volume bodies: muscle-red, opaque, under the skin
-    if (model.volumes.size() > 0) {
-      Eigen::Index count = 0;
-      for (const Eigen::Matrix3Xi& t : model.volumes.triangles) count += t.cols();
-      tissueTriangles.resize(3, count);
-      count = 0;
-      for (const Eigen::Matrix3Xi& t : model.volumes.triangles) {
-        tissueTriangles.middleCols(count, t.cols()) = t;
-        count += t.cols();
-      }
-      tissue = surface(model.nodes.size(), tissueTriangles);
-      vtkNew<vtkFloatArray> normals;  // smooth shading: setNormals() at every update
-      normals->SetNumberOfComponents(3);
-      normals->SetNumberOfTuples(tissue->GetNumberOfPoints());
-      normals->Fill(0.0f);
-      tissue->GetPointData()->SetNormals(normals);
-      tissueActor = actorFor(tissue);
-      tissueActor->GetProperty()->SetColor(0.74, 0.33, 0.31);
-      tissueActor->PickableOff();
-    }
-
     cavity = surface(model.cavity.vertices.size(), model.cavity.triangles);
     cavityActor = actorFor(cavity);
     cavityActor->GetProperty()->SetColor(0.55, 0.78, 0.98);
@@ -644,7 +616,7 @@ struct ModelScene::Impl {
     // the closed surfaces (outward triangles, sim/Model.h) draw their front faces only: a translucent one
     // blends one layer instead of two, which halves its fragments under software OpenGL
     for (vtkActor* a : {gutActor.GetPointer(), cavityActor.GetPointer(), lungActors[0].GetPointer(),
-                        lungActors[1].GetPointer(), skinActor.GetPointer(), tissueActor.GetPointer()})
+                        lungActors[1].GetPointer(), skinActor.GetPointer()})
       if (a) a->GetProperty()->BackfaceCullingOn();
 
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
@@ -692,7 +664,6 @@ struct ModelScene::Impl {
                                                                       : "Gut\ndisplacement\n[mm]");
       gutBar->SetVisibility(options.showGut && coloured);
     }
-    if (tissueActor) tissueActor->SetVisibility(options.showTissue);
     if (cavityActor) cavityActor->SetVisibility(options.showCavity);
     for (const auto& a : lungActors)
       if (a) a->SetVisibility(options.showLungs);
@@ -889,12 +860,6 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
     }
   }
 
-  // the volume bodies: their nodes
-  if (s.tissue) {
-    Impl::setPoints(s.tissue, s.posed.gut);
-    Impl::setNormals(s.tissue, s.posed.gut, s.tissueTriangles, s.normalScratch);
-  }
-
   // cavity and landmarks
   if (s.cavity) {
     Impl::setPoints(s.cavity, s.posed.cavity);
@@ -1028,11 +993,12 @@ void ModelScene::setOptions(const DisplayOptions& options) {
 const DisplayOptions& ModelScene::options() const { return m_impl->options; }
 
 const std::vector<std::pair<std::string, CameraPreset>>& cameraPresets() {
-  static const std::vector<std::pair<std::string, CameraPreset>> presets{{"anterior", CameraPreset::Anterior},
-                                                                          {"lateral", CameraPreset::Lateral},
-                                                                          {"superior", CameraPreset::Superior},
-                                                                          {"posterior", CameraPreset::Posterior},
-                                                                          {"oblique", CameraPreset::Oblique}};
+  static const std::vector<std::pair<std::string, CameraPreset>> presets{
+      {"anterior", CameraPreset::Anterior},
+      {"lateral", CameraPreset::Lateral},
+      {"superior", CameraPreset::Superior},
+      {"posterior", CameraPreset::Posterior},
+      {"oblique", CameraPreset::Oblique}};
   return presets;
 }
 

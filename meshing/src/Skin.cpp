@@ -32,11 +32,8 @@ constexpr double kDepthScalp = 0.008;     // [m] scalp over the vertex of the sk
 constexpr double kDepthClavicle = 0.012;  // [m] skin and platysma over the clavicle's shaft
 constexpr double kBoneClearance = 0.006;  // [m] least distance from skin to bone after registration
 constexpr double kGutClearance = 0.010;   // [m] least distance from skin to the gut surface
-// [m] least distance from skin to a volume body's surface (pectorals, shoulders): the skin and the thin
-// subcutaneous fat over the muscle
-constexpr double kTissueClearance = 0.004;
-constexpr double kThighCut = 0.10;       // [m] legs cut this far below the crotch
-constexpr double kPerineumDepth = 0.07;  // [m] crotch (perineum) below the pelvic floor
+constexpr double kThighCut = 0.10;        // [m] legs cut this far below the crotch
+constexpr double kPerineumDepth = 0.07;   // [m] crotch (perineum) below the pelvic floor
 constexpr double kThighCutSlack = 0.03;  // [m] a surface ending less than this below the cut is not cut again
 constexpr double kAnchorSpacing = 0.012;  // [m] one bone-surface anchor per cell of this size
 // [m] a skin vertex takes all of its anchors' motion within kFollowNear of them through the tissue, none
@@ -649,8 +646,7 @@ struct Obstacles {
   Points point;
   Points normal;
   std::vector<double> clearance;  // [m]
-  std::vector<int> body;          // body index, -1 for a node
-  std::vector<int> node;          // node index (a gut node or a volume body's superficial node), else -1
+  std::vector<int> body;          // body index, -1 for the gut
 };
 
 Obstacles obstaclesOf(const BuiltModel& built) {
@@ -664,31 +660,14 @@ Obstacles obstaclesOf(const BuiltModel& built) {
       o.normal.push_back(n.col(i));
       o.clearance.push_back(kBoneClearance);
       o.body.push_back(b);
-      o.node.push_back(-1);
     }
   }
-  // the nodes: the gut's, and the volume bodies' superficial ones (the skin lies over the pectorals and
-  // shoulders and follows them); their deep nodes, tied to a bone (a spring from the node to a body), lie
-  // under them
-  Eigen::Matrix3Xi surfaces = m.gut.triangles;
-  for (const Eigen::Matrix3Xi& t : m.volumes.triangles) {
-    surfaces.conservativeResize(3, surfaces.cols() + t.cols());
-    surfaces.rightCols(t.cols()) = t;
-  }
-  const Eigen::Matrix3Xd n = vertexNormals(m.nodes.rest, surfaces);
-  std::vector<char> isTied(static_cast<std::size_t>(m.nodes.size()), 0);
-  for (int e = 0; e < m.elements.size(); ++e)
-    if (sim::isApposition(m.elements, e))
-      for (const sim::AnchorSet* a : {&m.elements.endA, &m.elements.endB})
-        if (a->body[static_cast<std::size_t>(e)] < 0) isTied[static_cast<std::size_t>(a->nodes(0, e))] = 1;
+  const Eigen::Matrix3Xd n = vertexNormals(m.nodes.rest, m.gut.triangles);
   for (int i = 0; i < m.nodes.size(); ++i) {
-    const bool isTissue = m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Tissue;
-    if (isTissue && isTied[static_cast<std::size_t>(i)]) continue;
     o.point.push_back(m.nodes.rest.col(i));
     o.normal.push_back(n.col(i));
-    o.clearance.push_back(isTissue ? kTissueClearance : kGutClearance);
+    o.clearance.push_back(kGutClearance);
     o.body.push_back(-1);
-    o.node.push_back(i);
   }
   return o;
 }
@@ -808,7 +787,8 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
       if (b >= 0)
         out.anchors.addBodyPoint(b, o.point[static_cast<std::size_t>(src)] - m.bodies.com.col(b));
       else
-        out.anchors.addNodePoint({o.node[static_cast<std::size_t>(src)], -1, -1}, {1, 0, 0});
+        out.anchors.addNodePoint({src - static_cast<int>(o.point.size()) + m.nodes.size(), -1, -1},
+                                 {1, 0, 0});
     }
     return simAnchor[static_cast<std::size_t>(a)];
   };

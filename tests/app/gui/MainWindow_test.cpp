@@ -617,7 +617,8 @@ TEST_F(DefaultModelWindow, AffectAndPatternScenariosOpenPlayAndSaveWhatDrivesThe
   // the style box and the parameter panel say that the pattern drives, not the calm style
   EXPECT_EQ(window.styleBox()->currentText().toStdString(), "pattern 'startle-at-10s'");
   EXPECT_FALSE(window.parameters()->frequencyField()->isEnabled());
-  EXPECT_TRUE(window.parameters()->driverText().contains("pattern")) << window.parameters()->driverText().toStdString();
+  EXPECT_TRUE(window.parameters()->driverText().contains("pattern"))
+      << window.parameters()->driverText().toStdString();
   ASSERT_TRUE(window.runUntil(5.0, 120000)) << window.lastError().toStdString();
   const app::PlotView* plot = window.plots()->volumePlot();
   ASSERT_EQ(plot->series().size(), 2u) << "simulated and target volume";
@@ -854,8 +855,8 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
   ASSERT_TRUE(pvd.open(QIODevice::ReadOnly));
   const QByteArray text = pvd.readAll();
   EXPECT_TRUE(text.contains("<VTKFile type=\"Collection\""));
-  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 7 parts each)
-  EXPECT_GE(text.count("<DataSet"), 7 * 30);
+  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 6 parts each)
+  EXPECT_GE(text.count("<DataSet"), 6 * 30);
   EXPECT_FALSE(QDir(out.filePath("run")).entryList({"*.vtp"}, QDir::Files).isEmpty());
 
   // an unwritable destination is an error, not a crash
@@ -1043,8 +1044,7 @@ TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
       for (std::size_t j = 0; j < boxes.size(); ++j) {
         if (j == i) continue;
         EXPECT_FALSE(boxes[i].rect.intersects(boxes[j].rect))
-            << "camera " << name << ": '" << boxes[i].text << "' covers '"
-            << boxes[j].text << "'";
+            << "camera " << name << ": '" << boxes[i].text << "' covers '" << boxes[j].text << "'";
       }
     }
     EXPECT_EQ(groups, 6);
