@@ -200,6 +200,24 @@ GutSurface buildGut(const AnatomyParams& a, const Skeleton& sk) {
   g.triangles.resize(3, static_cast<Eigen::Index>(tris.size()));
   for (std::size_t f = 0; f < tris.size(); ++f) g.triangles.col(static_cast<Eigen::Index>(f)) = tris[f];
   if (enclosedVolume(g.rest, g.triangles) < 0.0) g.triangles.row(1).swap(g.triangles.row(2));
+
+  // The dome's cap above the zone of apposition: its rings are the spine-notched outline scaled toward a
+  // centre near the notch, so the inner rings are concave at the back and zipping them leaves slivers there
+  // (on the default model a triangle 3.7 mm high on a 31 mm base beside the apex, which turned over at
+  // calm end-inspiration: the gut's and the cavity's only self-crossings). The cap is a height field over
+  // the transverse (x-y) plane, so its Delaunay triangulation there (delaunayFlips()) keeps the nodes and
+  // replaces the slivers. The zone of apposition and the rim keep the ring-to-ring triangulation.
+  std::vector<char> isCap(pts.size(), 0);
+  isCap[static_cast<std::size_t>(g.apex)] = 1;
+  for (std::size_t r = 0; r < g.domeRing.size(); ++r)
+    if (g.domeRingRise[r] > a.abdomen.appositionHeight)
+      for (const int v : g.domeRing[r]) isCap[static_cast<std::size_t>(v)] = 1;
+  std::vector<char> onCap(static_cast<std::size_t>(g.triangles.cols()), 0);
+  for (Eigen::Index f = 0; f < g.triangles.cols(); ++f)
+    onCap[static_cast<std::size_t>(f)] = isCap[static_cast<std::size_t>(g.triangles(0, f))] &&
+                                         isCap[static_cast<std::size_t>(g.triangles(1, f))] &&
+                                         isCap[static_cast<std::size_t>(g.triangles(2, f))];
+  delaunayFlips(g.triangles, g.rest.topRows<2>(), onCap);
   return g;
 }
 

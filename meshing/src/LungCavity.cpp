@@ -250,76 +250,14 @@ struct LungMeshes {
 /// moved and the face stays flat, so every volume is unchanged. Measured on the default model (crossing pairs
 /// summed over every style and affect, tests/validation/Surfaces_test.cpp): 1558 before, 877 after.
 void flipMediastinalFaces(TriangleMesh& lung, double faceX) {
-  const auto at = [](int i) { return static_cast<std::size_t>(i); };
-  const int nf = lung.triangleCount();
-  std::vector<char> isFlat(at(nf), 0);
-  for (int f = 0; f < nf; ++f) {
+  std::vector<char> isFlat(static_cast<std::size_t>(lung.triangleCount()), 0);
+  for (int f = 0; f < lung.triangleCount(); ++f) {
     bool flat = true;
     for (int k = 0; k < 3; ++k)
       flat = flat && std::abs(lung.vertices(0, lung.triangles(k, f)) - faceX) < kOnSurface;
-    isFlat[at(f)] = flat;
+    isFlat[static_cast<std::size_t>(f)] = flat;
   }
-  // y-z coordinates on the face; twice the signed area of (a, b, c)
-  const auto yz = [&](int v) { return Eigen::Vector2d(lung.vertices(1, v), lung.vertices(2, v)); };
-  const auto orient = [&](int a, int b, int c) {
-    const Eigen::Vector2d u = yz(b) - yz(a), w = yz(c) - yz(a);
-    return u.x() * w.y() - u.y() * w.x();
-  };
-  // > 0 when d lies inside the circumcircle of the counter-clockwise triangle (a, b, c)
-  const auto inCircle = [&](int a, int b, int c, int d) {
-    Eigen::Matrix3d m;
-    const std::array<int, 3> abc{a, b, c};
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector2d q = yz(abc[static_cast<std::size_t>(i)]) - yz(d);
-      m.row(i) << q.x(), q.y(), q.squaredNorm();
-    }
-    return m.determinant();
-  };
-  using Edge = std::pair<int, int>;
-  const auto edge = [](int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; };
-  std::map<Edge, std::vector<int>> faces;  // undirected edge -> the triangles that hold it
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k)
-      faces[edge(lung.triangles(k, f), lung.triangles((k + 1) % 3, f))].push_back(f);
-  // one flip at a time, each found by a fresh scan of the edges (the map changes under the scan)
-  constexpr int kMaxFlips = 100000;
-  for (int flip = 0; flip < kMaxFlips; ++flip) {
-    bool isFlipped = false;
-    for (auto it = faces.begin(); it != faces.end(); ++it) {
-      if (it->second.size() != 2 || !isFlat[at(it->second[0])] || !isFlat[at(it->second[1])]) continue;
-      const int f = it->second[0], g = it->second[1];
-      // f = (a, b, c) with a -> b the shared edge; g = (b, a, d) in a consistently oriented mesh
-      int k = 0;
-      while (edge(lung.triangles(k, f), lung.triangles((k + 1) % 3, f)) != it->first) ++k;
-      const int a = lung.triangles(k, f), b = lung.triangles((k + 1) % 3, f),
-                c = lung.triangles((k + 2) % 3, f);
-      int d = -1;
-      for (int j = 0; j < 3; ++j)
-        if (lung.triangles(j, g) == b && lung.triangles((j + 1) % 3, g) == a)
-          d = lung.triangles((j + 2) % 3, g);
-      if (d < 0 || faces.count(edge(c, d)) > 0) continue;
-      // the quadrilateral's size sets the tolerances (its coordinates are rounded to kGrid)
-      double size = 0.0;
-      for (const int v : {b, c, d}) size = std::max(size, (yz(v) - yz(a)).norm());
-      const double s = orient(a, b, c) > 0.0 ? 1.0 : -1.0;
-      if (s * orient(a, b, c) < 1e-9 * size * size || s * orient(b, a, d) < 1e-9 * size * size)
-        continue;  // a triangle of no area, whose orientation the rounding decides
-      if (s * orient(a, d, c) < 1e-6 * size * size || s * orient(b, c, d) < 1e-6 * size * size)
-        continue;  // a quadrilateral that is not strictly convex
-      if (s * inCircle(a, b, c, d) <= 1e-6 * std::pow(size, 4)) continue;  // Delaunay already (or cocircular)
-      // flip a-b to c-d: (a, d, c) and (b, c, d), orientation kept
-      lung.triangles.col(f) << a, d, c;
-      lung.triangles.col(g) << b, c, d;
-      const Edge old = it->first;
-      for (const auto& [e, from, to] : {std::tuple{edge(b, c), f, g}, std::tuple{edge(a, d), g, f}})
-        std::replace(faces[e].begin(), faces[e].end(), from, to);
-      faces[edge(c, d)] = {f, g};
-      faces.erase(old);
-      isFlipped = true;
-      break;
-    }
-    if (!isFlipped) return;
-  }
+  delaunayFlips(lung.triangles, lung.vertices.bottomRows<2>(), isFlat);  // the face's y-z coordinates
 }
 
 /// [m] spacing of the points added inside each lung's mediastinal face (addFacePoints()). Measured on the

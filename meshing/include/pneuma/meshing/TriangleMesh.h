@@ -3,6 +3,7 @@
 /// An indexed triangle mesh and the integral properties of the solid it bounds.
 
 #include <Eigen/Core>
+#include <vector>
 
 namespace pneuma::meshing {
 
@@ -44,5 +45,17 @@ MassProperties massProperties(const TriangleMesh& mesh, double density);
 
 /// Quality of a triangle, q = 4 sqrt(3) area / (sum of squared edge lengths): 1 equilateral, 0 degenerate.
 double triangleQuality(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+/// Delaunay edge flips (Lawson 1977, "Software for C1 surface interpolation") of the part of a consistently
+/// oriented triangle mesh that `isFlippable` marks (one flag per triangle), in the plane coordinates `planar`
+/// (2 x #V) [m] of its vertices: an edge shared by two marked triangles is flipped while the opposite corner
+/// of the other triangle lies strictly inside the circumcircle of the first and the two form a strictly
+/// convex quadrilateral (tolerances scaled by the quadrilateral's size). This ends with the Delaunay
+/// triangulation of the same points, which maximises the smallest angle; no vertex is added or moved,
+/// orientation is kept, and marked triangles stay marked. Cocircular quadrilaterals (ties, as in
+/// mirror-symmetric meshes) are left as they are, so the result does not depend on the order of the scan.
+/// Returns the number of flips.
+int delaunayFlips(Eigen::Matrix3Xi& triangles, const Eigen::Matrix2Xd& planar,
+                  const std::vector<char>& isFlippable);
 
 }  // namespace pneuma::meshing
