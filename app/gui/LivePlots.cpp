@@ -342,7 +342,7 @@ bool LivePlots::refresh() {
   if (atCursor)
     flowNote +=
         QString("  at %1 s: %2 L/s").arg(m_cursor, 0, 'f', 2).arg(m_plots[4]->cursorValue(0), 0, 'f', 2);
-  if (n > 0) m_plots[4]->setNote(flowNote);
+  m_plots[4]->setNote(n > 0 ? flowNote : QString());
   std::vector<PlotView::Series> pressures{{"abdominal (gut) pressure", QColor(120, 40, 160), false,
                                            column(kGutPressure, 1.0 / kPascalPerCmH2O), "Pab (gut)"}};
   std::vector<double> pdi = column(kPdi, 1.0 / kPascalPerCmH2O);
@@ -357,22 +357,25 @@ bool LivePlots::refresh() {
       pressures.push_back(std::move(pab));
   }
   m_plots[5]->setData(time, std::move(pressures));
+  QString pressureNote;  // none while the plots are empty (after a reset), like the others
   if (n > 0) {
     const double pab = atCursor ? m_plots[5]->cursorValue(0) : m_latest.gutPressure / kPascalPerCmH2O;
     const double pdiNow = hasPdi ? (atCursor ? m_plots[5]->cursorValue(1)
                                              : m_latest.transdiaphragmaticPressure / kPascalPerCmH2O)
                                  : std::numeric_limits<double>::quiet_NaN();
-    QString pressureNote = (atCursor ? QString("at %1 s: ").arg(m_cursor, 0, 'f', 2) : QString()) +
-                           QString("Pab %1").arg(pab, 0, 'f', 1);
+    pressureNote = (atCursor ? QString("at %1 s: ").arg(m_cursor, 0, 'f', 2) : QString()) +
+                   QString("Pab %1").arg(pab, 0, 'f', 1);
     if (hasPdi) pressureNote += QString("  Pdi %1").arg(pdiNow, 0, 'f', 1);
-    m_plots[5]->setNote(pressureNote + " cmH2O");
+    pressureNote += " cmH2O";
   }
+  m_plots[5]->setNote(pressureNote);
   refreshLoops();
 
   // gut volume error [%]
   m_plots[1]->setData(time,
                       {{"gut volume error", QColor(120, 40, 160), false, column(kGut, 100.0), QString()}});
-  if (n > 0) m_plots[1]->setNote(QString("now %1 %").arg(100.0 * m_latest.gutVolumeError, 0, 'f', 3));
+  m_plots[1]->setNote(n > 0 ? QString("now %1 %").arg(100.0 * m_latest.gutVolumeError, 0, 'f', 3)
+                            : QString());
 
   // activations r and alpha, and mean tension, of the muscle groups
   std::vector<PlotView::Series> act;

@@ -105,15 +105,16 @@ QString breathingText(const sim::Summary* b) {
     return std::isfinite(v) ? QString("%1 %2").arg(v * scale, 0, 'f', decimals).arg(unit) : QString("n/a");
   };
   const sim::Motion& m = b->motion;
-  return QStringList{QString("Tidal volume %1 at %2")
-                         .arg(value(b->tidalVolume, 1e6, 0, "mL"), value(b->breathsPerMinute, 1.0, 1, "b/m")),
-                     "Dome descent " + value(m.domeDescent, 1e3, 1, "mm"),
-                     "Rib 8 widening " + value(m.lowerRibExpansion, 1e3, 1, "mm"),
-                     "Sternum forward " + value(m.sternumAnterior, 1e3, 1, "mm") + ", up " +
-                         value(m.sternumCranial, 1e3, 1, "mm"),
-                     "Belly forward " + value(m.umbilicusAnterior, 1e3, 1, "mm"),
-                     "Rib cage share " + value(m.ribCageShare(), 100.0, 0, "%"),
-                     "Rib cage-abdomen phase " + value(m.phaseAngle, 180.0 / M_PI, 0, "\u00b0")}
+  return QStringList{
+      QString("Tidal volume %1 at %2")
+          .arg(value(b->tidalVolume, 1e6, 0, "mL"), value(b->breathsPerMinute, 1.0, 1, "b/min")),
+      "Dome descent " + value(m.domeDescent, 1e3, 1, "mm"),
+      "Rib 8 widening " + value(m.lowerRibExpansion, 1e3, 1, "mm"),
+      "Sternum forward " + value(m.sternumAnterior, 1e3, 1, "mm"),
+      "Sternum upward " + value(m.sternumCranial, 1e3, 1, "mm"),
+      "Belly forward " + value(m.umbilicusAnterior, 1e3, 1, "mm"),
+      "Rib cage share " + value(m.ribCageShare(), 100.0, 0, "%"),
+      "Rib cage-abdomen phase " + value(m.phaseAngle, 180.0 / M_PI, 0, "\u00b0")}
       .join('\n');
 }
 
@@ -339,6 +340,8 @@ void MainWindow::buildActions() {
   tools->addWidget(new QLabel(" Breath style ", this));
   m_styleCombo = new QComboBox(this);
   m_styleCombo->setMinimumWidth(130);
+  // wide enough for what drives instead of a style ("pattern 'startle-at-10s'")
+  m_styleCombo->setSizeAdjustPolicy(QComboBox::AdjustToContents);
   connect(m_styleCombo, &QComboBox::textActivated, this,
           [this](const QString& name) { setBreathStyle(name); });
   tools->addWidget(m_styleCombo);

@@ -37,17 +37,14 @@ std::string tickLabel(double v, double step) {
   return buf;
 }
 
-/// `text`, or when it is wider than `room` its tail after whole leading words dropped, behind an ellipsis
-/// ("lung-cavity volume [mL]" -> "\u2026volume [mL]"), so the unit stays readable.
+/// `text`, or when it is wider than `room` its unit alone ("tension [N]" -> "[N]": the plot's title names the
+/// quantity), never a fragment behind an ellipsis; when not even the unit fits, the whole text.
 std::string fitted(const std::string& text, double room,
                    const std::function<double(const std::string&)>& width) {
   if (width(text) <= room) return text;
-  const std::string ellipsis = "\u2026";
-  for (std::size_t at = text.find(' '); at != std::string::npos; at = text.find(' ', at + 1)) {
-    const std::string tail = ellipsis + text.substr(at + 1);
-    if (width(tail) <= room) return tail;
-  }
-  return text;  // not even the last word fits: keep the whole text rather than a fragment
+  const std::size_t open = text.rfind('[');
+  if (open != std::string::npos && open > 0 && width(text.substr(open)) <= room) return text.substr(open);
+  return text;
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "StepInternal.h"
 #include "pneuma/sim/Error.h"
@@ -30,21 +31,71 @@ void explicitVelocityUpdate(const Model& model, State& s, double dt, StepWork& w
   }
 }
 
-// joint friction (Eq. 3) for symplectic Euler, backward Euler per joint: the relative angular velocity
-// w_rel decays as (1 + dt mu W) w_rel' = w_rel with W = I_c^-1 + I_p^-1 (world), so any mu / I is stable
-void integrateJointFriction(const Model& model, State& s, double dt, const StepOptions& o,
-                            const StepWork& w) {
+// the joints of symplectic Euler, one backward-Euler solve per step: at every ball joint the linear impulse
+// lambda that stops the anchors' relative velocity u, and the angular impulse Lambda of the joint's friction
+// mu (Eq. 3) and rotational springs K (spine stiffness, rib-neck lock; Joints) with the relative angular
+// velocity w' after the step, Lambda = -dt mu w' - dt K (theta + dt w'). Gauss-Seidel over the joints, each
+// joint a 6x6 block solve:
+//   A lambda + C^T dLambda = -u,   c C lambda + (1 + c W) dLambda = -R,
+//   A = sum_b (1/m_b - [r_b] I_b^-1 [r_b]),  C = sum_b I_b^-1 [r_b],  W = sum_b I_b^-1,  c = dt mu + dt^2 K,
+// R = Lambda + c w + dt K theta the residual of the angular law (b: the two bodies, [r] the cross-product
+// matrix of the lever, world inverse inertias). Solving a joint's angle, friction and anchor together keeps
+// the scheme stable: friction and springs on a 10 g rib (mu dt / I ~ 50) applied about its centre of mass,
+// then anchor impulses about the joint, fought each other and pumped energy into the rib-neck hinges (issue
+// 13: the deep breath blew up at 0.16 s)
+void solveJointsImplicitly(const Model& model, State& s, double dt, const StepOptions& o, StepWork& w) {
+  constexpr double kVelocityTolerance = 1e-6;  // [m/s], [rad/s] of the residuals, scaled below
   const Joints& j = model.joints;
-  for (int i = 0; i < j.size(); ++i) {
-    const double mu = j.friction(i) * o.jointFrictionScale;
-    if (mu == 0.0) continue;
+  const int nj = j.size();
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  std::vector<Eigen::PartialPivLU<Matrix6d>> blocks(at(nj));
+  std::vector<Matrix3d> damping(at(nj)), spring(at(nj));
+  std::vector<Vector3d> springImpulse(at(nj)), leverP(at(nj)), leverC(at(nj)),
+      angular(at(nj), Vector3d::Zero());
+  auto invMass = [&](int b) { return model.bodies.isFixed[at(b)] ? 0.0 : 1.0 / model.bodies.mass(b); };
+  for (int i = 0; i < nj; ++i) {
     const int p = j.parent[at(i)], c = j.child[at(i)];
-    const Matrix3d inv = w.scratch.inverseInertiaWorld[at(c)] + w.scratch.inverseInertiaWorld[at(p)];
-    const Vector3d rel = s.bodyAngularVelocity.col(c) - s.bodyAngularVelocity.col(p);
-    const Vector3d relNew = (Matrix3d::Identity() + dt * mu * inv).inverse() * rel;
-    const Vector3d impulse = -dt * mu * relNew;  // [N m s] angular impulse on the child
-    s.bodyAngularVelocity.col(c) += w.scratch.inverseInertiaWorld[at(c)] * impulse;
-    s.bodyAngularVelocity.col(p) -= w.scratch.inverseInertiaWorld[at(p)] * impulse;
+    leverP[at(i)] = w.scratch.rotation[at(p)] * w.constants.jointLocalParent.col(i);
+    leverC[at(i)] = w.scratch.rotation[at(c)] * w.constants.jointLocalChild.col(i);
+    const Matrix3d& ip = w.scratch.inverseInertiaWorld[at(p)];
+    const Matrix3d& ic = w.scratch.inverseInertiaWorld[at(c)];
+    const Matrix3d sp = skew(leverP[at(i)]), sc = skew(leverC[at(i)]);
+    const Matrix3d a = (invMass(p) + invMass(c)) * Matrix3d::Identity() - sp * ip * sp - sc * ic * sc;
+    const Matrix3d cc = ic * sc + ip * sp;
+    spring[at(i)] = jointStiffness(j, i, w.scratch.rotation[at(p)]);
+    damping[at(i)] =
+        dt * j.friction(i) * o.jointFrictionScale * Matrix3d::Identity() + dt * dt * spring[at(i)];
+    springImpulse[at(i)] = dt * (spring[at(i)] * jointRotation(s, p, c));
+    Matrix6d m;
+    m << a, cc.transpose(), damping[at(i)] * cc, Matrix3d::Identity() + damping[at(i)] * (ic + ip);
+    blocks[at(i)].compute(m);
+  }
+  for (int it = 0; it < o.jointIterations; ++it) {
+    double worst = 0.0;
+    for (int i = 0; i < nj; ++i) {
+      const int p = j.parent[at(i)], c = j.child[at(i)];
+      const Vector3d &rp = leverP[at(i)], &rc = leverC[at(i)];
+      const Vector3d u = (s.bodyVelocity.col(c) + s.bodyAngularVelocity.col(c).cross(rc)) -
+                         (s.bodyVelocity.col(p) + s.bodyAngularVelocity.col(p).cross(rp));
+      const Vector3d rel = s.bodyAngularVelocity.col(c) - s.bodyAngularVelocity.col(p);
+      const Vector3d r = angular[at(i)] + damping[at(i)] * rel + springImpulse[at(i)];
+      worst = std::max({worst, u.norm(), r.norm() * w.scratch.inverseInertiaWorld[at(c)].norm()});
+      Vector6d rhs;
+      rhs << -u, -r;
+      const Vector6d x = blocks[at(i)].solve(rhs);
+      const Vector3d lambda = x.head<3>(), dLambda = x.tail<3>();
+      angular[at(i)] += dLambda;
+      if (!model.bodies.isFixed[at(c)]) {
+        s.bodyVelocity.col(c) += lambda / model.bodies.mass(c);
+        s.bodyAngularVelocity.col(c) += w.scratch.inverseInertiaWorld[at(c)] * (rc.cross(lambda) + dLambda);
+      }
+      if (!model.bodies.isFixed[at(p)]) {
+        s.bodyVelocity.col(p) -= lambda / model.bodies.mass(p);
+        s.bodyAngularVelocity.col(p) -= w.scratch.inverseInertiaWorld[at(p)] * (rp.cross(lambda) + dLambda);
+      }
+    }
+    if (worst < kVelocityTolerance) break;
   }
 }
 
@@ -235,12 +286,12 @@ void step(const Model& model, State& state, double dt, const Activations& act, c
   // integrate velocities
   if (options.integrator == IntegratorKind::SymplecticEuler) {
     explicitVelocityUpdate(model, state, dt, work);
-    integrateJointFriction(model, state, dt, options, work);
-  } else
+    solveJointsImplicitly(model, state, dt, options, work);
+  } else {
     implicitVelocityUpdate(model, state, dt, options, work);
-
-  // joints: remove relative velocity at every ball joint
-  solveJointVelocities(model, state, options, work);
+    // joints: remove relative velocity at every ball joint
+    solveJointVelocities(model, state, options, work);
+  }
 
   // integrate positions with the new velocities
   integratePositions(model, state, dt, work);

@@ -175,10 +175,11 @@ void accumulatePleuralPressure(const Model& model, const State& s, StepWork& w) 
 }
 
 // joint friction tau = -mu (w_child - w_parent) (Eq. 3) and passive rotational stiffness tau = -K theta;
-// the friction is left out for symplectic Euler, which integrates it implicitly (integrateJointFriction)
+// left out for symplectic Euler, which integrates both implicitly with the joints (solveJointsImplicitly)
 void accumulateJointTorques(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
   const Joints& j = model.joints;
-  const double frictionScale = o.integrator != IntegratorKind::SymplecticEuler ? o.jointFrictionScale : 0.0;
+  if (o.integrator == IntegratorKind::SymplecticEuler) return;
+  const double frictionScale = o.jointFrictionScale;
   for (int i = 0; i < j.size(); ++i) {
     const int p = j.parent[at(i)], c = j.child[at(i)];
     const double mu = j.friction(i) * frictionScale;

@@ -35,6 +35,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <set>
 #include <tuple>
@@ -698,6 +699,38 @@ TEST_F(DefaultModelWindow, OpenedTraceIsDrawnOnTheVolumePlotWithItsTrackingRms) 
   ASSERT_TRUE(window.runUntil(15.0, 60000));
   window.plots()->refresh();
   EXPECT_TRUE(QString::fromStdString(plot->toPlot().note()).contains("tracking RMS"));
+}
+
+// Reset empties the plots and every read-out above them: no note keeps the run before the reset (the gut
+// volume error's "now -0.244 %" stayed); the next samples write them again, as the plotted values
+TEST(MainWindow, ResetClearsEveryPlotsReadOut) {
+  ToyWindow w;
+  ASSERT_TRUE(w.window.runUntil(1.0));
+  const app::PlotView* gut = w.window.plots()->plots()[1];
+  const std::string before = gut->toPlot().note();
+  EXPECT_EQ(before.rfind("now ", 0), 0u) << before;
+  for (QAction* a : w.window.findChildren<QAction*>())
+    if (a->text() == "Reset") a->trigger();
+  QElapsedTimer clock;
+  clock.start();
+  while (!w.window.plots()->volumePlot()->time().empty() && clock.elapsed() < 10000)
+    QApplication::processEvents(QEventLoop::AllEvents, 20);
+  ASSERT_TRUE(w.window.plots()->volumePlot()->time().empty()) << "the reset emptied the plots";
+  for (const app::PlotView* plot : w.window.plots()->plots())
+    EXPECT_EQ(plot->toPlot().note(), "") << plot->title().toStdString() << " keeps a read-out of the old run";
+  // the new run's read-out: the gut volume error of its latest sample, within the last plotted values
+  ASSERT_TRUE(w.window.runUntil(0.5));
+  const std::string after = gut->toPlot().note();
+  double shown = std::nan("");
+  ASSERT_EQ(std::sscanf(after.c_str(), "now %lf %%", &shown), 1) << after;
+  const std::vector<double>& t = gut->time();
+  const std::vector<double>& y = gut->series()[0].y;
+  ASSERT_FALSE(t.empty());
+  double lo = 1e300, hi = -1e300;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] >= t.back() - 0.1) lo = std::min(lo, y[k]), hi = std::max(hi, y[k]);
+  EXPECT_GE(shown, lo - 5e-4) << after;
+  EXPECT_LE(shown, hi + 5e-4) << after;
 }
 
 TEST(MainWindow, ScrubbingRestoresThatInstantsVolumeInThePlotCursor) {

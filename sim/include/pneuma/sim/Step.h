@@ -293,9 +293,9 @@ StepWork makeStepWork(const Model& model);
 /// Stage 1 alone: clears and accumulates work.scratch.bodyForce [N], bodyTorque [N m] (world, about each com)
 /// and nodeForce [N] from muscles (Eq. 2), cartilage springs, gut pressure (Eq. 4, 5), the pleural pressure
 /// (Cavity), joint friction (Eq. 3) and stiffness, gravity and the gyroscopic term; also fills the
-/// per-element, gut and cavity by-products. Joint friction is included for ImplicitEulerJoints only;
-/// SymplecticEuler integrates it implicitly per joint right after the velocity update (unconditionally stable
-/// for light bones).
+/// per-element, gut and cavity by-products. Joint friction and joint stiffness are included for
+/// ImplicitEulerJoints only; SymplecticEuler integrates both by backward Euler together with the ball-joint
+/// constraint, after the velocity update (docs/integrator.md: unconditionally stable for light bones).
 void computeForces(const Model& model, const State& state, const Activations& act, const StepOptions& options,
                    StepWork& work);
 
