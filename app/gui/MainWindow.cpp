@@ -74,6 +74,7 @@ const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructur
     {"Bones", &viz::DisplayOptions::showBones},
     {"Gut", &viz::DisplayOptions::showGut},
     {"Translucent gut", &viz::DisplayOptions::isGutTranslucent},
+    {"Pectorals and shoulders", &viz::DisplayOptions::showTissue},
     {"Lung cavity", &viz::DisplayOptions::showCavity},
     {"Lungs", &viz::DisplayOptions::showLungs},
     {"Landmarks", &viz::DisplayOptions::showLandmarks},
