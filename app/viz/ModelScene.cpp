@@ -2,6 +2,7 @@
 
 #include <vtkActor.h>
 #include <vtkAxesActor.h>
+#include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCaptionActor2D.h>
 #include <vtkCellArray.h>
@@ -28,6 +29,7 @@
 #include <vtkProperty2D.h>
 #include <vtkQuadricDecimation.h>
 #include <vtkRenderStepsPass.h>
+#include <vtkRenderWindow.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
@@ -35,6 +37,7 @@
 #include <vtkStaticCellLocator.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTextRenderer.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
@@ -149,6 +152,11 @@ double autoTop(std::vector<double>& values, double top) {
 
 constexpr double kPascalPerCmH2O = 98.0665;  // [Pa / cmH2O]
 
+constexpr int kLabelFontSize = 13;  // [px] every teaching caption's text
+constexpr int kLabelPadding = 2;    // [px] between a caption's text and its box
+constexpr int kLabelGap = 3;        // [px] kept free between two captions, and between a caption and a legend
+constexpr int kLabelOffset = 28;    // [px] from a point to the near edge of its caption
+
 // a teaching label: a caption drawn over the scene (never hidden by it) with a leader to its point
 vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
   auto label = vtkSmartPointer<vtkCaptionActor2D>::New();
@@ -156,11 +164,13 @@ vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
   label->BorderOff();
   label->LeaderOn();
   label->ThreeDimensionalLeaderOff();
-  label->SetPadding(2);
-  label->SetWidth(0.022 + 0.0105 * static_cast<double>(text.size()));
-  label->SetHeight(0.034);
+  label->SetPadding(kLabelPadding);
+  // the box in pixels (layoutLabels() sizes it to the text at kLabelFontSize, so every caption has that size)
+  label->GetPosition2Coordinate()->SetCoordinateSystemToDisplay();
   label->GetProperty()->SetColor(1.0, 1.0, 0.8);
   vtkTextProperty* t = label->GetCaptionTextProperty();
+  t->SetFontSize(kLabelFontSize);
+  label->GetTextActor()->SetTextScaleModeToNone();  // that size, not scaled to fill the box
   t->SetColor(1.0, 1.0, 0.85);
   t->SetBackgroundColor(0.08, 0.09, 0.12);
   t->SetBackgroundOpacity(0.7);
@@ -336,6 +346,7 @@ std::array<double, 3> groupColour(sim::ElementGroup g) {
 struct ModelScene::Impl {
   vtkSmartPointer<vtkRenderer> renderer = vtkSmartPointer<vtkRenderer>::New();
   vtkSmartPointer<vtkOrientationMarkerWidget> marker;
+  unsigned long layoutObserver = 0;  // the renderer's StartEvent observer that runs layoutLabels()
   vtkSmartPointer<vtkLookupTable> forceTable = makeForceTable();
   vtkSmartPointer<vtkLookupTable> gutTable = makeGutTable();
   vtkSmartPointer<vtkLookupTable> activationTable = makeActivationTable();
@@ -651,16 +662,14 @@ struct ModelScene::Impl {
       Label label{makeLabel(name), static_cast<int>(l), -1, -1};
       labels.push_back(label);
     }
-    // group captions: a fixed column at the lower left of the view (above the orientation axes, below the
-    // landmarks' captions), one row per group, so that they never overlap; their leaders follow the groups
-    int row = 0;
+    // group captions: a fixed column at the lower left of the view (layoutLabels()), one row per group, so
+    // that they never overlap; their leaders follow the groups
     for (int gi = 0; gi < kGroups; ++gi) {
       if (groups[static_cast<std::size_t>(gi)].element.empty()) continue;
       auto caption = makeLabel(groupLabel(static_cast<sim::ElementGroup>(gi)));
       vtkCoordinate* at = caption->GetPositionCoordinate();
       at->SetReferenceCoordinate(nullptr);
-      at->SetCoordinateSystemToNormalizedViewport();
-      at->SetValue(0.015, 0.44 - 0.055 * row++);
+      at->SetCoordinateSystemToDisplay();  // placed by layoutLabels()
       labels.push_back(Label{caption, -1, gi, -1});
     }
     for (int b = 0; b < model.bodies.size(); ++b) {
@@ -717,6 +726,149 @@ struct ModelScene::Impl {
     return out.str();
   }
 
+  // the shown legends one above the other down the right edge (tension, skin, gut): two of 0.4 of the view's
+  // height each, as each was made, three of 0.27, so that none covers another
+  void stackLegends() {
+    std::vector<vtkScalarBarActor*> shown;
+    for (vtkScalarBarActor* bar : {forceBar.GetPointer(), skinBar.GetPointer(), gutBar.GetPointer()})
+      if (bar->GetVisibility()) shown.push_back(bar);
+    const double n = static_cast<double>(shown.size());
+    const double h = shown.size() > 2 ? 0.27 : 0.4;                          // [-] of the view's height
+    const double gap = shown.size() > 1 ? (0.88 - n * h) / (n - 1.0) : 0.0;  // between 0.07 and 0.95
+    for (std::size_t i = 0; i < shown.size(); ++i) {
+      shown[i]->SetHeight(h);
+      shown[i]->SetPosition(0.855, 0.95 - h - static_cast<double>(i) * (h + gap));
+    }
+  }
+
+  // a rectangle on the screen [px]: display coordinates, y up
+  struct Box {
+    double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
+    bool overlaps(const Box& o, double gap) const {
+      return x0 < o.x1 + gap && o.x0 < x1 + gap && y0 < o.y1 + gap && o.y0 < y1 + gap;
+    }
+  };
+
+  // a caption's box size [px] for its text at kLabelFontSize (FreeType's measure at the window's dpi),
+  // padded; one height for all, a line's with ascenders and descenders
+  static std::array<double, 2> captionSize(vtkCaptionActor2D* caption, int dpi) {
+    int bbox[4] = {0, 0, 0, 0}, line[4] = {0, 0, 0, 0};
+    vtkTextRenderer* text = vtkTextRenderer::GetInstance();
+    vtkTextProperty* property = caption->GetCaptionTextProperty();
+    if (!text || !text->GetBoundingBox(property, caption->GetCaption(), bbox, dpi) ||
+        !text->GetBoundingBox(property, "Ahgjpqy|", line, dpi))
+      return {8.0 * static_cast<double>(std::string(caption->GetCaption()).size()), 18.0};
+    const double pad = 2.0 * kLabelPadding + 2.0;  // [px] +2: a pixel of slack on each side
+    return {bbox[1] - bbox[0] + 1.0 + pad, line[3] - line[2] + 1.0 + pad};
+  }
+
+  static Box displayBox(vtkActor2D* actor, vtkViewport* viewport) {
+    const int* a = actor->GetPositionCoordinate()->GetComputedDisplayValue(viewport);
+    const int* b = actor->GetPosition2Coordinate()->GetComputedDisplayValue(viewport);
+    return {static_cast<double>(std::min(a[0], b[0])), static_cast<double>(std::min(a[1], b[1])),
+            static_cast<double>(std::max(a[0], b[0])), static_cast<double>(std::max(a[1], b[1]))};
+  }
+
+  // The teaching captions on the screen, before each render (so for any camera, view size or off-screen
+  // frame): every caption's box sized to its text, so all have one font size; the group captions in their
+  // column; each landmark's or bone's caption kLabelOffset beside its point, on the side of the body its
+  // point lies (the subject's right drawn left from the front, right from the back), then moved up or down,
+  // whichever is shorter, until it overlaps no other caption, the colour legends, the "motion x5" caption or
+  // the orientation axes, and kept left of the legends.
+  void layoutLabels() {
+    vtkRenderWindow* window = renderer->GetRenderWindow();
+    const int* size = renderer->GetSize();
+    if (!window || size[0] <= 0 || size[1] <= 0) return;
+    const double width = size[0], height = size[1];
+    const int dpi = window->GetDPI();
+    std::vector<Box> taken;            // what a point's caption must not overlap
+    double right = width - kLabelGap;  // [px] right edge for captions: left of the legends
+    for (vtkScalarBarActor* bar : {forceBar.GetPointer(), gutBar.GetPointer(), skinBar.GetPointer()})
+      if (bar->GetVisibility()) {
+        const Box b = displayBox(bar, renderer);
+        taken.push_back(b);
+        right = std::min(right, b.x0 - kLabelGap);
+      }
+    if (motionText->GetVisibility()) {
+      double bbox[4];
+      motionText->GetBoundingBox(renderer, bbox);
+      taken.push_back({bbox[0], bbox[2], bbox[1], bbox[3]});
+    }
+    if (marker && marker->GetEnabled()) {
+      const double* v = marker->GetViewport();
+      taken.push_back({v[0] * width, v[1] * height, v[2] * width, v[3] * height});
+    }
+    // the group captions first: their fixed column at the lower left, above the orientation axes, a row each
+    int row = 0;
+    for (const Label& l : labels) {
+      const std::array<double, 2> box = captionSize(l.actor, dpi);
+      l.actor->GetPosition2Coordinate()->SetValue(box[0], box[1]);
+      if (l.group < 0) continue;
+      l.actor->GetPositionCoordinate()->SetValue(
+          std::round(0.015 * width), std::round(0.44 * height - (row++) * (box[1] + 2.0 * kLabelGap)));
+      if (l.actor->GetVisibility()) taken.push_back(displayBox(l.actor, renderer));
+    }
+    // which way the subject's right (+x) runs on the screen
+    auto toDisplay = [&](const Eigen::Vector3d& p) {
+      renderer->SetWorldPoint(p.x(), p.y(), p.z(), 1.0);
+      renderer->WorldToDisplay();
+      const double* d = renderer->GetDisplayPoint();
+      return Eigen::Vector2d(d[0], d[1]);
+    };
+    const Eigen::Vector3d centre = posed.landmarks.cols() > 0
+                                       ? Eigen::Vector3d(posed.landmarks.rowwise().mean())
+                                       : Eigen::Vector3d::Zero();
+    const double rightward = toDisplay(centre + Eigen::Vector3d(0.1, 0.0, 0.0)).x() - toDisplay(centre).x();
+    // the points' captions, from the top of the screen down
+    struct Placed {
+      const Label* label;
+      Eigen::Vector2d anchor;  // [px]
+      double w, h;             // [px]
+      bool isLeft;
+    };
+    std::vector<Placed> points;
+    for (const Label& l : labels) {
+      if (l.group >= 0 || !l.actor->GetVisibility()) continue;
+      const double* a = l.actor->GetAttachmentPoint();
+      const double* box = l.actor->GetPosition2Coordinate()->GetValue();
+      const bool isSubjectsRight = a[0] > 0.01;  // [m] off the midline to the subject's right
+      points.push_back({&l, toDisplay(Eigen::Vector3d(a[0], a[1], a[2])), box[0], box[1],
+                        isSubjectsRight == (rightward <= 0.0)});
+    }
+    std::stable_sort(points.begin(), points.end(),
+                     [](const Placed& p, const Placed& q) { return p.anchor.y() > q.anchor.y(); });
+    for (const Placed& p : points) {
+      Box b;
+      b.x0 = p.isLeft ? p.anchor.x() - kLabelOffset - p.w : p.anchor.x() + kLabelOffset;
+      b.x0 = std::clamp(b.x0, static_cast<double>(kLabelGap), std::max<double>(kLabelGap, right - p.w));
+      b.x1 = b.x0 + p.w;
+      const double y = std::clamp(p.anchor.y() - 0.5 * p.h, static_cast<double>(kLabelGap),
+                                  std::max<double>(kLabelGap, height - kLabelGap - p.h));
+      // the nearest free height below and above
+      auto moved = [&](double dir) {
+        double y0 = y;
+        for (bool isBlocked = true; isBlocked;) {
+          isBlocked = false;
+          for (const Box& t : taken)
+            if (Box{b.x0, y0, b.x1, y0 + p.h}.overlaps(t, kLabelGap)) {
+              y0 = dir < 0.0 ? t.y0 - kLabelGap - p.h - 1.0 : t.y1 + kLabelGap + 1.0;
+              isBlocked = true;
+            }
+        }
+        return y0;
+      };
+      const double down = moved(-1.0), up = moved(1.0);
+      const bool isDownInside = down >= 0.0, isUpInside = up + p.h <= height;
+      b.y0 = isDownInside && (!isUpInside || y - down <= up - y) ? down : isUpInside ? up : y;
+      b.y1 = b.y0 + p.h;
+      taken.push_back(b);
+      vtkCoordinate* at = p.label->actor->GetPositionCoordinate();
+      at->SetReferenceCoordinate(nullptr);
+      at->SetCoordinateSystemToDisplay();
+      at->SetValue(std::round(b.x0), std::round(b.y0));
+    }
+  }
+
   void applyOptions() {
     const bool byForce = options.muscleColouring != MuscleColouring::Group;  // force or activation
     const bool byActivation = options.muscleColouring == MuscleColouring::Activation;
@@ -763,6 +915,7 @@ struct ModelScene::Impl {
       skinActor->GetMapper()->SetScalarVisibility(isSkinColoured);
     }
     skinBar->SetVisibility(isSkinShown && isSkinColoured);
+    stackLegends();
     for (const auto& g : ghost) g.second->SetVisibility(hasGhost && options.showGhost);
     motionText->SetInput(motionCaption().c_str());
     motionText->SetVisibility(!motionCaption().empty());
@@ -816,10 +969,16 @@ ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
   text->SetBackgroundOpacity(0.7);
   motion->PickableOff();
   r->AddViewProp(motion);
+  // the teaching captions are laid out on the screen before every render, whatever moved the camera
+  vtkNew<vtkCallbackCommand> layout;
+  layout->SetClientData(m_impl.get());
+  layout->SetCallback(
+      [](vtkObject*, unsigned long, void* impl, void*) { static_cast<Impl*>(impl)->layoutLabels(); });
+  m_impl->layoutObserver = r->AddObserver(vtkCommand::StartEvent, layout);
   m_impl->applyOptions();
 }
 
-ModelScene::~ModelScene() = default;
+ModelScene::~ModelScene() { m_impl->renderer->RemoveObserver(m_impl->layoutObserver); }
 
 vtkRenderer* ModelScene::renderer() const { return m_impl->renderer; }
 
@@ -990,10 +1149,8 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
       }
     }
     l.actor->SetAttachmentPoint(at.x(), at.y(), at.z());
-    // landmark and bone captions beside their point: the subject's right (x > 0) to one side, the rest to the
-    // other (group captions sit in their fixed column)
-    if (l.group < 0) l.actor->SetPosition(at.x() > 0.01 ? -150.0 : 40.0, 14.0);
   }
+  // (the captions are placed on the screen before each render: layoutLabels())
 
   // selection highlight
   if (s.highlight.kind == Pick::Kind::Element) {

@@ -229,14 +229,18 @@ AnatomyParams parseAnatomy(const std::string& anatomyText, const std::string& ga
                            const std::string& sourceName, const std::string& gainsName) {
   const sim::JsonDocument doc = sim::JsonDocument::parse(anatomyText, sourceName);
   const Reader r = doc.root();
-  r.allowKeys({"name", "description", "gains", "bone_density_kg_m3", "floating_ribs_moving", "ribs", "spine",
-               "sternum", "pelvis", "abdomen", "resolution", "shoulder_girdle", "girdle"});
+  r.allowKeys({"name", "description", "gains", "bone_density_kg_m3", "floating_ribs_moving",
+               "rib_joint_friction_scale", "ribs", "spine", "sternum", "pelvis", "abdomen", "resolution",
+               "shoulder_girdle", "girdle"});
   AnatomyParams a;
   a.source = sourceName;
   a.name = r.at("name").string();
   if (a.name.empty()) r.at("name").fail("must be a non-empty string");
   a.boneDensity = r.at("bone_density_kg_m3").numberIn(100.0, 5000.0);
   a.areFloatingRibsMoving = r.at("floating_ribs_moving").boolean();
+  // optional: the shared friction when absent
+  if (r.has("rib_joint_friction_scale"))
+    a.ribJointFrictionScale = r.at("rib_joint_friction_scale").numberIn(0.1, 10.0);
 
   // rib levels 1..12, in order
   const Reader ribs = r.at("ribs");

@@ -77,7 +77,7 @@ void buildJoints(const AnatomyParams& a, const Skeleton& sk, sim::Joints& j) {
     j.child.push_back(s.child);
     j.anchor.col(i) = s.anchor;
     const JointGains& g = a.gains.joints[static_cast<std::size_t>(s.kind)];
-    j.friction(i) = g.friction;
+    j.friction(i) = s.kind == kCostovertebralJoint ? a.ribJointFrictionScale * g.friction : g.friction;
     j.stiffness(i) = g.stiffness;
     j.axis.col(i) = s.axis;
     j.lockStiffness(i) = g.lockStiffness;

@@ -90,6 +90,47 @@ TEST(AnatomyParams, ZoneOfAppositionGrowsWithItsHeight) {
   EXPECT_GT(tall, preset);
 }
 
+TEST(AnatomyParams, RibJointFrictionScaleOutOfRangeIsRejectedNamingTheField) {
+  const std::string e = errorOf([](nlohmann::json& j) { j["rib_joint_friction_scale"] = -1; });
+  EXPECT_NE(e.find("male.json: rib_joint_friction_scale: must be in [0.1, 10], got -1"), std::string::npos)
+      << e;
+}
+
+// the preset's rib-joint friction scales the costovertebral joints' mu of Eq. 3 and no other joint's; absent,
+// the shared value holds; the female rib cage moves with less resistance than the male (README: the female
+// preset's rib-cage share is at least the male's, Bellemare et al. 2003, Romei et al. 2010)
+TEST(AnatomyParams, RibJointFrictionScaleActsOnTheRibJointsOnly) {
+  nlohmann::json g = nlohmann::json::parse(read(kDir + "muscle_gains.json"));
+  g["joints"]["spine"]["friction"] = 3.0;  // a spine joint with friction of its own, which must stay
+  const std::string gains = g.dump();
+  const auto friction = [&](const nlohmann::json& j, const std::string& prefix) {
+    const sim::Model m = buildModel(parseAnatomy(j.dump(), gains), "").model;
+    std::vector<double> mu;
+    for (std::size_t i = 0; i < m.joints.name.size(); ++i)
+      if (m.joints.name[i].rfind(prefix, 0) == 0)
+        mu.push_back(m.joints.friction(static_cast<Eigen::Index>(i)));
+    return mu;
+  };
+  nlohmann::json j = nlohmann::json::parse(read(kDir + "male.json"));
+  j.erase("rib_joint_friction_scale");
+  const std::vector<double> ribShared = friction(j, "costovertebral"), spineShared = friction(j, "spine");
+  j["rib_joint_friction_scale"] = 0.5;
+  const std::vector<double> ribHalf = friction(j, "costovertebral"), spineHalf = friction(j, "spine");
+  ASSERT_EQ(ribShared.size(), 20u);  // ribs 1-10 per side move
+  const double mu = loadAnatomy(kDir + "male.json").gains.joints[kCostovertebralJoint].friction;
+  for (std::size_t i = 0; i < ribShared.size(); ++i) {
+    EXPECT_DOUBLE_EQ(ribShared[i], mu);
+    EXPECT_DOUBLE_EQ(ribHalf[i], 0.5 * mu);
+  }
+  ASSERT_FALSE(spineShared.empty());
+  for (std::size_t i = 0; i < spineShared.size(); ++i) {
+    EXPECT_DOUBLE_EQ(spineShared[i], 3.0);
+    EXPECT_DOUBLE_EQ(spineHalf[i], 3.0);
+  }
+  EXPECT_DOUBLE_EQ(loadAnatomy(kDir + "male.json").ribJointFrictionScale, 1.0);
+  EXPECT_LT(loadAnatomy(kDir + "female.json").ribJointFrictionScale, 1.0);
+}
+
 TEST(AnatomyParams, TooFewSpineSegmentsAreRejected) {
   const std::string e = errorOf([](nlohmann::json& j) {
     j["spine"]["thoracic_segments"] = {{1, 6}, {7, 12}};

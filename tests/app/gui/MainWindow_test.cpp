@@ -1051,44 +1051,59 @@ TEST(MainWindow, GltfExportOfAModelWithoutSkinIsRefused) {
   EXPECT_TRUE(QDir(out.path()).isEmpty());
 }
 
-// the teaching view: no muscle group's caption covers another caption, from any camera preset
-TEST_F(DefaultModelWindow, GroupCaptionsDoNotOverlapOtherCaptions) {
+// the teaching view: no caption covers another caption or a colour legend, from any camera preset and with
+// all three legends shown ("diaphragm apex" lay over "xiphoid", a landmark's caption over the colour bar);
+// every caption is inside the view and of one height (one font size)
+TEST_F(DefaultModelWindow, CaptionsOverlapNeitherEachOtherNorTheLegends) {
   const std::set<std::string> groupNames = {
       "External intercostals", "Internal intercostals",  "Diaphragm",
       "Rectus abdominis",      "Transversus / obliques", "Costal cartilage"};
+  ASSERT_TRUE(window.runUntil(3.5)) << window.lastError().toStdString();  // mid-inspiration, magnified
   viz::DisplayOptions o = window.scene().options();
   o.showLabels = true;
   o.showLandmarks = true;
+  o.skinColouring = viz::SkinColouring::Displacement;
   window.setDisplayOptions(o);
   vtkRenderer* renderer = window.scene().renderer();
+  struct Box {
+    std::string text;
+    QRectF rect;  // [px] display coordinates
+  };
+  auto boxOf = [renderer](vtkActor2D* actor) {
+    const int* a = actor->GetPositionCoordinate()->GetComputedDisplayValue(renderer);
+    const int* b = actor->GetPosition2Coordinate()->GetComputedDisplayValue(renderer);
+    return QRectF(QPointF(a[0], a[1]), QPointF(b[0], b[1])).normalized();
+  };
   for (const auto& [name, preset] : viz::cameraPresets()) {
     window.scene().setCamera(preset);
-    window.grabView();  // renders
-    struct Box {
-      std::string text;
-      QRectF rect;  // [px] display coordinates
-    };
-    std::vector<Box> boxes;
+    window.grabView();  // renders, which lays the captions out
+    const QRectF view(0, 0, renderer->GetSize()[0], renderer->GetSize()[1]);
+    std::vector<Box> captions, legends;
     vtkPropCollection* props = renderer->GetViewProps();
     props->InitTraversal();
     while (vtkProp* prop = props->GetNextProp()) {
-      auto* caption = vtkCaptionActor2D::SafeDownCast(prop);
-      if (caption == nullptr || !caption->GetVisibility()) continue;
-      const int* a = caption->GetPositionCoordinate()->GetComputedDisplayValue(renderer);
-      const int* b = caption->GetPosition2Coordinate()->GetComputedDisplayValue(renderer);
-      boxes.push_back({caption->GetCaption(), QRectF(QPointF(a[0], a[1]), QPointF(b[0], b[1])).normalized()});
+      if (!prop->GetVisibility()) continue;
+      if (auto* caption = vtkCaptionActor2D::SafeDownCast(prop))
+        captions.push_back({caption->GetCaption(), boxOf(caption)});
+      if (auto* bar = vtkScalarBarActor::SafeDownCast(prop)) legends.push_back({bar->GetTitle(), boxOf(bar)});
     }
+    EXPECT_EQ(legends.size(), 3u) << "tension, gut and skin legends";
     int groups = 0;
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      if (groupNames.count(boxes[i].text) == 0) continue;
-      ++groups;
-      for (std::size_t j = 0; j < boxes.size(); ++j) {
-        if (j == i) continue;
-        EXPECT_FALSE(boxes[i].rect.intersects(boxes[j].rect))
-            << "camera " << name << ": '" << boxes[i].text << "' covers '" << boxes[j].text << "'";
-      }
+    for (std::size_t i = 0; i < captions.size(); ++i) {
+      groups += static_cast<int>(groupNames.count(captions[i].text));
+      EXPECT_TRUE(view.contains(captions[i].rect)) << "camera " << name << ": '" << captions[i].text << "'";
+      EXPECT_NEAR(captions[i].rect.height(), captions[0].rect.height(), 1.0)
+          << "camera " << name << ": '" << captions[i].text << "'";
+      for (std::size_t j = i + 1; j < captions.size(); ++j)
+        EXPECT_FALSE(captions[i].rect.intersects(captions[j].rect))
+            << "camera " << name << ": '" << captions[i].text << "' covers '" << captions[j].text << "'";
+      for (const Box& legend : legends)
+        EXPECT_FALSE(captions[i].rect.intersects(legend.rect))
+            << "camera " << name << ": '" << captions[i].text << "' covers the legend '" << legend.text
+            << "'";
     }
     EXPECT_EQ(groups, 6);
+    EXPECT_GE(captions.size(), 6u + 6u) << "the groups, five landmarks and the sternum";
   }
 }
 

@@ -178,7 +178,15 @@ struct AnatomyParams {
   std::string source;                  ///< file it was read from
   double boneDensity = 0.0;            ///< [kg/m^3] uniform bone density for mass properties
   bool areFloatingRibsMoving = false;  ///< ribs 11-12: moving bodies (true) or fixed (false)
-  std::vector<RibLevel> ribs;          ///< rib levels 1..12 (index 0 = rib 1)
+  /// [-] scale of the costovertebral joints' friction (muscle_gains.json `joints.costovertebral.friction`, mu
+  /// of Eq. 3) in this preset: mu = scale x the shared value (optional, 1 when absent). The rib cage's
+  /// resistance to motion, the one preset-specific term of the rib-cage share: women breathe with a larger
+  /// rib-cage contribution than men (Bellemare, Jeanneret & Couture 2003, Am J Respir Crit Care Med 168:305;
+  /// Romei et al. 2010, Respir Physiol Neurobiol 172:184), so the female preset's value is the round value
+  /// that gives it at least the male preset's rib-cage share in calm and deep breathing.
+  /// resources/anatomy/README.md has the measurements and why it is not the rib-cage muscles' strength.
+  double ribJointFrictionScale = 1.0;
+  std::vector<RibLevel> ribs;  ///< rib levels 1..12 (index 0 = rib 1)
   SpineParams spine;
   SternumParams sternum;
   PelvisParams pelvis;
