@@ -36,6 +36,7 @@
 #include <QTimer>
 #include <QToolBar>
 #include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -74,6 +75,7 @@ const std::vector<std::pair<const char*, bool viz::DisplayOptions::*>> kStructur
     {"Bones", &viz::DisplayOptions::showBones},
     {"Gut", &viz::DisplayOptions::showGut},
     {"Translucent gut", &viz::DisplayOptions::isGutTranslucent},
+    {"Pectorals and shoulders", &viz::DisplayOptions::showTissue},
     {"Lung cavity", &viz::DisplayOptions::showCavity},
     {"Lungs", &viz::DisplayOptions::showLungs},
     {"Landmarks", &viz::DisplayOptions::showLandmarks},
@@ -716,11 +718,16 @@ QString MainWindow::openModel(const QString& dir) {
   m_plots->clearTraces();
   m_params->setSettings(m_settings, model);
   m_plots->setBreathPeriod(60.0 / m_settings.style.breathsPerMinute);
-  m_modelText = QString("Model: %1 (%2 bodies, %3 elements, %4 gut nodes)")
+  // the nodes: the gut's, and the volume bodies' (pectorals, shoulders) counted apart
+  const auto tissueNodes =
+      std::count(model->nodes.region.begin(), model->nodes.region.end(), sim::NodeRegion::Tissue);
+  m_modelText = QString("Model: %1 (%2 bodies, %3 elements, %4 gut nodes")
                     .arg(QString::fromStdString(model->name))
                     .arg(model->bodies.size())
                     .arg(model->elements.size())
-                    .arg(model->nodes.size());
+                    .arg(model->nodes.size() - tissueNodes);
+  if (tissueNodes > 0) m_modelText += QString(", %1 tissue nodes").arg(tissueNodes);
+  m_modelText += ")";
   m_statusModel->setText(modelStatus());
   setWindowTitle(QString("Pneuma \u2014 %1").arg(QString::fromStdString(model->name)));
 

@@ -61,7 +61,7 @@ void SeriesDialog::update() {
           ? static_cast<double>(m_recordedFrames - 1) / (m_recordedTo - m_recordedFrom)
           : 0.0;  // [1/s]
   showSummary(
-      QString("%1 frames (every %2 recorded frame: %3 per second, %4 s to %5 s), 6 files each, about %6")
+      QString("%1 frames (every %2 recorded frame: %3 per second, %4 s to %5 s), 7 files each, about %6")
           .arg(frames)
           .arg(ordinal(r.stride))
           .arg(recordedRate / r.stride, 0, 'g', 3)

@@ -51,6 +51,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Ties.h"
 #include "viz/PlotLayout.h"
 
 namespace pneuma::viz {
@@ -393,6 +394,11 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkPolyData> cavity;
   vtkSmartPointer<vtkActor> cavityActor;
 
+  // the soft-tissue volume bodies, one surface of all their triangles over the nodes
+  vtkSmartPointer<vtkPolyData> tissue;
+  Eigen::Matrix3Xi tissueTriangles;
+  vtkSmartPointer<vtkActor> tissueActor;
+
   std::array<vtkSmartPointer<vtkPolyData>, 2> lungs;  // right, left
   std::array<vtkSmartPointer<vtkActor>, 2> lungActors;
 
@@ -430,7 +436,8 @@ struct ModelScene::Impl {
     bodies.clear();
     bodyPose.clear();
     labels.clear();
-    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = nullptr;
+    gutActor = cavityActor = landmarkActor = highlightActor = skinActor = tissueActor = nullptr;
+    tissue = nullptr;
     skin = nullptr;
     drawnSkin = {};
     ghost.clear();
@@ -452,7 +459,8 @@ struct ModelScene::Impl {
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
                        static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
-                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor)})
+                       static_cast<vtkProp*>(landmarkActor), static_cast<vtkProp*>(highlightActor),
+                       static_cast<vtkProp*>(tissueActor)})
       if (p) props.push_back(p);
     for (const auto& g : ghost) props.push_back(g.second);
     if (skinActor) props.push_back(skinActor);
@@ -578,9 +586,15 @@ struct ModelScene::Impl {
       bodyPose.push_back(pose);
     }
 
-    // muscle elements by group; the apposition springs (the pleural fluid's hold) are not drawn
+    // muscle elements by group; the apposition springs (the pleural fluid's hold) are not drawn, nor the
+    // volume bodies' springs and ties (a node of region Tissue at an end: the body is drawn as its surface)
+    const auto isTissueEnd = [&](const sim::AnchorSet& a, int e) {
+      return a.body[static_cast<std::size_t>(e)] < 0 &&
+             model.nodes.region[static_cast<std::size_t>(a.nodes(0, e))] == sim::NodeRegion::Tissue;
+    };
     for (int e = 0; e < model.elements.size(); ++e)
-      if (!sim::isApposition(model.elements, e))
+      if (!sim::isApposition(model, e) && !isTissueEnd(model.elements.endA, e) &&
+          !isTissueEnd(model.elements.endB, e))
         groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(
             e);
     for (int gi = 0; gi < kGroups; ++gi) {
@@ -613,6 +627,27 @@ struct ModelScene::Impl {
     // gut, cavity, landmarks
     gut = surface(model.nodes.size(), model.gut.triangles);
     gutActor = scalarSurfaceActor(gut, gutScalar, gutTable);
+
+    // the volume bodies: muscle-red, opaque, under the skin
+    if (model.volumes.size() > 0) {
+      Eigen::Index count = 0;
+      for (const Eigen::Matrix3Xi& t : model.volumes.triangles) count += t.cols();
+      tissueTriangles.resize(3, count);
+      count = 0;
+      for (const Eigen::Matrix3Xi& t : model.volumes.triangles) {
+        tissueTriangles.middleCols(count, t.cols()) = t;
+        count += t.cols();
+      }
+      tissue = surface(model.nodes.size(), tissueTriangles);
+      vtkNew<vtkFloatArray> normals;  // smooth shading: setNormals() at every update
+      normals->SetNumberOfComponents(3);
+      normals->SetNumberOfTuples(tissue->GetNumberOfPoints());
+      normals->Fill(0.0f);
+      tissue->GetPointData()->SetNormals(normals);
+      tissueActor = actorFor(tissue);
+      tissueActor->GetProperty()->SetColor(0.74, 0.33, 0.31);
+      tissueActor->PickableOff();
+    }
 
     cavity = surface(model.cavity.vertices.size(), model.cavity.triangles);
     cavityActor = actorFor(cavity);
@@ -710,7 +745,7 @@ struct ModelScene::Impl {
     // the closed surfaces (outward triangles, sim/Model.h) draw their front faces only: a translucent one
     // blends one layer instead of two, which halves its fragments under software OpenGL
     for (vtkActor* a : {gutActor.GetPointer(), cavityActor.GetPointer(), lungActors[0].GetPointer(),
-                        lungActors[1].GetPointer(), skinActor.GetPointer()})
+                        lungActors[1].GetPointer(), skinActor.GetPointer(), tissueActor.GetPointer()})
       if (a) a->GetProperty()->BackfaceCullingOn();
 
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
@@ -901,6 +936,7 @@ struct ModelScene::Impl {
                                                                       : "Gut\ndisplacement\n[mm]");
       gutBar->SetVisibility(options.showGut && coloured);
     }
+    if (tissueActor) tissueActor->SetVisibility(options.showTissue);
     if (cavityActor) cavityActor->SetVisibility(options.showCavity);
     for (const auto& a : lungActors)
       if (a) a->SetVisibility(options.showLungs);
@@ -1106,6 +1142,12 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
       if (isAuto) s.gutDisplacementTop = autoTop(s.values, s.gutDisplacementTop);
       setScale(s.gutBar, s.gutTable, 0.0, isAuto ? std::max(s.gutDisplacementTop, 1.0) : kGutDisplacementTop);
     }
+  }
+
+  // the volume bodies: their nodes
+  if (s.tissue) {
+    Impl::setPoints(s.tissue, s.posed.gut);
+    Impl::setNormals(s.tissue, s.posed.gut, s.tissueTriangles, s.normalScratch);
   }
 
   // cavity and landmarks

@@ -90,6 +90,8 @@ struct DisplayOptions {
   bool isGutTranslucent = true;
   bool showBones = true;
   bool showGut = true;
+  /// the soft-tissue volume bodies (Model::volumes: the pectorals and shoulders), muscle-red
+  bool showTissue = true;
   bool showCavity = false;
   bool showLungs = true;  ///< the right and left lungs, translucent (Model::lungs)
   bool showLandmarks = true;

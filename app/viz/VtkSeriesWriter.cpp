@@ -26,6 +26,7 @@
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/PosedGeometry.h"
+#include "pneuma/sim/Ties.h"
 #include "viz/AtomicFile.h"
 #include "viz/ModelScene.h"
 
@@ -35,8 +36,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity", "lungs", "skin"};
-constexpr int kPartCount = 6;
+constexpr const char* kPartNames[] = {"bones", "muscles", "gut", "cavity", "lungs", "skin", "tissue"};
+constexpr int kPartCount = 7;
 
 // true for a part file of a series ("gut_000012.vtp")
 bool isPartFile(const std::string& name) {
@@ -198,10 +199,10 @@ struct VtkSeriesWriter::Impl {
     return writer->GetOutputString();
   }
 
-  // the six parts of the posed frame, encoded
+  // the seven parts of the posed frame, encoded
   std::array<std::string, kPartCount> encodeFrame(const sim::Metrics& metrics) const {
-    return {encode(bones()),         encode(muscles(metrics)), encode(gut(metrics)),
-            encode(cavity(metrics)), encode(lungs(metrics)),   encode(skin())};
+    return {encode(bones()),        encode(muscles(metrics)), encode(gut(metrics)),   encode(cavity(metrics)),
+            encode(lungs(metrics)), encode(skin()),           encode(tissue(metrics))};
   }
 
   // written through writeFileAtomically(), whose every write is checked: VTK's own file output can report
@@ -259,7 +260,7 @@ struct VtkSeriesWriter::Impl {
       force->SetValue(e, f);
       tension->SetValue(e, f < 0.0 ? -f : 0.0);
       group->InsertNextValue(static_cast<int>(el.group[static_cast<std::size_t>(e)]));
-      apposition->InsertNextValue(sim::isApposition(el, e) ? 1 : 0);
+      apposition->InsertNextValue(sim::isApposition(model, e) ? 1 : 0);
       slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size()
                                  ? metrics.isSlack[static_cast<std::size_t>(e)]
                                  : 0);
@@ -320,6 +321,41 @@ struct VtkSeriesWriter::Impl {
     fieldValue(pd, "right_lung_volume_m3", metrics.rightLungVolume);
     fieldValue(pd, "left_lung_volume_m3", metrics.leftLungVolume);
     fieldValue(pd, "lung_volume_m3", metrics.lungVolume);
+    return pd;
+  }
+
+  // the volume bodies over all nodes (empty for a model without them); cell data body (index in
+  // Model::volumes), point data displacement_m from the rest pose, field data volume_error per body
+  vtkSmartPointer<vtkPolyData> tissue(const sim::Metrics& metrics) const {
+    const sim::VolumeBodies& v = model.volumes;
+    Eigen::Index count = 0;
+    for (const Eigen::Matrix3Xi& t : v.triangles) count += t.cols();
+    Eigen::Matrix3Xi t(3, count);
+    auto body = vtkSmartPointer<vtkIntArray>::New();
+    body->SetName("body");
+    count = 0;
+    for (int k = 0; k < v.size(); ++k) {
+      const Eigen::Matrix3Xi& tk = v.triangles[static_cast<std::size_t>(k)];
+      t.middleCols(count, tk.cols()) = tk;
+      count += tk.cols();
+      for (Eigen::Index i = 0; i < tk.cols(); ++i) body->InsertNextValue(k);
+    }
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    setPoints(pd, v.size() > 0 ? posed.gut : Eigen::Matrix3Xd(3, 0));
+    pd->SetPolys(triangles(t));
+    pd->GetCellData()->AddArray(body);
+    if (v.size() > 0) {
+      auto disp = scalarArray("displacement_m", 3, posed.gut.cols());
+      for (Eigen::Index i = 0; i < posed.gut.cols(); ++i) {
+        const Eigen::Vector3d d = posed.gut.col(i) - model.nodes.rest.col(i);
+        disp->SetTuple3(i, d.x(), d.y(), d.z());
+      }
+      pd->GetPointData()->AddArray(disp);
+    }
+    auto error = scalarArray("volume_error", 1, metrics.volumeBodyError.size());
+    for (Eigen::Index k = 0; k < metrics.volumeBodyError.size(); ++k)
+      error->SetValue(k, metrics.volumeBodyError(k));
+    pd->GetFieldData()->AddArray(error);
     return pd;
   }
 

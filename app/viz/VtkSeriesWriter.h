@@ -1,7 +1,7 @@
 #pragma once
 /// @file VtkSeriesWriter.h
 /// Export of a running simulation as a ParaView time series: one .pvd collection that lists, per frame,
-/// six .vtp parts (VTK XML polydata, SI units), all posed by sim::poseGeometry():
+/// seven .vtp parts (VTK XML polydata, SI units), all posed by sim::poseGeometry():
 ///   part 0 bones    body meshes posed in world [m]; cell data body_id
 ///   part 1 muscles  one line per element [m]; cell data force_N (signed, <= 0 is tension), tension_N,
 ///                   group (ElementGroup index), is_slack
@@ -12,6 +12,9 @@
 ///                   lung_volume_m3
 ///   part 5 skin     the body surface [m] (empty for a model without one); point data displacement_m (3) from
 ///                   the rest pose
+///   part 6 tissue   the soft-tissue volume bodies (Model::volumes: pectorals, shoulders) over the nodes [m]
+///                   (empty for a model without them); cell data body (index in Model::volumes), point data
+///                   displacement_m (3) from the rest pose, field data volume_error (one tuple per body)
 /// Every file is written to a temporary name and renamed; the .pvd is written by finish(). With
 /// Staging::TemporaryFolder (the app's export) the frames go into a folder of the writer's own
 /// ("<baseName>.tmp-<pid>"), renamed to <baseName>/ by finish(), and a writer destroyed unfinished (a
@@ -73,14 +76,14 @@ class VtkSeriesWriter {
   VtkSeriesWriter(const VtkSeriesWriter&) = delete;
   VtkSeriesWriter& operator=(const VtkSeriesWriter&) = delete;
 
-  /// Writes the six parts of one frame at `state.time`.
+  /// Writes the seven parts of one frame at `state.time`.
   void writeFrame(const sim::State& state, const sim::Metrics& metrics);
   /// Renames the frames' folder to `outDir`/`baseName` (replacing an earlier series there; a folder that
   /// holds anything but series frames is refused) and writes the .pvd collection of all frames written so
   /// far; returns its file name ("<baseName>.pvd"). @throws std::runtime_error naming the folder or file.
   std::string finish();
-  /// The bytes one frame of `state` takes on disk, its six parts encoded as writeFrame() writes them, without
-  /// writing anything: a series' size before it is written (its frames differ by a few per cent).
+  /// The bytes one frame of `state` takes on disk, its seven parts encoded as writeFrame() writes them,
+  /// without writing anything: a series' size before it is written (its frames differ by a few per cent).
   static std::size_t frameBytes(const sim::Model& model, const std::string& modelDir, const sim::State& state,
                                 const sim::Metrics& metrics);
   /// Number of frames written.

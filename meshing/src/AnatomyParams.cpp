@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/JsonReader.h"
@@ -144,7 +145,7 @@ Gains readGains(const Reader& r) {
   r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s",
                "abdominal_wall_tone_upright", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
                "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
-               "diaphragm_mass_kg", "joints", "shoulder_springs"});
+               "diaphragm_mass_kg", "joints", "shoulder_springs", "tissue_bodies"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -197,6 +198,24 @@ Gains readGains(const Reader& r) {
   shoulder.allowKeys({"kpe", "b"});
   g.shoulder.kpe = shoulder.at("kpe").numberIn(0.0, 1e9);
   g.shoulder.damping = shoulder.at("b").numberIn(0.0, 1e9);
+  // optional: no tissue bodies when absent
+  if (r.has("tissue_bodies")) {
+    const Reader t = r.at("tissue_bodies");
+    t.allowKeys({"description", "kappa_pa", "density_kg_per_m3", "surface", "tie", "pectoral_thickness_mm",
+                 "deltoid_thickness_mm"});
+    TissueGains& tg = g.tissue;
+    tg.kappa = t.at("kappa_pa").positiveAtMost(1e9);
+    tg.density = t.at("density_kg_per_m3").numberIn(100.0, 3000.0);
+    for (const auto& [key, gains] :
+         {std::pair<const char*, GroupGains*>{"surface", &tg.surface}, {"tie", &tg.tie}}) {
+      const Reader s = t.at(key);
+      s.allowKeys({"kpe", "b"});
+      gains->kpe = s.at("kpe").positiveAtMost(1e9);
+      gains->damping = s.at("b").numberIn(0.0, 1e9);
+    }
+    tg.pectoralThickness = t.at("pectoral_thickness_mm").numberIn(2.0, 60.0) * 1e-3;
+    tg.deltoidThickness = t.at("deltoid_thickness_mm").numberIn(2.0, 60.0) * 1e-3;
+  }
   return g;
 }
 

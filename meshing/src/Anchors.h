@@ -3,6 +3,10 @@
 /// Points bound to a rigid body or to gut nodes, as the builder collects them in world coordinates
 /// before converting them to sim::AnchorSet entries.
 
+#include <string>
+
+#include "pneuma/meshing/AnatomyParams.h"
+#include "pneuma/sim/Error.h"
 #include "pneuma/sim/Model.h"
 
 namespace pneuma::meshing {
@@ -28,5 +32,38 @@ inline void addEndpoint(sim::AnchorSet& set, const Endpoint& e, const sim::Bodie
     set.addNodePoint(e.nodes, e.weights);
   }
 }
+
+/// Appends elements to a model, converting endpoints and scaling the group gains by rest length.
+class ElementSink {
+ public:
+  ElementSink(const Gains& gains, sim::Model& model) : m_gains(gains), m_model(model) {}
+
+  /// Adds one element; `active` [-] scales kac (0: a passive element), `stiffness` [-] scales kpe and b.
+  void add(sim::ElementGroup group, const Endpoint& a, const Endpoint& b, double active = 1.0,
+           double stiffness = 1.0) {
+    add(group, a, b, m_gains.group[static_cast<std::size_t>(group)], active, stiffness);
+  }
+  /// Adds one element of `group` with the gains `g` (at the reference length) instead of the group's.
+  void add(sim::ElementGroup group, const Endpoint& a, const Endpoint& b, const GroupGains& g,
+           double active = 1.0, double stiffness = 1.0) {
+    const double l0 = (a.world - b.world).norm();
+    if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
+    sim::Elements& e = m_model.elements;
+    e.group.push_back(group);
+    addEndpoint(e.endA, a, m_model.bodies);
+    addEndpoint(e.endB, b, m_model.bodies);
+    const double scale = m_gains.referenceLength / l0;
+    const Eigen::Index n = static_cast<Eigen::Index>(e.group.size());
+    for (Eigen::VectorXd* v : {&e.restLength, &e.kac, &e.kpe, &e.damping}) v->conservativeResize(n);
+    e.restLength(n - 1) = l0;
+    e.kac(n - 1) = active * g.kac * scale;
+    e.kpe(n - 1) = stiffness * g.kpe * scale;
+    e.damping(n - 1) = stiffness * g.damping * scale;
+  }
+
+ private:
+  const Gains& m_gains;
+  sim::Model& m_model;
+};
 
 }  // namespace pneuma::meshing

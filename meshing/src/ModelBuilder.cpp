@@ -12,6 +12,7 @@
 #include "MuscleNetwork.h"
 #include "Skeleton.h"
 #include "Skin.h"
+#include "TissueBodies.h"
 #include "pneuma/meshing/MeshTools.h"
 #include "pneuma/meshing/Tetrahedralizer.h"
 #include "pneuma/sim/Error.h"
@@ -192,6 +193,8 @@ BuiltModel buildModel(const AnatomyParams& a, const std::string& skinFile) {
   out.model.cavity.recoilPressure = a.gains.lungRecoil;
   out.model.cavity.compliance = a.gains.lungCompliance;
   buildLandmarks(a, sk, gut, out.model);
+  // the pectoral and shoulder volume bodies, on the bones and under the skin
+  buildTissueBodies(a, sk, out.model);
   if (!skinFile.empty()) {
     if (skinFile == kDefaultSkinFile && !std::filesystem::exists(skinFile))
       throw sim::Error(

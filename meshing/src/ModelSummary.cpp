@@ -44,10 +44,16 @@ ModelSummary summarizeModel(const sim::Model& m) {
     if (m.nodes.isFixed(i)) ++s.fixedNodes;
     if (m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Wall)
       s.gutWallMass += m.nodes.mass(i);
+    if (m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Tissue) {
+      ++s.tissueNodes;
+      s.tissueMass += m.nodes.mass(i);
+    }
   }
   for (sim::ElementGroup g : m.elements.group) ++s.elements[static_cast<std::size_t>(g)];
   s.gutVolume = enclosedVolume(m.nodes.rest, m.gut.triangles);
   s.cavityVolume = enclosedVolume(restPoints(m.cavity.vertices, m), m.cavity.triangles);
+  s.tissueBodies = m.volumes.size();
+  for (const Eigen::Matrix3Xi& t : m.volumes.triangles) s.tissueVolume += enclosedVolume(m.nodes.rest, t);
   s.skinVertices = m.skin.vertexCount();
   s.skinTriangles = static_cast<int>(m.skin.triangles.cols());
   s.skinTetrahedra = m.skin.tetrahedra;
@@ -79,6 +85,10 @@ std::string summaryJson(const ModelSummary& s) {
                {"triangles", s.skinTriangles},
                {"tetrahedra", s.skinTetrahedra},
                {"volume_ml", std::round(s.skinVolume * kMlPerM3 * 10.0) / 10.0}};
+  j["volume_bodies"] = {{"bodies", s.tissueBodies},
+                        {"nodes", s.tissueNodes},
+                        {"volume_ml", std::round(s.tissueVolume * kMlPerM3 * 10.0) / 10.0},
+                        {"mass_kg", std::round(s.tissueMass * 1e4) / 1e4}};
   return j.dump(2);
 }
 
@@ -106,6 +116,12 @@ std::string summaryText(const ModelSummary& s) {
   } else {
     o << "skin:            none\n";
   }
+  o.precision(1);
+  if (s.tissueBodies > 0)
+    o << "volume bodies:   " << s.tissueBodies << " (pectorals, shoulders), " << s.tissueNodes << " nodes, "
+      << s.tissueVolume * kMlPerM3 << " mL\n";
+  else
+    o << "volume bodies:   none\n";
   return o.str();
 }
 

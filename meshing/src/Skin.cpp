@@ -15,6 +15,7 @@
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/meshing/Tetrahedralizer.h"
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Ties.h"
 
 namespace pneuma::meshing {
 
@@ -32,8 +33,11 @@ constexpr double kDepthScalp = 0.008;     // [m] scalp over the vertex of the sk
 constexpr double kDepthClavicle = 0.012;  // [m] skin and platysma over the clavicle's shaft
 constexpr double kBoneClearance = 0.006;  // [m] least distance from skin to bone after registration
 constexpr double kGutClearance = 0.010;   // [m] least distance from skin to the gut surface
-constexpr double kThighCut = 0.10;        // [m] legs cut this far below the crotch
-constexpr double kPerineumDepth = 0.07;   // [m] crotch (perineum) below the pelvic floor
+// [m] least distance from skin to a volume body's surface (pectorals, shoulders): the skin and the thin
+// subcutaneous fat over the muscle
+constexpr double kTissueClearance = 0.004;
+constexpr double kThighCut = 0.10;       // [m] legs cut this far below the crotch
+constexpr double kPerineumDepth = 0.07;  // [m] crotch (perineum) below the pelvic floor
 constexpr double kThighCutSlack = 0.03;  // [m] a surface ending less than this below the cut is not cut again
 constexpr double kAnchorSpacing = 0.012;  // [m] one bone-surface anchor per cell of this size
 // [m] a skin vertex takes all of its anchors' motion within kFollowNear of them through the tissue, none
@@ -646,7 +650,8 @@ struct Obstacles {
   Points point;
   Points normal;
   std::vector<double> clearance;  // [m]
-  std::vector<int> body;          // body index, -1 for the gut
+  std::vector<int> body;          // body index, -1 for a node
+  std::vector<int> node;          // node index (a gut node or a volume body's superficial node), else -1
 };
 
 Obstacles obstaclesOf(const BuiltModel& built) {
@@ -660,14 +665,29 @@ Obstacles obstaclesOf(const BuiltModel& built) {
       o.normal.push_back(n.col(i));
       o.clearance.push_back(kBoneClearance);
       o.body.push_back(b);
+      o.node.push_back(-1);
     }
   }
-  const Eigen::Matrix3Xd n = vertexNormals(m.nodes.rest, m.gut.triangles);
+  // the nodes: the gut's, and the volume bodies' superficial ones (the skin lies over the pectorals and
+  // shoulders; bind() takes no anchor from them); their deep nodes, tied to a bone (a spring from the node to
+  // a body), lie under them
+  Eigen::Matrix3Xi surfaces = m.gut.triangles;
+  for (const Eigen::Matrix3Xi& t : m.volumes.triangles) {
+    surfaces.conservativeResize(3, surfaces.cols() + t.cols());
+    surfaces.rightCols(t.cols()) = t;
+  }
+  const Eigen::Matrix3Xd n = vertexNormals(m.nodes.rest, surfaces);
+  std::vector<char> isTied(static_cast<std::size_t>(m.nodes.size()), 0);
+  for (int e = 0; e < m.elements.size(); ++e)
+    if (sim::isApposition(m.elements, e)) isTied[static_cast<std::size_t>(sim::tiedNode(m.elements, e))] = 1;
   for (int i = 0; i < m.nodes.size(); ++i) {
+    const bool isTissue = m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Tissue;
+    if (isTissue && isTied[static_cast<std::size_t>(i)]) continue;
     o.point.push_back(m.nodes.rest.col(i));
     o.normal.push_back(n.col(i));
-    o.clearance.push_back(kGutClearance);
+    o.clearance.push_back(isTissue ? kTissueClearance : kGutClearance);
     o.body.push_back(-1);
+    o.node.push_back(i);
   }
   return o;
 }
@@ -726,6 +746,11 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
   {
     std::map<std::array<long long, 4>, int> seen;
     for (std::size_t i = 0; i < o.point.size(); ++i) {
+      // a volume body's node is an obstacle only: the skin slides over the pectorals and shoulders as they
+      // slide over the ribs (bound to them, the skin at the inframammary fold, between the lens and the skin
+      // bound to the dome, crossed itself in a deep breath)
+      if (o.node[i] >= 0 && m.nodes.region[static_cast<std::size_t>(o.node[i])] == sim::NodeRegion::Tissue)
+        continue;
       const Eigen::Vector3d& p = o.point[i];
       const std::array<long long, 4> key{o.body[i],
                                          static_cast<long long>(std::floor(p.x() / kAnchorSpacing)),
@@ -787,8 +812,7 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
       if (b >= 0)
         out.anchors.addBodyPoint(b, o.point[static_cast<std::size_t>(src)] - m.bodies.com.col(b));
       else
-        out.anchors.addNodePoint({src - static_cast<int>(o.point.size()) + m.nodes.size(), -1, -1},
-                                 {1, 0, 0});
+        out.anchors.addNodePoint({o.node[static_cast<std::size_t>(src)], -1, -1}, {1, 0, 0});
     }
     return simAnchor[static_cast<std::size_t>(a)];
   };

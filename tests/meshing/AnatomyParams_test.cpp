@@ -8,6 +8,7 @@
 
 #include "pneuma/meshing/ModelBuilder.h"
 #include "pneuma/sim/Error.h"
+#include "pneuma/sim/Ties.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -81,7 +82,7 @@ TEST(AnatomyParams, ZoneOfAppositionGrowsWithItsHeight) {
     j["abdomen"]["apposition_height_mm"] = heightMm;
     const sim::Model m = buildModel(parseAnatomy(j.dump(), read(kDir + "muscle_gains.json")), "").model;
     int n = 0;
-    for (int e = 0; e < m.elements.size(); ++e) n += sim::isApposition(m.elements, e) ? 1 : 0;
+    for (int e = 0; e < m.elements.size(); ++e) n += sim::isApposition(m, e) ? 1 : 0;
     return n;
   };
   const int none = apposed(20), preset = apposed(65), tall = apposed(90);

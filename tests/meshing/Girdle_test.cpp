@@ -11,6 +11,7 @@
 #include <string>
 
 #include "SurfaceCrossings.h"
+#include "TissueChecks.h"
 #include "pneuma/meshing/AnatomyParams.h"
 #include "pneuma/meshing/MeshTools.h"
 #include "pneuma/meshing/ModelBuilder.h"
@@ -141,7 +142,9 @@ TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   for (int e = 0; e < m.elements.size(); ++e) {
     const int a = m.elements.endA.body[static_cast<std::size_t>(e)],
               b = m.elements.endB.body[static_cast<std::size_t>(e)];
-    const bool onGirdle = girdle.count(a) || girdle.count(b);
+    // springs between bones only: the deltoid volume bodies' ties (a node to the humerus or scapula) are not
+    // muscles
+    const bool onGirdle = a >= 0 && b >= 0 && (girdle.count(a) || girdle.count(b));
     if (onGirdle && a != head && b != head) ++shoulder;
     if (a == cervical && (b == body(m, "rib1_right") || b == body(m, "rib1_left"))) {
       ++scalenes;
@@ -197,6 +200,13 @@ TEST_P(GirdlePresets, EveryGirdleBoneLiesInsideTheSkin) {
       if (!test::isInside(bone.col(i), skin, m.skin.triangles)) ++outside;
     EXPECT_EQ(outside, 0) << part << ": " << outside << " of " << bone.cols() << " vertices outside the skin";
   }
+}
+
+// the shoulder (deltoid) volume bodies: caps over the glenohumeral joints between the bones and the skin
+// (TissueChecks.h); [m^3] an adult deltoid is 200-400 mL
+TEST_P(GirdlePresets, DeltoidVolumesLieBetweenTheBonesAndTheSkin) {
+  for (const char* name : {"deltoid_right", "deltoid_left"})
+    pneuma::test::expectBetweenBonesAndSkin(builtWithSkin(GetParam()), name, 50e-6, 600e-6);
 }
 
 // the sternocleidomastoids (from the mastoid) and the scalenes (from the cervical spine to rib 1) run inside

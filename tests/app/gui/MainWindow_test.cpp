@@ -167,7 +167,8 @@ TEST(MainWindow, InhaleShowsForceColouredMusclesAndHidingThemRemovesThem) {
 TEST_F(DefaultModelWindow, LungsAreDrawnAndTheirCheckBoxHidesThem) {
   viz::DisplayOptions o = window.scene().options();
   EXPECT_TRUE(o.showLungs);
-  o.showBones = o.showGut = o.showLandmarks = false;
+  // the lungs alone: the pectorals (opaque, over the front of the rib cage) would hide most of them
+  o.showBones = o.showGut = o.showLandmarks = o.showTissue = false;
   o.skin = viz::SkinDisplay::Hidden;
   o.showGroup.fill(false);
   window.setDisplayOptions(o);
@@ -234,7 +235,8 @@ TEST_F(DefaultModelWindow, SkinShowsTheBodyAndTheRibCageThroughIt) {
 // bones still show (hiding them changes a good part of the body)
 TEST_F(DefaultModelWindow, OpaqueSkinHidesTheInsideAndTheTranslucentOneShowsIt) {
   viz::DisplayOptions o = window.scene().options();
-  o.showGut = o.showLungs = o.showLandmarks = false;
+  // the bones and the skin alone: the pectorals (opaque, on the front of the rib cage) hidden too
+  o.showGut = o.showLungs = o.showLandmarks = o.showTissue = false;
   o.showGroup.fill(false);
   o.skin = viz::SkinDisplay::Opaque;
   const auto grab = [&](bool bones) {
@@ -896,8 +898,8 @@ TEST(MainWindow, RunExportsAsParaViewSeries) {
   ASSERT_TRUE(pvd.open(QIODevice::ReadOnly));
   const QByteArray text = pvd.readAll();
   EXPECT_TRUE(text.contains("<VTKFile type=\"Collection\""));
-  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 6 parts each)
-  EXPECT_GE(text.count("<DataSet"), 6 * 30);
+  // one dataset entry per part and recorded frame (0.5 s at 60 Hz: 30 or 31 frames, 7 parts each)
+  EXPECT_GE(text.count("<DataSet"), 7 * 30);
   EXPECT_FALSE(QDir(out.filePath("run")).entryList({"*.vtp"}, QDir::Files).isEmpty());
 
   // an unwritable destination is an error, not a crash
@@ -975,7 +977,7 @@ TEST(MainWindow, SeriesDialogAnnouncesFramesAndSizeAndTheExportWritesThem) {
   const double estimate = about.captured(1).toDouble() * (about.captured(2) == "MB" ? 1e6 : 1e3);  // [bytes]
   double written = 0.0;
   const QFileInfoList files = QDir(out.filePath("run")).entryInfoList(QDir::Files);
-  EXPECT_EQ(files.size(), 6 * 21);
+  EXPECT_EQ(files.size(), 7 * 21);  // seven parts per frame (VtkSeriesWriter.h)
   for (const QFileInfo& f : files) written += static_cast<double>(f.size());
   EXPECT_NEAR(written, estimate, 0.1 * estimate);
 }

@@ -77,7 +77,7 @@ TEST(VtkSeriesWriter, FramesHoldThePosedGeometry) {
   }
   EXPECT_EQ(writer.finish(), "run.pvd");
 
-  // the collection lists the six parts of each frame at its time
+  // the collection lists the seven parts of each frame at its time
   std::ifstream pvdFile(dir / "run.pvd");
   std::stringstream pvd;
   pvd << pvdFile.rdbuf();
@@ -232,7 +232,7 @@ TEST(VtkSeriesWriter, UnfinishedWriterRemovesOnlyItsOwnFiles) {
   viz::VtkSeriesWriter writer(f.model, f.dir.string(), f.dir.string(), "run", kStaged);
   f.writeFrames(writer, 2);
   EXPECT_EQ(writer.finish(), "run.pvd");
-  EXPECT_EQ(f.entries(f.dir / "run"), 12u) << "two frames of six parts";
+  EXPECT_EQ(f.entries(f.dir / "run"), 14u) << "two frames of seven parts";
   EXPECT_GT(fs::file_size(f.dir / "run" / "bones_000000.vtp"), 100u);
   EXPECT_EQ(f.entries(f.dir), 3u) << "run, run.pvd and notes.txt";
 }

@@ -128,6 +128,21 @@ enum JointKind : int {
 constexpr std::array<const char*, 6> kJointKinds = {
     "spine", "costovertebral", "sternoclavicular", "acromioclavicular", "glenohumeral", "elbow"};
 
+/// The soft-tissue volume bodies over the chest and shoulders (sim::VolumeBodies, built by TissueBodies.cpp),
+/// muscle_gains.json `tissue_bodies` (optional: none when absent).
+struct TissueGains {
+  double kappa = 0.0;    ///< [Pa] bulk modulus of Eq. 4 of every tissue body; 0: no tissue bodies
+  double density = 0.0;  ///< [kg/m^3] a body's mass is density x its rest volume, shared equally by its nodes
+  /// [N/m], [N s/m] kpe and b (kac unused) of the springs along the surface edges and through the thickness,
+  /// at the reference length
+  GroupGains surface{};
+  /// [N/m], [N s/m] kpe and b of each of the three springs tying a deep node to its bone (20 mm arms, the
+  /// reference length's scaling applied to them)
+  GroupGains tie{};
+  double pectoralThickness = 0.0;  ///< [m] largest thickness of a pectoral lens over the chest wall
+  double deltoidThickness = 0.0;   ///< [m] largest thickness of a shoulder (deltoid) cap
+};
+
 /// Everything of resources/anatomy/muscle_gains.json.
 struct Gains {
   double referenceLength = 0.0;  ///< [m] element length at which the group gains apply unscaled
@@ -153,6 +168,7 @@ struct Gains {
   /// length: Zordan et al. 2004, Table 1, the 52 shoulder elements (kpe 10, b 1), and the
   /// sternocleidomastoids
   GroupGains shoulder{};
+  TissueGains tissue{};        ///< the pectoral and shoulder volume bodies
   double wallMass = 0.0;       ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
   double diaphragmMass = 0.0;  ///< [kg] total mass of the diaphragm dome nodes
 };

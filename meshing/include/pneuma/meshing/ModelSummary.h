@@ -19,12 +19,16 @@ struct ModelSummary {
   std::array<int, sim::kElementGroupCount> elements{};  ///< per sim::ElementGroup
   double gutVolume = 0.0;                               ///< [m^3] enclosed by the gut surface at rest
   double cavityVolume = 0.0;                            ///< [m^3] enclosed by the lung-cavity surface at rest
-  double gutWallMass = 0.0;  ///< [kg] mass of the moving abdominal-wall nodes (region Wall)
-  double boneMass = 0.0;     ///< [kg] mass of all bodies
-  int skinVertices = 0;      ///< vertices of the skin (0: the model has none)
-  int skinTriangles = 0;     ///< triangles of the skin
-  int skinTetrahedra = 0;    ///< TetGen tetrahedra of the soft tissue the skin is bound through
-  double skinVolume = 0.0;   ///< [m^3] enclosed by the skin at rest
+  double gutWallMass = 0.0;   ///< [kg] mass of the moving abdominal-wall nodes (region Wall)
+  double boneMass = 0.0;      ///< [kg] mass of all bodies
+  int skinVertices = 0;       ///< vertices of the skin (0: the model has none)
+  int skinTriangles = 0;      ///< triangles of the skin
+  int skinTetrahedra = 0;     ///< TetGen tetrahedra of the soft tissue the skin is bound through
+  double skinVolume = 0.0;    ///< [m^3] enclosed by the skin at rest
+  int tissueBodies = 0;       ///< soft-tissue volume bodies (sim::VolumeBodies: pectorals, shoulders)
+  int tissueNodes = 0;        ///< their nodes (region Tissue)
+  double tissueVolume = 0.0;  ///< [m^3] the volume they enclose at rest, together
+  double tissueMass = 0.0;    ///< [kg] the mass of their nodes
 };
 
 /// World rest positions of the points of `set` (3 x #P) [m]: body points at com + local (body axes are
