@@ -1492,7 +1492,7 @@ TEST_F(DefaultModelWindow, SkinIsDrawnDecimatedAndCoversTheFullSkinsPixels) {
   ASSERT_GT(model.skin.vertexCount(), 0);
   ASSERT_TRUE(window.runUntil(5.0));
   viz::DisplayOptions o = window.scene().options();
-  o.showBones = o.showGut = o.showLungs = o.showLandmarks = false;
+  o.showBones = o.showGut = o.showLungs = o.showLandmarks = o.showTissue = false;
   o.showGroup.fill(false);
   o.skin = viz::SkinDisplay::Opaque;
   window.setDisplayOptions(o);
