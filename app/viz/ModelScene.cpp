@@ -10,10 +10,14 @@
 #include <vtkCellPicker.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkCoordinate.h>
+#include <vtkCullerCollection.h>
 #include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
+#include <vtkIdList.h>
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
+#include <vtkOpenGLPolyDataMapper.h>
+#include <vtkOpenGLVertexBufferObject.h>
 #include <vtkOrientationMarkerWidget.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -30,6 +34,7 @@
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkSphereSource.h>
+#include <vtkStaticCellLocator.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkTextRenderer.h>
@@ -177,17 +182,19 @@ vtkSmartPointer<vtkCaptionActor2D> makeLabel(const std::string& text) {
   return label;
 }
 
-// display only: a bone mesh with kBoneDisplayKeep of its triangles (quadric decimation, volume kept), shaded
-// with normals split at 60 degrees as readBodyMesh() does. Under software OpenGL the bones' 41 000 triangles
-// cost a third of a frame whatever the window size. The exports (ParaView series, glTF) read the full mesh.
-constexpr double kBoneDisplayKeep = 0.3;         // [-] share of the triangles drawn
-constexpr vtkIdType kBoneDecimationFloor = 400;  // [-] meshes with fewer triangles are drawn as they are
+// display only: a mesh with `keep` of its triangles (quadric decimation, volume kept), shaded with normals
+// split at 60 degrees as readBodyMesh() does. Under software OpenGL the bones' 41 000 triangles cost a third
+// of a frame whatever the window size, and the skin's 20 800 (re-uploaded at every frame) a quarter. The
+// exports (ParaView series, glTF) read the full meshes.
+constexpr double kBoneDisplayKeep = 0.3;     // [-] share of the bones' triangles drawn
+constexpr double kSkinDisplayKeep = 0.5;     // [-] share of the skin's triangles drawn (DisplaySkin)
+constexpr vtkIdType kDecimationFloor = 400;  // [-] meshes with fewer triangles are drawn as they are
 
-vtkSmartPointer<vtkPolyData> decimateForDisplay(vtkPolyData* mesh) {
-  if (mesh->GetNumberOfPolys() < kBoneDecimationFloor) return mesh;
+vtkSmartPointer<vtkPolyData> decimateForDisplay(vtkPolyData* mesh, double keep) {
+  if (mesh->GetNumberOfPolys() < kDecimationFloor) return mesh;
   vtkNew<vtkQuadricDecimation> decimate;
   decimate->SetInputData(mesh);
-  decimate->SetTargetReduction(1.0 - kBoneDisplayKeep);
+  decimate->SetTargetReduction(1.0 - keep);
   decimate->VolumePreservationOn();
   vtkNew<vtkPolyDataNormals> normals;
   normals->SetInputConnection(decimate->GetOutputPort());
@@ -195,6 +202,63 @@ vtkSmartPointer<vtkPolyData> decimateForDisplay(vtkPolyData* mesh) {
   normals->Update();
   if (normals->GetOutput()->GetNumberOfPolys() == 0) return mesh;
   return normals->GetOutput();
+}
+
+// the drawn skin (display only): the skin decimated to kSkinDisplayKeep of its triangles, each of its
+// vertices embedded in the full skin at rest (the three corners of the nearest full triangle and their
+// barycentric weights, in LungSurface's form), so that it is posed from the full skin's posed vertices
+// (PosedGeometry::skin) by sim::lungPositions(): x_v = sum_k w_k s_{i_k}. One posing function, a smaller mesh
+// to draw.
+sim::LungSurface displaySkin(const sim::Skin& skin, const Eigen::Matrix3Xd& rest) {
+  vtkNew<vtkPolyData> full;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(rest.cols());
+  for (Eigen::Index v = 0; v < rest.cols(); ++v) points->SetPoint(v, rest(0, v), rest(1, v), rest(2, v));
+  full->SetPoints(points);
+  vtkNew<vtkCellArray> polys;
+  for (Eigen::Index t = 0; t < skin.triangles.cols(); ++t) {
+    const vtkIdType ids[3] = {skin.triangles(0, t), skin.triangles(1, t), skin.triangles(2, t)};
+    polys->InsertNextCell(3, ids);
+  }
+  full->SetPolys(polys);
+  vtkSmartPointer<vtkPolyData> drawn = decimateForDisplay(full, kSkinDisplayKeep);
+
+  sim::LungSurface out;
+  const vtkIdType n = drawn->GetNumberOfPoints();
+  out.cavityVertex.setConstant(sim::kLungVertexSlots, n, -1);
+  out.weights.setZero(sim::kLungVertexSlots, n);
+  vtkNew<vtkStaticCellLocator> locator;
+  locator->SetDataSet(full);
+  locator->BuildLocator();
+  for (vtkIdType v = 0; v < n; ++v) {
+    double at[3], closest[3], distance2 = 0.0;
+    drawn->GetPoint(v, at);
+    vtkIdType cell = -1;
+    int sub = 0;
+    locator->FindClosestPoint(at, closest, cell, sub, distance2);
+    // barycentric weights of the closest point in its triangle (a, b, c), clamped into it
+    const Eigen::Vector3i corner = skin.triangles.col(cell);
+    const Eigen::Vector3d a = rest.col(corner(0)), e1 = rest.col(corner(1)) - a, e2 = rest.col(corner(2)) - a;
+    const Eigen::Vector3d p = Eigen::Vector3d(closest[0], closest[1], closest[2]) - a;
+    const double d11 = e1.dot(e1), d12 = e1.dot(e2), d22 = e2.dot(e2), det = d11 * d22 - d12 * d12;
+    double u = det > 0.0 ? (d22 * e1.dot(p) - d12 * e2.dot(p)) / det : 0.0;
+    double w = det > 0.0 ? (d11 * e2.dot(p) - d12 * e1.dot(p)) / det : 0.0;
+    u = std::clamp(u, 0.0, 1.0);
+    w = std::clamp(w, 0.0, 1.0 - u);
+    const std::array<double, 3> weight{1.0 - u - w, u, w};
+    for (int k = 0; k < 3; ++k) {
+      out.cavityVertex(k, v) = corner(k);
+      out.weights(k, v) = weight[static_cast<std::size_t>(k)];
+    }
+  }
+  vtkCellArray* cells = drawn->GetPolys();
+  out.triangles.resize(3, cells->GetNumberOfCells());
+  vtkNew<vtkIdList> ids;
+  cells->InitTraversal();
+  for (Eigen::Index t = 0; cells->GetNextCell(ids); ++t)
+    for (int k = 0; k < 3; ++k) out.triangles(k, t) = static_cast<int>(ids->GetId(k));
+  return out;
 }
 
 }  // namespace
@@ -341,7 +405,11 @@ struct ModelScene::Impl {
   vtkSmartPointer<vtkPolyData> landmarks;
   vtkSmartPointer<vtkActor> landmarkActor;
 
-  // the skin, coloured plain or by its displacement from the rest pose
+  // the skin, coloured plain or by its displacement from the rest pose, drawn decimated (displaySkin())
+  sim::LungSurface drawnSkin;           // the drawn mesh, embedded in the full skin
+  Eigen::Matrix3Xd drawnSkinAt;         // [m] its vertices as drawn (magnified)
+  Eigen::Matrix3Xd drawnSkinReal;       // [m] as the state puts them (unmagnified)
+  Eigen::Matrix3Xd drawnSkinReference;  // [m] at the end-expiratory reference
   vtkSmartPointer<vtkPolyData> skin;
   vtkSmartPointer<vtkFloatArray> skinScalar;  // [mm] displacement from end-expiration
   vtkSmartPointer<vtkActor> skinActor;
@@ -370,6 +438,8 @@ struct ModelScene::Impl {
     labels.clear();
     gutActor = cavityActor = landmarkActor = highlightActor = skinActor = tissueActor = nullptr;
     tissue = nullptr;
+    skin = nullptr;
+    drawnSkin = {};
     ghost.clear();
     hasGhost = false;
     lungs = {};
@@ -400,6 +470,10 @@ struct ModelScene::Impl {
   static vtkSmartPointer<vtkActor> actorFor(vtkPolyData* data) {
     vtkNew<vtkPolyDataMapper> mapper;
     mapper->SetInputData(data);
+    // the model lies within a metre of the origin [m]: single precision holds it to a micrometre, so the
+    // coordinate shift and scale, whose range scan of every moved array cost at each upload, is off
+    if (auto* gl = vtkOpenGLPolyDataMapper::SafeDownCast(mapper))
+      gl->SetVBOShiftScaleMethod(vtkOpenGLVertexBufferObject::DISABLE_SHIFT_SCALE);
     auto actor = vtkSmartPointer<vtkActor>::New();
     actor->SetMapper(mapper);
     return actor;
@@ -462,6 +536,13 @@ struct ModelScene::Impl {
     return data;
   }
 
+  // the drawn skin posed from the full skin's vertices `full` (3 x #V [m]): its points and normals
+  void setSkin(const Eigen::Matrix3Xd& full) {
+    sim::lungPositions(drawnSkin, full, drawnSkinAt);
+    setPoints(skin, drawnSkinAt);
+    setNormals(skin, drawnSkinAt, drawnSkin.triangles, normalScratch);
+  }
+
   static void setPoints(vtkPolyData* data, const Eigen::Matrix3Xd& x) {
     vtkPoints* points = data->GetPoints();
     for (Eigen::Index i = 0; i < x.cols(); ++i) points->SetPoint(i, x(0, i), x(1, i), x(2, i));
@@ -481,7 +562,8 @@ struct ModelScene::Impl {
         meshes.emplace_back(sphere->GetOutput());
       } else {
         meshes.push_back(decimateForDisplay(readBodyMesh((std::filesystem::path(modelDir) / file).string(),
-                                                         model.bodies.name[static_cast<std::size_t>(b)])));
+                                                         model.bodies.name[static_cast<std::size_t>(b)]),
+                                            kBoneDisplayKeep));
       }
     }
     return meshes;
@@ -586,7 +668,10 @@ struct ModelScene::Impl {
 
     // the skin: smooth-shaded, drawn last among the surfaces so the translucent body wraps the rest
     if (model.skin.vertexCount() > 0) {
-      skin = surface(model.skin.vertexCount(), model.skin.triangles);
+      sim::PosedGeometry rest;
+      sim::poseGeometry(model, sim::makeInitialState(model), rest);
+      drawnSkin = displaySkin(model.skin, rest.skin);
+      skin = surface(drawnSkin.vertexCount(), drawnSkin.triangles);
       skinActor = scalarSurfaceActor(skin, skinScalar, skinTable);
       skinActor->GetProperty()->SetSpecular(0.15);
       skinActor->GetProperty()->SetSpecularPower(12.0);
@@ -895,6 +980,9 @@ ModelScene::ModelScene() : m_impl(std::make_unique<Impl>()) {
   // under software OpenGL
   vtkNew<vtkRenderStepsPass> steps;
   r->SetPass(steps);
+  // no frustum culling: the whole model is in view, and the culler's bounds of every moved actor (a pass over
+  // its cells) were recomputed at every frame
+  r->GetCullers()->RemoveAllItems();
   // paraview-like blue-grey gradient
   r->GradientBackgroundOn();
   r->SetBackground(0.11, 0.12, 0.16);
@@ -983,6 +1071,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
   const double referenceKey = endExpiration ? endExpiration->time : -1.0;
   if (!(referenceKey == s.referenceTime)) {
     sim::poseGeometry(model, endExpiration ? *endExpiration : sim::makeInitialState(model), s.reference);
+    if (s.skin) sim::lungPositions(s.drawnSkin, s.reference.skin, s.drawnSkinReference);
     s.referenceTime = referenceKey;
   }
   const bool isAuto = s.options.isAutoRange;
@@ -1072,11 +1161,12 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
 
   // skin and its real displacement from end-expiration [mm]
   if (s.skin) {
-    Impl::setPoints(s.skin, s.posed.skin);
-    Impl::setNormals(s.skin, s.posed.skin, model.skin.triangles, s.normalScratch);
+    s.setSkin(s.posed.skin);
+    if (isMagnified) sim::lungPositions(s.drawnSkin, real.skin, s.drawnSkinReal);
+    const Eigen::Matrix3Xd& drawnReal = isMagnified ? s.drawnSkinReal : s.drawnSkinAt;
     s.values.clear();
-    for (Eigen::Index v = 0; v < s.posed.skin.cols(); ++v) {
-      const double d = 1000.0 * (real.skin.col(v) - s.reference.skin.col(v)).norm();
+    for (Eigen::Index v = 0; v < drawnReal.cols(); ++v) {
+      const double d = 1000.0 * (drawnReal.col(v) - s.drawnSkinReference.col(v)).norm();
       s.skinScalar->SetValue(v, static_cast<float>(d));
       if (isAuto) s.values.push_back(d);
     }
@@ -1152,7 +1242,7 @@ const std::string& ModelScene::morphPlayback() const { return m_impl->playback; 
 
 void ModelScene::updateMorphPlayback(const sim::MorphTargets& targets, const Eigen::VectorXd& weights) {
   Impl& s = *m_impl;
-  if (!s.skinActor || !s.skin || targets.base.cols() != s.skin->GetNumberOfPoints() ||
+  if (!s.skinActor || !s.skin || targets.base.cols() != s.model.skin.vertexCount() ||
       weights.size() != static_cast<Eigen::Index>(targets.targets.size()))
     return;
   // the skin: base + m sum_k w_k D_k [m]
@@ -1160,8 +1250,7 @@ void ModelScene::updateMorphPlayback(const sim::MorphTargets& targets, const Eig
   Eigen::Matrix3Xd x = targets.base;
   for (std::size_t k = 0; k < targets.targets.size(); ++k)
     x += m * weights(static_cast<Eigen::Index>(k)) * targets.targets[k].displacement;
-  Impl::setPoints(s.skin, x);
-  Impl::setNormals(s.skin, x, s.model.skin.triangles, s.normalScratch);
+  s.setSkin(x);
   // the bones by the same (magnified) weights; a body the targets do not carry stays hidden
   const std::vector<Eigen::Isometry3d> poses = sim::blendBones(targets, m * weights);
   s.playbackBone.assign(s.bodies.size(), 0);

@@ -5,10 +5,18 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <vtkActor.h>
+#include <vtkActorCollection.h>
 #include <vtkCaptionActor2D.h>
+#include <vtkCellArray.h>
 #include <vtkCoordinate.h>
 #include <vtkDoubleArray.h>
+#include <vtkMapper.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
 #include <vtkPropCollection.h>
+#include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkScalarsToColors.h>
@@ -1473,6 +1481,99 @@ TEST_F(DefaultModelWindow, MorphPlaybackBreathesTheSkinWithThePhysicsPaused) {
   EXPECT_EQ(window.shown()->state.time, paused);
   for (const std::string& text : shownTexts(window.scene().renderer()))
     EXPECT_EQ(text.find("morph playback"), std::string::npos) << text;
+}
+
+// the skin is drawn decimated (docs/app.md, "Measured under Xvfb": half its triangles, embedded in the full
+// skin and posed from it) and still covers the body's pixels: opaque and alone in the view, its silhouette at
+// a breathing instant is the full-resolution skin's, posed the same, to within a few pixels along the
+// outline; coloured by displacement, its heat map still shows the breathing chest and belly in orange to red
+TEST_F(DefaultModelWindow, SkinIsDrawnDecimatedAndCoversTheFullSkinsPixels) {
+  const sim::Model& model = *window.model();
+  ASSERT_GT(model.skin.vertexCount(), 0);
+  ASSERT_TRUE(window.runUntil(5.0));
+  viz::DisplayOptions o = window.scene().options();
+  o.showBones = o.showGut = o.showLungs = o.showLandmarks = o.showTissue = false;
+  o.showGroup.fill(false);
+  o.skin = viz::SkinDisplay::Opaque;
+  window.setDisplayOptions(o);
+  const QImage drawn = window.grabView();
+
+  // the one actor shown is the skin, with at most 60 % of the model's triangles
+  vtkActor* skin = nullptr;
+  int shown = 0;
+  vtkActorCollection* actors = window.scene().renderer()->GetActors();
+  actors->InitTraversal();
+  while (vtkActor* a = actors->GetNextActor())
+    if (a->GetVisibility()) {
+      skin = a;
+      ++shown;
+    }
+  ASSERT_EQ(shown, 1);
+  const vtkIdType triangles = vtkPolyData::SafeDownCast(skin->GetMapper()->GetInput())->GetNumberOfPolys();
+  EXPECT_LT(triangles, 0.6 * static_cast<double>(model.skin.triangles.cols()));
+  EXPECT_GT(triangles, 0.3 * static_cast<double>(model.skin.triangles.cols()));
+
+  // the full skin as posed for the same frame, drawn alone in its place
+  const Eigen::Matrix3Xd& full = window.scene().posed().skin;
+  vtkNew<vtkPolyData> mesh;
+  vtkNew<vtkPoints> points;
+  for (Eigen::Index v = 0; v < full.cols(); ++v) points->InsertNextPoint(full(0, v), full(1, v), full(2, v));
+  mesh->SetPoints(points);
+  vtkNew<vtkCellArray> cells;
+  for (Eigen::Index t = 0; t < model.skin.triangles.cols(); ++t) {
+    const vtkIdType ids[3] = {model.skin.triangles(0, t), model.skin.triangles(1, t),
+                              model.skin.triangles(2, t)};
+    cells->InsertNextCell(3, ids);
+  }
+  mesh->SetPolys(cells);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(mesh);
+  vtkNew<vtkActor> reference;
+  reference->SetMapper(mapper);
+  reference->GetProperty()->SetColor(skin->GetProperty()->GetColor());
+  o.skin = viz::SkinDisplay::Hidden;
+  window.setDisplayOptions(o);
+  window.scene().renderer()->AddActor(reference);
+  const QImage fullSkin = window.grabView();
+  window.scene().renderer()->RemoveActor(reference);
+
+  const std::vector<bool> a = bodyMask(drawn), b = bodyMask(fullSkin);
+  ASSERT_EQ(a.size(), b.size());
+  // the full skin's outline: its pixels with a horizontal or vertical neighbour outside it
+  const auto w = static_cast<std::size_t>(drawn.width());
+  int body = 0, mismatched = 0, outline = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    body += b[i];
+    mismatched += a[i] != b[i];
+    outline += b[i] && ((i % w > 0 && !b[i - 1]) || (i % w + 1 < w && !b[i + 1]) || (i >= w && !b[i - w]) ||
+                        (i + w < b.size() && !b[i + w]));
+  }
+  EXPECT_GT(body, static_cast<int>(b.size()) / 10) << "the skin covers the view's middle";
+  EXPECT_LT(mismatched, outline) << "the drawn skin covers the full skin's pixels to within a pixel or so";
+
+  // the breathing heat map: orange to red skin (blue under 55 % of red) over a tenth of the body at the
+  // breath's largest displacement, none with the plain colour
+  const auto heated = [](const QImage& image) {
+    int n = 0;
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x) {
+        const QColor c = image.pixelColor(x, y);
+        n += c.red() > 80 && c.blue() < 0.55 * c.red();
+      }
+    return n;
+  };
+  o.skin = viz::SkinDisplay::Opaque;
+  o.skinColouring = viz::SkinColouring::Plain;
+  window.setDisplayOptions(o);
+  EXPECT_LT(heated(window.grabView()), body / 100) << "plain skin is skin-coloured";
+  o.skinColouring = viz::SkinColouring::Displacement;
+  window.setDisplayOptions(o);
+  int most = 0;
+  for (double t = 5.25; t <= 9.0; t += 0.25) {
+    ASSERT_TRUE(window.runUntil(t));
+    most = std::max(most, heated(window.grabView()));
+  }
+  EXPECT_GT(most, body / 10) << "the breathing skin shows its displacement";
 }
 
 TEST(MainWindow, MorphPlaybackOfAModelWithoutSkinIsDisabledWithTheReason) {
