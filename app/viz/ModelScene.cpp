@@ -14,6 +14,7 @@
 #include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkIdList.h>
+#include <vtkIntArray.h>
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
 #include <vtkOpenGLPolyDataMapper.h>
@@ -38,6 +39,7 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkTextRenderer.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
@@ -384,8 +386,22 @@ struct ModelScene::Impl {
   std::array<Group, kGroups> groups;
   sim::PosedGeometry posed;  // the model posed for the last update() (the one posing function)
 
-  std::vector<vtkSmartPointer<vtkActor>> bodies;
-  std::vector<vtkSmartPointer<vtkMatrix4x4>> bodyPose;
+  // the bones, every body's mesh in one actor: one draw instead of one per body (31 actors cost 12 ms of a
+  // frame under software OpenGL). Body b owns the points [start[b], start[b+1]); update() poses them from
+  // their body-frame positions, x = R_b p + t_b and n = R_b n0, and colours them per body.
+  struct Bones {
+    vtkSmartPointer<vtkPolyData> data;
+    vtkSmartPointer<vtkActor> actor;
+    vtkSmartPointer<vtkFloatArray> xyz;                // [m] posed points       (3 x #P)
+    vtkSmartPointer<vtkFloatArray> normal;             // [-] posed normals      (3 x #P)
+    vtkSmartPointer<vtkUnsignedCharArray> colour;      // RGB per point          (3 x #P)
+    Eigen::Matrix3Xf local;                            // [m] body-frame points  (3 x #P)
+    Eigen::Matrix3Xf localNormal;                      // [-] body-frame normals (3 x #P)
+    std::vector<Eigen::Index> start;                   // first point of each body (#B + 1)
+    std::vector<vtkSmartPointer<vtkCellArray>> polys;  // each body's triangles, its own point ids (#B)
+    std::vector<int> cellBody;                         // body of each drawn cell
+    std::vector<char> shown;                           // per body: its cells are drawn (#B)
+  } bones;
 
   vtkSmartPointer<vtkPolyData> gut;
   vtkSmartPointer<vtkFloatArray> gutScalar;
@@ -433,8 +449,7 @@ struct ModelScene::Impl {
   void clear() {
     for (vtkProp* prop : ownedProps()) renderer->RemoveViewProp(prop);
     for (Group& g : groups) g = Group{};
-    bodies.clear();
-    bodyPose.clear();
+    bones = Bones{};
     labels.clear();
     gutActor = cavityActor = landmarkActor = highlightActor = skinActor = tissueActor = nullptr;
     tissue = nullptr;
@@ -455,7 +470,7 @@ struct ModelScene::Impl {
     std::vector<vtkProp*> props;
     for (const Group& g : groups)
       if (g.actor) props.push_back(g.actor);
-    for (const auto& b : bodies) props.push_back(b);
+    if (bones.actor) props.push_back(bones.actor);
     for (const Label& l : labels) props.push_back(l.actor);
     for (vtkProp* p : {static_cast<vtkProp*>(gutActor), static_cast<vtkProp*>(cavityActor),
                        static_cast<vtkProp*>(lungActors[0]), static_cast<vtkProp*>(lungActors[1]),
@@ -570,21 +585,7 @@ struct ModelScene::Impl {
   }
 
   void build(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes) {
-    // bones
-    for (int b = 0; b < model.bodies.size(); ++b) {
-      auto actor = actorFor(meshes[static_cast<std::size_t>(b)]);
-      const bool isFixed = model.bodies.isFixed[static_cast<std::size_t>(b)] != 0;
-      if (isFixed)
-        actor->GetProperty()->SetColor(0.50, 0.49, 0.47);  // fixed bodies are dark (Figure 2)
-      else
-        actor->GetProperty()->SetColor(0.93, 0.90, 0.82);
-      actor->GetProperty()->SetSpecular(0.25);
-      actor->GetProperty()->SetSpecularPower(20.0);
-      auto pose = vtkSmartPointer<vtkMatrix4x4>::New();
-      actor->SetUserMatrix(pose);
-      bodies.push_back(actor);
-      bodyPose.push_back(pose);
-    }
+    buildBones(meshes);
 
     // muscle elements by group; the apposition springs (the pleural fluid's hold) are not drawn, nor the
     // volume bodies' springs and ties (a node of region Tissue at an end: the body is drawn as its surface)
@@ -749,6 +750,121 @@ struct ModelScene::Impl {
       if (a) a->GetProperty()->BackfaceCullingOn();
 
     for (vtkProp* prop : ownedProps()) renderer->AddViewProp(prop);
+  }
+
+  // fixed bodies are dark (Figure 2), moving ones bone-white
+  std::array<unsigned char, 3> boneColour(int b) const {
+    if (model.bodies.isFixed[static_cast<std::size_t>(b)] != 0) return {128, 125, 120};
+    return {237, 230, 209};
+  }
+
+  void colourBone(int b, const std::array<unsigned char, 3>& rgb) {
+    const auto k = static_cast<std::size_t>(b);
+    if (!bones.colour || k + 1 >= bones.start.size()) return;
+    for (Eigen::Index i = bones.start[k]; i < bones.start[k + 1]; ++i)
+      for (int c = 0; c < 3; ++c) bones.colour->SetValue(3 * i + c, rgb[static_cast<std::size_t>(c)]);
+    bones.colour->Modified();
+  }
+
+  // the bones' meshes (body frame) appended into one polydata with per-point normals and colours
+  void buildBones(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes) {
+    Bones& B = bones;
+    const std::size_t count = meshes.size();
+    B.start.assign(1, 0);
+    for (const auto& mesh : meshes) B.start.push_back(B.start.back() + mesh->GetNumberOfPoints());
+    const Eigen::Index n = B.start.back();
+    B.local.resize(3, n);
+    B.localNormal.setZero(3, n);
+    for (std::size_t b = 0; b < count; ++b) {
+      vtkPolyData* mesh = meshes[b];
+      vtkDataArray* normals = mesh->GetPointData()->GetNormals();
+      for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i) {
+        double p[3];
+        mesh->GetPoint(i, p);
+        B.local.col(B.start[b] + i) = Eigen::Vector3d(p[0], p[1], p[2]).cast<float>();
+        if (normals) {
+          normals->GetTuple(i, p);
+          B.localNormal.col(B.start[b] + i) = Eigen::Vector3d(p[0], p[1], p[2]).cast<float>();
+        }
+      }
+      auto polys = vtkSmartPointer<vtkCellArray>::New();
+      polys->DeepCopy(mesh->GetPolys());
+      B.polys.push_back(polys);
+    }
+    B.data = vtkSmartPointer<vtkPolyData>::New();
+    B.xyz = vtkSmartPointer<vtkFloatArray>::New();
+    B.xyz->SetNumberOfComponents(3);
+    B.xyz->SetNumberOfTuples(n);
+    vtkNew<vtkPoints> points;
+    points->SetData(B.xyz);
+    B.data->SetPoints(points);
+    B.normal = vtkSmartPointer<vtkFloatArray>::New();
+    B.normal->SetNumberOfComponents(3);
+    B.normal->SetNumberOfTuples(n);
+    B.data->GetPointData()->SetNormals(B.normal);
+    B.colour = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    B.colour->SetName("colour");
+    B.colour->SetNumberOfComponents(3);
+    B.colour->SetNumberOfTuples(n);
+    B.data->GetPointData()->SetScalars(B.colour);
+    // which body each point belongs to (tests and tools read it; the mapper does not)
+    vtkNew<vtkIntArray> body;
+    body->SetName("body");
+    body->SetNumberOfValues(n);
+    for (std::size_t b = 0; b < count; ++b)
+      for (Eigen::Index i = B.start[b]; i < B.start[b + 1]; ++i) body->SetValue(i, static_cast<int>(b));
+    B.data->GetPointData()->AddArray(body);
+    for (std::size_t b = 0; b < count; ++b) colourBone(static_cast<int>(b), boneColour(static_cast<int>(b)));
+    B.actor = actorFor(B.data);
+    B.actor->GetMapper()->SetColorModeToDirectScalars();
+    B.actor->GetMapper()->SetScalarModeToUsePointData();
+    B.actor->GetProperty()->SetSpecular(0.25);
+    B.actor->GetProperty()->SetSpecularPower(20.0);
+    B.shown.clear();
+    showBones([](std::size_t) { return true; });
+    poseBones();
+  }
+
+  // the drawn cells: those of the bodies `isShown` picks (rebuilt only when that set changes)
+  template <class IsShown>
+  void showBones(IsShown isShown) {
+    Bones& B = bones;
+    if (!B.actor) return;
+    std::vector<char> shown(B.polys.size());
+    for (std::size_t b = 0; b < shown.size(); ++b) shown[b] = isShown(b) ? 1 : 0;
+    B.actor->SetVisibility(std::find(shown.begin(), shown.end(), 1) != shown.end());
+    if (shown == B.shown) return;
+    B.shown = shown;
+    vtkNew<vtkCellArray> cells;
+    B.cellBody.clear();
+    for (std::size_t b = 0; b < shown.size(); ++b) {
+      if (!shown[b]) continue;
+      cells->Append(B.polys[b], B.start[b]);
+      B.cellBody.resize(static_cast<std::size_t>(cells->GetNumberOfCells()), static_cast<int>(b));
+    }
+    B.data->SetPolys(cells);
+  }
+
+  // the bones' points and normals at posed.body's poses (before the first update(): at rest)
+  void poseBones() {
+    Bones& B = bones;
+    if (!B.data) return;
+    const Eigen::Index n = B.local.cols();
+    Eigen::Map<Eigen::Matrix3Xf> x(B.xyz->GetPointer(0), 3, n), normal(B.normal->GetPointer(0), 3, n);
+    for (std::size_t b = 0; b + 1 < B.start.size(); ++b) {
+      const Eigen::Index first = B.start[b], size = B.start[b + 1] - first;
+      const Eigen::Isometry3d T =
+          b < posed.body.size()
+              ? posed.body[b]
+              : Eigen::Isometry3d(Eigen::Translation3d(model.bodies.com.col(static_cast<Eigen::Index>(b))));
+      const Eigen::Matrix3f R = T.linear().cast<float>();
+      x.middleCols(first, size) =
+          (R * B.local.middleCols(first, size)).colwise() + T.translation().cast<float>();
+      normal.middleCols(first, size) = R * B.localNormal.middleCols(first, size);
+    }
+    B.xyz->Modified();
+    B.normal->Modified();
+    B.data->GetPoints()->Modified();
   }
 
   void resetAutoRange() { muscleTop = gutDisplacementTop = gutPressureTop = skinTop = 0.0; }
@@ -925,7 +1041,7 @@ struct ModelScene::Impl {
       anyMuscleShown = anyMuscleShown || (shown && colourByForce && !g.element.empty());
     }
     forceBar->SetVisibility(anyMuscleShown);
-    for (const auto& b : bodies) b->SetVisibility(options.showBones);
+    showBones([&](std::size_t) { return options.showBones; });
     if (gutActor) {
       gutActor->SetVisibility(options.showGut);
       gutActor->GetProperty()->SetOpacity(options.isGutTranslucent ? 0.55 : 1.0);  // one layer (front faces)
@@ -958,8 +1074,8 @@ struct ModelScene::Impl {
     // morph playback: the skin, plain, and the baked bones; everything else the physics moves is hidden
     if (!playback.empty()) {
       for (vtkProp* prop : ownedProps()) prop->SetVisibility(prop == skinActor.GetPointer() && isSkinShown);
-      for (std::size_t b = 0; b < bodies.size(); ++b)
-        bodies[b]->SetVisibility(options.showBones && b < playbackBone.size() && playbackBone[b]);
+      showBones(
+          [&](std::size_t b) { return options.showBones && b < playbackBone.size() && playbackBone[b]; });
       for (vtkProp* bar : {forceBar.GetPointer(), gutBar.GetPointer(), skinBar.GetPointer()})
         bar->SetVisibility(false);
       if (skinActor) skinActor->GetMapper()->SetScalarVisibility(false);
@@ -1076,14 +1192,7 @@ void ModelScene::update(const sim::State& state, const sim::Metrics& metrics,
   }
   const bool isAuto = s.options.isAutoRange;
 
-  // bones: rigid transforms body -> world
-  for (std::size_t b = 0; b < s.bodies.size(); ++b) {
-    const Eigen::Matrix4d T = s.posed.body[b].matrix();
-    vtkMatrix4x4* m = s.bodyPose[b];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 4; ++j) m->SetElement(i, j, T(i, j));
-    m->Modified();
-  }
+  s.poseBones();
 
   // muscle elements: end positions, and their tension [N] (NaN = slack = grey) or their group's activation
   const bool hasForces = metrics.elementForce.size() == model.elements.size();
@@ -1253,22 +1362,18 @@ void ModelScene::updateMorphPlayback(const sim::MorphTargets& targets, const Eig
   s.setSkin(x);
   // the bones by the same (magnified) weights; a body the targets do not carry stays hidden
   const std::vector<Eigen::Isometry3d> poses = sim::blendBones(targets, m * weights);
-  s.playbackBone.assign(s.bodies.size(), 0);
+  const std::size_t bodyCount = s.bones.polys.size();
+  s.playbackBone.assign(bodyCount, 0);
   for (std::size_t k = 0; k < poses.size(); ++k) {
     const auto& names = s.model.bodies.name;
     const auto b =
         static_cast<std::size_t>(std::find(names.begin(), names.end(), targets.bones[k]) - names.begin());
-    if (b >= s.bodies.size()) continue;
-    if (s.posed.body.size() != s.bodies.size())
-      s.posed.body.resize(s.bodies.size(), Eigen::Isometry3d::Identity());
+    if (b >= bodyCount) continue;
+    if (s.posed.body.size() != bodyCount) s.posed.body.resize(bodyCount, Eigen::Isometry3d::Identity());
     s.playbackBone[b] = 1;
     s.posed.body[b] = poses[k];
-    const Eigen::Matrix4d T = poses[k].matrix();
-    vtkMatrix4x4* pose = s.bodyPose[b];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 4; ++j) pose->SetElement(i, j, T(i, j));
-    pose->Modified();
   }
+  s.poseBones();
   s.applyOptions();
 }
 
@@ -1329,26 +1434,21 @@ Pick ModelScene::pick(int x, int y) const {
     if (hit && hit == g.actor && picker->GetCellId() >= 0 &&
         static_cast<std::size_t>(picker->GetCellId()) < g.element.size())
       return {Pick::Kind::Element, g.element[static_cast<std::size_t>(picker->GetCellId())]};
-  for (std::size_t b = 0; b < m_impl->bodies.size(); ++b)
-    if (hit == m_impl->bodies[b]) return {Pick::Kind::Body, static_cast<int>(b)};
+  const Impl::Bones& bones = m_impl->bones;
+  if (hit && hit == bones.actor && picker->GetCellId() >= 0 &&
+      static_cast<std::size_t>(picker->GetCellId()) < bones.cellBody.size())
+    return {Pick::Kind::Body, bones.cellBody[static_cast<std::size_t>(picker->GetCellId())]};
   return {};
 }
 
 void ModelScene::setHighlight(const Pick& pick) {
   Impl& s = *m_impl;
   // restore the previous body colour, then mark the new selection
-  if (s.highlight.kind == Pick::Kind::Body) {
-    const bool isFixed = s.model.bodies.isFixed[static_cast<std::size_t>(s.highlight.index)] != 0;
-    if (isFixed)
-      s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.50, 0.49, 0.47);
-    else
-      s.bodies[static_cast<std::size_t>(s.highlight.index)]->GetProperty()->SetColor(0.93, 0.90, 0.82);
-  }
+  if (s.highlight.kind == Pick::Kind::Body) s.colourBone(s.highlight.index, s.boneColour(s.highlight.index));
   s.highlight = pick;
   if (!s.highlightActor) return;
   s.highlightActor->SetVisibility(pick.kind == Pick::Kind::Element);
-  if (pick.kind == Pick::Kind::Body)
-    s.bodies[static_cast<std::size_t>(pick.index)]->GetProperty()->SetColor(0.3, 0.95, 0.95);
+  if (pick.kind == Pick::Kind::Body) s.colourBone(pick.index, {77, 242, 242});
   if (pick.kind == Pick::Kind::Element) {
     const int e = pick.index;
     s.highlightLine->GetPoints()->SetPoint(0, s.posed.elementA(0, e), s.posed.elementA(1, e),

@@ -49,6 +49,20 @@ struct DeepGrid {
   bool isRim(int r, int c) const { return r == 0 || c == 0 || r == rows - 1 || c == cols - 1; }
 };
 
+/// The outward unit normal of the deep face (the chest wall under the lens) at grid point `i`: the cross
+/// product of the grid's tangents along its rows and columns (central differences, one-sided at the rim),
+/// turned to the side of `g.outward`. A rib's own normal (g.outward) lies in the rib's plane, which tilts
+/// about 40 deg down at the front of the lower ribs: a tie along it let the deep nodes slide into the ribs
+/// below as the ribs rose.
+Eigen::Vector3d wallNormal(const DeepGrid& g, std::size_t i) {
+  const int r = static_cast<int>(i) / g.cols, c = static_cast<int>(i) % g.cols;
+  auto p = [&](int rr, int cc) { return g.point[static_cast<std::size_t>(g.at(rr, cc))]; };
+  const Eigen::Vector3d alongRow = p(r, std::min(c + 1, g.cols - 1)) - p(r, std::max(c - 1, 0));
+  const Eigen::Vector3d alongColumn = p(std::min(r + 1, g.rows - 1), c) - p(std::max(r - 1, 0), c);
+  const Eigen::Vector3d n = alongRow.cross(alongColumn).normalized();
+  return n.dot(g.outward[i]) >= 0.0 ? n : Eigen::Vector3d(-n);
+}
+
 /// Appends the lens over `g` with largest thickness `thickness` [m] as volume body `name`: nodes, surface,
 /// springs and ties (TissueBodies.h).
 void addLens(const std::string& name, const DeepGrid& g, double thickness, const TissueGains& tg,
@@ -131,12 +145,12 @@ void addLens(const std::string& name, const DeepGrid& g, double thickness, const
     sink.add(sim::ElementGroup::Cartilage, node(e.first), node(e.second), tg.surface, 0.0);
   }
   // ties: a fixed deep node to its bone by three springs along the world axes; a sliding one by one long
-  // spring along the normal, as stiff along it as a tie
+  // spring along the chest wall's normal (wallNormal()), as stiff along it as a tie
   for (std::size_t i = 0; i < g.point.size(); ++i) {
     if (g.slides[i]) {
-      sink.add(sim::ElementGroup::Cartilage,
-               Endpoint::onBody(g.bone[i], g.point[i] - kSlideArm * g.outward[i]), node(deep[i]), tg.tie, 0.0,
-               kSlideArm / kTieArm);
+      const Eigen::Vector3d wall = wallNormal(g, i);
+      sink.add(sim::ElementGroup::Cartilage, Endpoint::onBody(g.bone[i], g.point[i] - kSlideArm * wall),
+               node(deep[i]), tg.tie, 0.0, kSlideArm / kTieArm);
       continue;
     }
     for (int k = 0; k < 3; ++k)

@@ -12,12 +12,14 @@
 /// spring supports"). The gains and thicknesses are muscle_gains.json `tissue_bodies` (TissueGains); without
 /// that block no body is built. Each deep node is tied to one bone: where the muscle takes origin by three
 /// two-sided springs along the world axes, 20 mm long (for small motions the paper's zero-length spring,
-/// stiffness k I); where it slides on the bone by one spring along the bone's normal, anchored kSlideArm
-/// (100 mm) inside it and as stiff along that line: it holds the node's distance to the bone and hardly a
-/// slide across it, as loose areolar tissue lets the pectoral slide on the chest wall. Tied rigidly all over,
-/// the pectorals coupled ribs 2-6 and the sternum, and the tension-only intercostals chattered between steps
-/// at the turn from expiration to inspiration (AffectFlow: a flow jump of 86 % of peak flow in focus). The
-/// skin lies over the bodies (they are obstacles of its registration, Skin.cpp) but is not bound to them.
+/// stiffness k I); where it slides on the bone by one spring along the chest wall's normal (the deep face's,
+/// from the grid: a rib's own in-plane normal tilts about 40 deg down at the front of ribs 4-6, and ties
+/// along it let 20-26 deep nodes sink 2-3 mm into the ribs at the end of a deep inhale), anchored kSlideArm
+/// (100 mm) inside it and as stiff along that line: it holds the node's distance to the chest wall and hardly
+/// a slide across it, as loose areolar tissue lets the pectoral slide on the chest wall. Tied rigidly all
+/// over, the pectorals coupled ribs 2-6 and the sternum, and the tension-only intercostals chattered between
+/// steps at the turn from expiration to inspiration (AffectFlow: a flow jump of 86 % of peak flow in focus).
+/// The skin lies over the bodies (they are obstacles of its registration, Skin.cpp) but is not bound to them.
 ///   - pectoral_right, pectoral_left: over ribs 2-6 anteriorly, from the sternal border (deep nodes tied to
 ///     the sternum) to a third of the way from the costochondral junction to the rib's most lateral point;
 ///     tied firmly at the sternal border and along rib 2 (the upper edge, standing in for the clavicular

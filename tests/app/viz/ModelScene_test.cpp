@@ -1,14 +1,17 @@
-// The 3D scene (viz::ModelScene) draws the posed model: after update(), each bone's actor carries its body's
-// pose [R x], and the drawn points (every actor's data through its matrix) hold every gut node, both ends of
-// every element and every cavity vertex where the state puts them, none left at rest.
+// The 3D scene (viz::ModelScene) draws the posed model: after update(), each bone's drawn points are its rest
+// points moved by its body's pose [R x], and the drawn points (every actor's data through its matrix) hold
+// every gut node, both ends of every element and every cavity vertex where the state puts them, none left at
+// rest.
 #include "viz/ModelScene.h"
 
 #include <gtest/gtest.h>
 #include <vtkActor.h>
 #include <vtkActorCollection.h>
+#include <vtkDataArray.h>
 #include <vtkDataSet.h>
 #include <vtkMapper.h>
 #include <vtkMatrix4x4.h>
+#include <vtkPointData.h>
 #include <vtkRenderer.h>
 
 #include <limits>
@@ -42,6 +45,23 @@ void drawn(vtkRenderer* renderer, std::vector<Vector3d>& points, std::vector<Eig
   }
 }
 
+// the bones' drawn points with their body (the point array "body" of the bones' one actor), world [m]
+std::vector<std::pair<int, Vector3d>> bonePoints(vtkRenderer* renderer) {
+  std::vector<std::pair<int, Vector3d>> out;
+  vtkActorCollection* actors = renderer->GetActors();
+  actors->InitTraversal();
+  while (vtkActor* actor = actors->GetNextActor()) {
+    vtkDataSet* data = actor->GetMapper() ? actor->GetMapper()->GetInput() : nullptr;
+    vtkDataArray* body = data ? data->GetPointData()->GetArray("body") : nullptr;
+    for (vtkIdType k = 0; body && k < data->GetNumberOfPoints(); ++k) {
+      double p[3];
+      data->GetPoint(k, p);
+      out.emplace_back(static_cast<int>(body->GetTuple1(k)), Vector3d(p[0], p[1], p[2]));
+    }
+  }
+  return out;
+}
+
 double nearest(const std::vector<Vector3d>& points, const Vector3d& x) {
   double best = std::numeric_limits<double>::infinity();
   for (const Vector3d& p : points) best = std::min(best, (p - x).squaredNorm());
@@ -55,23 +75,30 @@ TEST(ModelScene, ActorsAreAtThePosedPositions) {
   viz::DisplayOptions all = scene.options();
   all.showCavity = true;
   scene.setOptions(all);
+  const double tol = 1e-6;  // [m] VTK keeps points in single precision
+  const sim::State rest = sim::makeInitialState(model);
+  scene.update(rest, test::someMetrics(model, rest, 3));
+  const std::vector<std::pair<int, Vector3d>> restBones = bonePoints(scene.renderer());
   const sim::State s = test::posedState(model, 3);
   scene.update(s, test::someMetrics(model, s, 3));
 
   std::vector<Vector3d> points;
   std::vector<Eigen::Matrix4d> matrices;
   drawn(scene.renderer(), points, matrices);
-  const double tol = 1e-6;  // [m] VTK keeps points in single precision
 
-  // each bone is drawn with its body's pose
-  for (int b = 0; b < model.bodies.size(); ++b) {
-    Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
-    pose.topLeftCorner<3, 3>() = s.bodyOrientation[static_cast<std::size_t>(b)].toRotationMatrix();
-    pose.topRightCorner<3, 1>() = s.bodyPosition.col(b);
-    double best = std::numeric_limits<double>::infinity();
-    for (const Eigen::Matrix4d& m : matrices) best = std::min(best, (m - pose).norm());
-    EXPECT_LT(best, 1e-12) << "body " << b;
+  // each bone is drawn at its body's pose: x = R (x_rest - c_rest) + c, every point of every body
+  const std::vector<std::pair<int, Vector3d>> posedBones = bonePoints(scene.renderer());
+  ASSERT_EQ(posedBones.size(), restBones.size());
+  std::vector<int> pointsOf(static_cast<std::size_t>(model.bodies.size()), 0);
+  for (std::size_t k = 0; k < posedBones.size(); ++k) {
+    const int b = posedBones[k].first;
+    ASSERT_EQ(b, restBones[k].first);
+    const Eigen::Matrix3d R = s.bodyOrientation[static_cast<std::size_t>(b)].toRotationMatrix();
+    const Vector3d expected = R * (restBones[k].second - model.bodies.com.col(b)) + s.bodyPosition.col(b);
+    EXPECT_LT((posedBones[k].second - expected).norm(), tol) << "body " << b << " point " << k;
+    ++pointsOf[static_cast<std::size_t>(b)];
   }
+  for (int b = 0; b < model.bodies.size(); ++b) EXPECT_GT(pointsOf[static_cast<std::size_t>(b)], 0) << b;
   // gut nodes, element ends and cavity vertices where the state puts them
   for (int i = 0; i < model.nodes.size(); ++i)
     EXPECT_LT(nearest(points, s.nodePosition.col(i)), tol) << "node " << i;
