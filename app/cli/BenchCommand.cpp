@@ -61,6 +61,7 @@ sim::Model thinned(const sim::Model& model, int stride) {
   el.kac.resize(el.restLength.size());
   el.kpe.resize(el.restLength.size());
   el.damping.resize(el.restLength.size());
+  if (src.recruitment.size() > 0) el.recruitment.resize(el.restLength.size());
   for (std::size_t k = 0; k < keep.size(); ++k) {
     const int e = keep[k];
     const auto i = static_cast<Eigen::Index>(k);
@@ -69,6 +70,7 @@ sim::Model thinned(const sim::Model& model, int stride) {
     el.kac(i) = src.kac(e);
     el.kpe(i) = src.kpe(e);
     el.damping(i) = src.damping(e);
+    if (src.recruitment.size() > 0) el.recruitment(i) = src.recruitment(e);
   }
   el.endA = subset(src.endA, keep);
   el.endB = subset(src.endB, keep);

@@ -145,7 +145,7 @@ Gains readGains(const Reader& r) {
   r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s",
                "abdominal_wall_tone_upright", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
                "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
-               "diaphragm_mass_kg", "joints", "shoulder_springs", "tissue_bodies"});
+               "diaphragm_mass_kg", "joints", "shoulder_springs", "accessory_muscles", "tissue_bodies"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -198,6 +198,13 @@ Gains readGains(const Reader& r) {
   shoulder.allowKeys({"kpe", "b"});
   g.shoulder.kpe = shoulder.at("kpe").numberIn(0.0, 1e9);
   g.shoulder.damping = shoulder.at("b").numberIn(0.0, 1e9);
+  // optional: the accessory muscles are passive shoulder springs when absent
+  if (r.has("accessory_muscles")) {
+    const Reader acc = r.at("accessory_muscles");
+    acc.allowKeys({"description", "kac", "recruitment"});
+    g.accessory.kac = acc.at("kac").numberIn(0.0, 1e9);
+    g.accessory.recruitment = acc.at("recruitment").numberIn(0.0, 0.99);
+  }
   // optional: no tissue bodies when absent
   if (r.has("tissue_bodies")) {
     const Reader t = r.at("tissue_bodies");

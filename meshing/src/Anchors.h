@@ -43,9 +43,10 @@ class ElementSink {
            double stiffness = 1.0) {
     add(group, a, b, m_gains.group[static_cast<std::size_t>(group)], active, stiffness);
   }
-  /// Adds one element of `group` with the gains `g` (at the reference length) instead of the group's.
+  /// Adds one element of `group` with the gains `g` (at the reference length) instead of the group's;
+  /// `recruitment` [-] is its recruitment threshold c0 (sim::Elements::recruitment; 0: an ordinary element).
   void add(sim::ElementGroup group, const Endpoint& a, const Endpoint& b, const GroupGains& g,
-           double active = 1.0, double stiffness = 1.0) {
+           double active = 1.0, double stiffness = 1.0, double recruitment = 0.0) {
     const double l0 = (a.world - b.world).norm();
     if (!(l0 > 1e-4)) throw sim::Error(std::string(sim::groupName(group)) + " element: zero rest length");
     sim::Elements& e = m_model.elements;
@@ -59,6 +60,13 @@ class ElementSink {
     e.kac(n - 1) = active * g.kac * scale;
     e.kpe(n - 1) = stiffness * g.kpe * scale;
     e.damping(n - 1) = stiffness * g.damping * scale;
+    // the thresholds are stored once one element has one (the elements before it: 0)
+    if (recruitment > 0.0 || e.recruitment.size() > 0) {
+      const Eigen::Index before = e.recruitment.size();
+      e.recruitment.conservativeResize(n);
+      e.recruitment.tail(n - before).setZero();
+      e.recruitment(n - 1) = recruitment;
+    }
   }
 
  private:

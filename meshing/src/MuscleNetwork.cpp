@@ -328,12 +328,16 @@ void addScalenes(const Skeleton& sk, ElementSink& sink) {
 ///    rib 1 (the model without the girdle) give -0.73 mm but leave the skin at the base of the neck. On the
 ///    back half of rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale;
 ///  - sternocleidomastoid: from the mastoid process to the manubrium (sternal head) and the medial clavicle
-///    (clavicular head), passive at the shoulder gains;
+///    (clavicular head);
 ///  - Breathe Easy's 26 shoulder elements (Zordan et al. 2004, Table 1: 52 in all), passive at the shoulder
 ///    gains (kpe 10, b 1): upper (3), middle (2) and lower (2) trapezius, levator scapulae (2), rhomboids
 ///    (3), serratus anterior (5), pectoralis minor (3) and major (3), subclavius (1) and deltoid (2).
-/// Two-sided springs of the cartilage group: the element groups are the respiratory muscles the breath styles
-/// drive, and none of these is driven.
+/// Two-sided springs of the cartilage group, except the accessory inspiratory muscles (the
+/// sternocleidomastoids and the upper trapezius: 5 per side): muscles of the external intercostal group (the
+/// rib cage's inspiratory drive) with the shoulder gains' kpe and b, muscle_gains.json's `accessory_muscles`
+/// kac and a recruitment threshold above calm demand (sim::recruitedActivation()), so that a deep breath
+/// lifts the shoulders and a calm one barely (Hudson, Gandevia & Butler 2007, J Physiol 584:261; Raper et al.
+/// 1966, J Appl Physiol 21:497).
 void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
   if (!sk.hasGirdle) return;
   const GroupGains& shoulder = a.gains.shoulder;
@@ -375,6 +379,14 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
     auto spring = [&](const Endpoint& p, const Endpoint& q) {
       sink.add(ElementGroup::Cartilage, p, q, shoulder, 0.0);
     };
+    // an accessory inspiratory muscle: the shoulder springs' passive gains, driven with the external
+    // intercostals above its recruitment threshold (passive springs when muscle_gains.json has no
+    // accessory_muscles block)
+    auto accessory = [&](const Endpoint& p, const Endpoint& q) {
+      if (!(a.gains.accessory.kac > 0.0)) return spring(p, q);
+      const GroupGains g{a.gains.accessory.kac, shoulder.kpe, shoulder.damping};
+      sink.add(ElementGroup::IntercostalExternal, p, q, g, 1.0, 1.0, a.gains.accessory.recruitment);
+    };
 
     // scalenes, each in its rib point's sagittal plane, and sternocleidomastoid
     for (double f : {0.8, 0.88, 0.96}) {
@@ -385,15 +397,15 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
                rib);
     }
     const Endpoint mastoid = Endpoint::onBody(sk.head, s.mastoid);
-    spring(mastoid, Endpoint::onBody(sk.sternum, sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) +
-                                                     0.01 * sk.sternumAxis));
-    spring(mastoid, clavicle(0.08));
+    accessory(mastoid, Endpoint::onBody(sk.sternum, sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) +
+                                                        0.01 * sk.sternumAxis));
+    accessory(mastoid, clavicle(0.08));
 
-    // trapezius: upper from the neck to the clavicle and acromion, middle and lower from T1-T7 to the
-    // scapular spine
-    spring(cervical(2, 0.0), clavicle(0.75));
-    spring(cervical(4, 0.0), scapula(s.acromion));
-    spring(cervical(7, 0.0), superiorBorder(0.8));
+    // trapezius: upper (accessory) from the neck to the clavicle and acromion, middle and lower from T1-T7
+    // to the scapular spine
+    accessory(cervical(2, 0.0), clavicle(0.75));
+    accessory(cervical(4, 0.0), scapula(s.acromion));
+    accessory(cervical(7, 0.0), superiorBorder(0.8));
     spring(spinous(1), superiorBorder(0.3));
     spring(spinous(3), superiorBorder(0.5));
     spring(spinous(5), scapula(s.spineRoot));

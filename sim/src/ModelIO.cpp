@@ -468,7 +468,8 @@ void validateModel(const Model& m) {
   // elements
   const int nE = m.elements.size();
   if (m.elements.endA.size() != nE || m.elements.endB.size() != nE || m.elements.restLength.size() != nE ||
-      m.elements.kac.size() != nE || m.elements.kpe.size() != nE || m.elements.damping.size() != nE)
+      m.elements.kac.size() != nE || m.elements.kpe.size() != nE || m.elements.damping.size() != nE ||
+      (m.elements.recruitment.size() != 0 && m.elements.recruitment.size() != nE))
     invalid("elements", "inconsistent array sizes");
   validateAnchors(m.elements.endA, "elements.a", nB, nN);
   validateAnchors(m.elements.endB, "elements.b", nB, nN);
@@ -482,6 +483,10 @@ void validateModel(const Model& m) {
     requireNonNegative(m.elements.kac[i], f + ".kac");
     requireNonNegative(m.elements.kpe[i], f + ".kpe");
     requireNonNegative(m.elements.damping[i], f + ".damping");
+    const double c0 = m.elements.recruitmentOf(i);
+    if (!(c0 >= 0.0 && c0 < 1.0)) invalid(f + ".recruitment", "must be in [0, 1), got " + num(c0));
+    if (c0 > 0.0 && !isMuscleGroup(m.elements.group[static_cast<std::size_t>(i)]))
+      invalid(f + ".recruitment", "only a muscle is recruited; a cartilage spring is passive");
   }
   if (m.elements.kpe.maxCoeff() <= 0.0)
     invalid("elements.kpe",
@@ -684,7 +689,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     v->resize(static_cast<Eigen::Index>(nE));
   for (std::size_t i = 0; i < nE; ++i) {
     const Reader e = elements[i];
-    e.allowKeys({"group", "a", "b", "rest_length", "kac", "kpe", "damping"});
+    e.allowKeys({"group", "a", "b", "rest_length", "kac", "kpe", "damping", "recruitment"});
     const auto k = static_cast<Eigen::Index>(i);
     ElementGroup g;
     const std::string group = e.at("group").string();
@@ -696,6 +701,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     m.elements.kac[k] = e.at("kac").number();
     m.elements.kpe[k] = e.at("kpe").number();
     m.elements.damping[k] = e.at("damping").number();
+    // optional: an ordinary element (threshold 0) when absent
+    if (e.has("recruitment")) {
+      if (m.elements.recruitment.size() == 0) m.elements.recruitment.setZero(static_cast<Eigen::Index>(nE));
+      m.elements.recruitment[k] = e.at("recruitment").number();
+    }
   }
 
   // cavity
@@ -833,6 +843,7 @@ std::string serializeModel(const Model& m) {
                         {"kac", m.elements.kac[i]},
                         {"kpe", m.elements.kpe[i]},
                         {"damping", m.elements.damping[i]}});
+    if (m.elements.recruitmentOf(i) > 0.0) elements.back()["recruitment"] = m.elements.recruitment[i];
   }
   doc["elements"] = std::move(elements);
 

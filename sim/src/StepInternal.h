@@ -28,8 +28,8 @@ inline double effectiveDrag(const Model& model, const StepOptions& o) {
   return model.gut.drag * o.gutDragScale;
 }
 
-// muscle parameters of element e under the group's activation and gain scales (and its half's, for the
-// diaphragm)
+// muscle parameters of element e under the group's activation (above its recruitment threshold, if any) and
+// gain scales (and its half's, for the diaphragm)
 inline MuscleParams muscleParams(const Model& model, const StepConstants& c, int e, const Activations& act,
                                  const StepOptions& o) {
   const int g = static_cast<int>(model.elements.group[at(e)]);
@@ -39,7 +39,9 @@ inline MuscleParams muscleParams(const Model& model, const StepConstants& c, int
   p.kac = model.elements.kac(e) * o.activeGainScale[at(g)] * hemidiaphragmScale(model, c, e, o);
   p.kpe = model.elements.kpe(e) * o.passiveGainScale[at(g)];
   p.damping = model.elements.damping(e) * o.passiveGainScale[at(g)];
-  p.alpha = ga.alpha;
+  // an accessory muscle takes the part of its group's drive above its recruitment threshold
+  const double c0 = model.elements.recruitmentOf(e);
+  p.alpha = c0 > 0.0 ? recruitedActivation(ga.alpha, ga.r, c0) : ga.alpha;
   p.r = ga.r;
   return p;
 }

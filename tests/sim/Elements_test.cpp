@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 
 #include "ToyTorso.h"
@@ -54,6 +55,30 @@ TEST(MuscleLaw, Damping) {
   EXPECT_DOUBLE_EQ(muscleForce(l, -1.0, p), elastic + 2.0);  // shortening: less tension
   EXPECT_DOUBLE_EQ(muscleForce(l, 1.0, p), elastic - 2.0);   // lengthening: more tension
   EXPECT_EQ(muscleForce(l, -100.0, p), 0.0);                 // never pushes
+}
+
+// an accessory muscle recruited above a threshold c0 of its group's command c = alpha (1 - r): silent up to
+// it, then its active tension at rest length is kac l0 (c - c0), never more than the group's
+TEST(MuscleLaw, RecruitmentThreshold) {
+  const double l0 = 0.1, c0 = 0.2;
+  // calm's external intercostal command peaks at 0.16 (r 0.84, alpha 1): below the threshold, no activation
+  EXPECT_EQ(recruitedActivation(1.0, 0.84, c0), 0.0);
+  EXPECT_EQ(recruitedActivation(0.4, 0.6, c0), 0.0);  // deep's at 40 % drive: c = 0.16
+  // deep's at full drive: c = 0.4, half of it above the threshold
+  const double a = recruitedActivation(1.0, 0.6, c0);
+  EXPECT_DOUBLE_EQ(a, 0.5);
+  EXPECT_DOUBLE_EQ(-muscleForce(l0, 0.0, params(a, 0.6)), 400.0 * l0 * (0.4 - c0));
+  // continuous in the drive, never above the group's activation, and silent for a lengthening command
+  for (double alpha = 0.0; alpha <= 1.0; alpha += 0.05) {
+    const double e = recruitedActivation(alpha, 0.6, c0);
+    EXPECT_GE(e, 0.0);
+    EXPECT_LE(e, alpha);
+    EXPECT_NEAR(e, std::max(0.0, alpha - c0 / 0.4), 1e-12);
+  }
+  EXPECT_EQ(recruitedActivation(1.0, 1.0, c0), 0.0);
+  EXPECT_EQ(recruitedActivation(1.0, 1.2, c0), 0.0);
+  // no threshold: the group's activation
+  EXPECT_DOUBLE_EQ(recruitedActivation(0.7, 0.8, 0.0), 0.7);
 }
 
 // structural springs are two-sided and damped

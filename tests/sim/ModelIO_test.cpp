@@ -221,6 +221,30 @@ TEST(ModelIO, ModelWithoutWallToneLoadsWithNone) {
   EXPECT_DOUBLE_EQ(parseModel(j.dump()).gut.wallToneUpright, 0.0);
 }
 
+// a recruitment threshold (sim::Elements::recruitment) is written only for an element that has one: a model
+// without any reads back without the array and writes no key; a bad value or a recruited spring is named
+TEST(ModelIO, RecruitmentIsOptionalAndChecked) {
+  const std::string plain = serializeModel(tinyModel());
+  EXPECT_EQ(plain.find("recruitment"), std::string::npos);
+  EXPECT_EQ(parseModel(plain).elements.recruitment.size(), 0);
+  Model m = tinyModel();
+  m.elements.recruitment = Eigen::VectorXd::Constant(1, 0.2);
+  const std::string text = serializeModel(m);
+  const Model back = parseModel(text);
+  ASSERT_EQ(back.elements.recruitment.size(), 1);
+  EXPECT_EQ(back.elements.recruitment(0), 0.2);
+  EXPECT_EQ(serializeModel(back), text);
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["elements"][0]["recruitment"] = 1.0; }),
+            "model.json: elements[0].recruitment: must be in [0, 1), got 1");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) { j["elements"][0]["recruitment"] = -0.1; }),
+            "model.json: elements[0].recruitment: must be in [0, 1), got -0.1");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& j) {
+              j["elements"][0]["group"] = "cartilage";
+              j["elements"][0]["recruitment"] = 0.2;
+            }),
+            "model.json: elements[0].recruitment: only a muscle is recruited; a cartilage spring is passive");
+}
+
 TEST(ModelIO, RejectsTruncatedJson) {
   const std::string text = serializeModel(tinyModel());
   try {

@@ -106,6 +106,14 @@ struct GroupGains {
   double damping = 0.0;  ///< [N s/m] at the reference length
 };
 
+/// The neck's accessory inspiratory muscles with the shoulder girdle (muscle_gains.json `accessory_muscles`):
+/// the sternocleidomastoids and the upper trapezius, recruited above calm demand
+/// (sim::recruitedActivation()).
+struct AccessoryGains {
+  double kac = 0.0;          ///< [N/m] active gain at the reference length (0: passive, as without the block)
+  double recruitment = 0.0;  ///< [-] recruitment threshold c0 on the external intercostals' command, [0, 1)
+};
+
 /// Gains of one kind of joint (muscle_gains.json `joints.<kind>`; sim::Joints has the law).
 struct JointGains {
   double friction = 0.0;       ///< [N m s/rad] mu of Eq. 3
@@ -168,6 +176,7 @@ struct Gains {
   /// length: Zordan et al. 2004, Table 1, the 52 shoulder elements (kpe 10, b 1), and the
   /// sternocleidomastoids
   GroupGains shoulder{};
+  AccessoryGains accessory{};  ///< the sternocleidomastoids' and upper trapezius' drive
   TissueGains tissue{};        ///< the pectoral and shoulder volume bodies
   double wallMass = 0.0;       ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
   double diaphragmMass = 0.0;  ///< [kg] total mass of the diaphragm dome nodes

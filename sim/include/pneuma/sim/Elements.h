@@ -29,6 +29,21 @@ inline double muscleForce(double l, double ldot, const MuscleParams& p) {
   return std::min(elastic - p.damping * ldot, 0.0);
 }
 
+/// [-] activation of a muscle recruited above a threshold of its group's drive. The group's command is its
+/// active tension at rest length per kac l0, c = alpha (1 - r) (Eq. 2 at l = l0); the element takes the
+/// command left above its threshold c0 at the group's r:
+///   alpha_e = max(0, alpha (1 - r) - c0) / (1 - r)  for r < 1,  0 for r >= 1 (a lengthening command),
+/// so that alpha_e kac (1 - r) l0 = kac l0 max(0, c - c0) and alpha_e <= alpha. Motor units are recruited in
+/// order of size as the drive grows, and a muscle with a small mechanical advantage is recruited late: the
+/// scalenes fire in every quiet breath, the sternocleidomastoids only at larger efforts (Hudson, Gandevia &
+/// Butler 2007, J Physiol 584:261; Raper et al. 1966, J Appl Physiol 21:497; De Troyer & Estenne 1984, J
+/// Appl Physiol 57:899). @param alpha the group's activation [-] in [0, 1], @param r its contraction ratio
+/// [-], @param c0 the element's threshold [-] in [0, 1).
+inline double recruitedActivation(double alpha, double r, double c0) {
+  if (r >= 1.0) return 0.0;
+  return std::max(0.0, alpha * (1.0 - r) - c0) / (1.0 - r);
+}
+
 /// Slack length [m] of a muscle: the length at which its elastic part, -alpha kac (l - r l0) - kpe (l - l0),
 /// is zero: l_s = (alpha kac r + kpe) l0 / (alpha kac + kpe); l0 when alpha kac + kpe = 0.
 inline double muscleSlackLength(const MuscleParams& p) {

@@ -167,8 +167,16 @@ struct Elements {
   Eigen::VectorXd kac;              ///< [N/m] active gain      (#E)
   Eigen::VectorXd kpe;              ///< [N/m] passive gain     (#E)
   Eigen::VectorXd damping;          ///< [N s/m] b              (#E)
+  /// [-] recruitment threshold c0 in [0, 1) of a muscle recruited only above a level of its group's drive
+  /// (#E, or empty: none; 0 = an ordinary element). The group's command is its active tension at rest length
+  /// per kac l0, c = alpha (1 - r); a recruited element works at the command left above its threshold, max(0,
+  /// c - c0) (recruitedActivation(), Elements.h). The shoulder girdle's accessory inspiratory muscles use it
+  /// (docs/model-format.md).
+  Eigen::VectorXd recruitment;
 
   int size() const { return static_cast<int>(group.size()); }
+  /// [-] recruitment threshold c0 of element `e` (0 when the model has none).
+  double recruitmentOf(int e) const { return recruitment.size() == 0 ? 0.0 : recruitment(e); }
 };
 
 /// True for an apposition spring: a Cartilage element between a gut node (the dome in the zone of apposition)
