@@ -12,14 +12,17 @@
 /// Control law, every step, in volume-fraction units (a demand is a fraction change from rest):
 ///   d   = (v_T - v_rest) + K_p e + I,  dI/dt = K_i e     static feed-forward plus PI feedback on
 ///                                                      e = v_T - v_M (v_M measured at each frame)
-///   D(tau_in, tau_out) = max(d + tau_in dv_T/dt, 0) + min(d + tau_out dv_T/dt, 0)
+///   D(tau_in, tau_out) = m(d + tau_in dv_T/dt) - m(-(d + tau_out dv_T/dt)),   m(x) = max(x, 0) with its
+///                        corner rounded over |x| < w/2 by (x + w/2)^2 / (2 w), w = 0.006 (15 mL)
 ///   d_c = b D(tau_c,in, tau_c,out)                      chest channel (intercostals)
 ///   d_a = (1 - b) D(tau_a,in, tau_a,out)                belly channel (diaphragm, abdominal wall)
 /// with b the thoraco-abdominal balance [-], dv_T/dt [1/s] the target's rate (backward difference over
 /// the last step) and tau [s] the identified lags (DriveCalibration::timeConstant) of the channel's raising
 /// (in) and lowering (out) lever: the tau term inverts a first-order lag (tau dV/dt + V = u  =>  u = V +
 /// tau dV/dt). D is continuous in d and the rate, so the demand does not jump when the rate changes sign
-/// between two levers of different lag (docs/patterns.md, "Control law"). The rib friction
+/// between two levers of different lag, and so is its slope, so the flow does not jump where one lever's lag
+/// term sets in: the chest follows its activation within a step (docs/patterns.md, "Control law"). The rib
+/// friction
 /// makes the intercostals lag their activation by about 0.2 s on the default model; without the term
 /// the chest falls behind fast breathing and stays above the trough, waiting for the ribs' slow passive
 /// release. d_c > 0 drives the external intercostals, d_c < 0 the internal intercostals; d_a > 0 the
