@@ -16,7 +16,6 @@
 #include <vtkIdList.h>
 #include <vtkIntArray.h>
 #include <vtkLookupTable.h>
-#include <vtkMatrix4x4.h>
 #include <vtkOpenGLPolyDataMapper.h>
 #include <vtkOpenGLVertexBufferObject.h>
 #include <vtkOrientationMarkerWidget.h>

@@ -24,8 +24,8 @@ namespace {
 
 using Eigen::Vector3d;
 
-// the points of every actor's data in world coordinates, and the actors' matrices
-void drawn(vtkRenderer* renderer, std::vector<Vector3d>& points, std::vector<Eigen::Matrix4d>& matrices) {
+// the points of every actor's data in world coordinates (through the actor's matrix)
+void drawn(vtkRenderer* renderer, std::vector<Vector3d>& points) {
   vtkActorCollection* actors = renderer->GetActors();
   actors->InitTraversal();
   while (vtkActor* actor = actors->GetNextActor()) {
@@ -36,7 +36,6 @@ void drawn(vtkRenderer* renderer, std::vector<Vector3d>& points, std::vector<Eig
     Eigen::Matrix4d m;
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j) m(i, j) = actor->GetMatrix()->GetElement(i, j);
-    matrices.push_back(m);
     for (vtkIdType k = 0; data && k < data->GetNumberOfPoints(); ++k) {
       double p[3];
       data->GetPoint(k, p);
@@ -83,8 +82,7 @@ TEST(ModelScene, ActorsAreAtThePosedPositions) {
   scene.update(s, test::someMetrics(model, s, 3));
 
   std::vector<Vector3d> points;
-  std::vector<Eigen::Matrix4d> matrices;
-  drawn(scene.renderer(), points, matrices);
+  drawn(scene.renderer(), points);
 
   // each bone is drawn at its body's pose: x = R (x_rest - c_rest) + c, every point of every body
   const std::vector<std::pair<int, Vector3d>> posedBones = bonePoints(scene.renderer());
