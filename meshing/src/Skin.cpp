@@ -677,9 +677,7 @@ Obstacles obstaclesOf(const BuiltModel& built) {
     surfaces.rightCols(t.cols()) = t;
   }
   const Eigen::Matrix3Xd n = vertexNormals(m.nodes.rest, surfaces);
-  std::vector<char> isTied(static_cast<std::size_t>(m.nodes.size()), 0);
-  for (int e = 0; e < m.elements.size(); ++e)
-    if (sim::isApposition(m.elements, e)) isTied[static_cast<std::size_t>(sim::tiedNode(m.elements, e))] = 1;
+  const std::vector<char> isTied = sim::tiedNodes(m);
   for (int i = 0; i < m.nodes.size(); ++i) {
     const bool isTissue = m.nodes.region[static_cast<std::size_t>(i)] == sim::NodeRegion::Tissue;
     if (isTissue && isTied[static_cast<std::size_t>(i)]) continue;

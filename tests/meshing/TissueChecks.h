@@ -37,9 +37,7 @@ inline void expectBetweenBonesAndSkin(const meshing::BuiltModel& b, const std::s
   ASSERT_GT(m.skin.vertexCount(), 0);
   Eigen::Matrix3Xd skin;
   sim::skinPositions(m.skin, meshing::restPoints(m.skin.anchors, m), skin);
-  std::vector<char> isTied(static_cast<std::size_t>(m.nodes.size()), 0);
-  for (int e = 0; e < m.elements.size(); ++e)
-    if (sim::isApposition(m.elements, e)) isTied[static_cast<std::size_t>(sim::tiedNode(m.elements, e))] = 1;
+  const std::vector<char> isTied = sim::tiedNodes(m);
   const Eigen::Matrix3Xi& t = m.volumes.triangles[static_cast<std::size_t>(k)];
   const double volume = sim::enclosedVolume(m.nodes.rest, t);
   ::testing::Test::RecordProperty(name + "_volume_mL", std::to_string(volume * 1e6));

@@ -6,6 +6,7 @@
 /// of the body held on its bone (VolumeBodies). The body end of either lies off the bone's surface.
 
 #include <cstddef>
+#include <vector>
 
 #include "pneuma/sim/Model.h"
 
@@ -14,6 +15,14 @@ namespace pneuma::sim {
 /// The node of tie `i` (isApposition(e, i) true).
 inline int tiedNode(const Elements& e, int i) {
   return e.endA.body[static_cast<std::size_t>(i)] < 0 ? e.endA.nodes(0, i) : e.endB.nodes(0, i);
+}
+
+/// Per node (#N): 1 when a tie holds it (a dome node in the zone of apposition, a volume body's deep node).
+inline std::vector<char> tiedNodes(const Model& m) {
+  std::vector<char> tied(static_cast<std::size_t>(m.nodes.size()), 0);
+  for (int e = 0; e < m.elements.size(); ++e)
+    if (isApposition(m.elements, e)) tied[static_cast<std::size_t>(tiedNode(m.elements, e))] = 1;
+  return tied;
 }
 
 /// True for an apposition spring proper: a tie whose node is the gut's, not a volume body's
