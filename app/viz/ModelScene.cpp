@@ -493,8 +493,19 @@ struct ModelScene::Impl {
     return actor;
   }
 
-  // a smooth-shaded surface of `data` coloured through `table` by one float scalar per point (`scalar`, zero
-  // at first); its point normals are computed from its triangles at every setPoints() (setNormals())
+  // a smooth-shaded actor of `data`: its point normals, zero at first, are computed from its triangles at
+  // every update (setNormals())
+  static vtkSmartPointer<vtkActor> smoothActor(vtkPolyData* data) {
+    vtkNew<vtkFloatArray> normals;
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(data->GetNumberOfPoints());
+    normals->Fill(0.0f);
+    data->GetPointData()->SetNormals(normals);
+    return actorFor(data);
+  }
+
+  // a smooth-shaded surface of `data` (smoothActor()) coloured through `table` by one float scalar per point
+  // (`scalar`, zero at first)
   static vtkSmartPointer<vtkActor> scalarSurfaceActor(vtkPolyData* data,
                                                       vtkSmartPointer<vtkFloatArray>& scalar,
                                                       vtkLookupTable* table) {
@@ -502,12 +513,7 @@ struct ModelScene::Impl {
     scalar->SetNumberOfValues(data->GetNumberOfPoints());
     scalar->Fill(0.0f);
     data->GetPointData()->SetScalars(scalar);
-    vtkNew<vtkFloatArray> normals;
-    normals->SetNumberOfComponents(3);
-    normals->SetNumberOfTuples(data->GetNumberOfPoints());
-    normals->Fill(0.0f);
-    data->GetPointData()->SetNormals(normals);
-    auto actor = actorFor(data);
+    auto actor = smoothActor(data);
     actor->GetMapper()->SetLookupTable(table);
     actor->GetMapper()->UseLookupTableScalarRangeOn();
     actor->PickableOff();
@@ -639,12 +645,7 @@ struct ModelScene::Impl {
         count += t.cols();
       }
       tissue = surface(model.nodes.size(), tissueTriangles);
-      vtkNew<vtkFloatArray> normals;  // smooth shading: setNormals() at every update
-      normals->SetNumberOfComponents(3);
-      normals->SetNumberOfTuples(tissue->GetNumberOfPoints());
-      normals->Fill(0.0f);
-      tissue->GetPointData()->SetNormals(normals);
-      tissueActor = actorFor(tissue);
+      tissueActor = smoothActor(tissue);
       tissueActor->GetProperty()->SetColor(0.74, 0.33, 0.31);
       tissueActor->PickableOff();
     }

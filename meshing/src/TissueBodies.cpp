@@ -24,7 +24,7 @@ constexpr double kTieArm = 0.02;    // [m] length of a deep node's three tie spr
 // the node's distance to the bone and hardly a slide along it (a slide s lengthens it by about s^2 / 2 l)
 constexpr double kSlideArm = 0.1;
 constexpr double kProfilePower = 0.6;  // [-] fullness of the thickness profile sin^p (1: a plain sine)
-constexpr int kPectoralColumns = 7;    // [-] sternal border, costochondral junction, then five along the rib
+constexpr int kPectoralColumns = 5;    // [-] sternal border, costochondral junction, then three along the rib
 // [-] the pectoral's lateral edge: this share of the way from the costochondral junction back to the rib's
 // most lateral point (about the anterior axillary line)
 constexpr double kPectoralLateralShare = 0.35;
@@ -160,13 +160,13 @@ void addLens(const std::string& name, const DeepGrid& g, double thickness, const
   }
 }
 
-/// The deep face of the pectoral on `side`: rows at ribs 2-6 and midway between them, columns from the
+/// The deep face of the pectoral on `side`: a row at each of ribs 2-6, columns from the
 /// sternal border (tied to the sternum) over the costochondral junction along the rib (tied to it).
 DeepGrid pectoralGrid(const AnatomyParams& a, const Skeleton& sk, int side) {
   constexpr int kFirstRib = 2, kLastRib = 6;
   const int levels = kLastRib - kFirstRib + 1;
   DeepGrid g;
-  g.rows = 2 * levels - 1;
+  g.rows = levels;
   g.cols = kPectoralColumns;
   g.point.resize(static_cast<std::size_t>(g.rows * g.cols));
   g.bone.resize(g.point.size());
@@ -183,7 +183,7 @@ DeepGrid pectoralGrid(const AnatomyParams& a, const Skeleton& sk, int side) {
     for (std::size_t i = 0; i < rib.centre.size(); ++i)
       if (std::abs(rib.centre[i].x()) > std::abs(rib.centre[lateral].x())) lateral = i;
     const double sEnd = rib.arc[lateral] + kPectoralLateralShare * (rib.length() - rib.arc[lateral]);
-    const int r = 2 * l;
+    const int r = l;
     const int i0 = g.at(r, 0);
     g.point[static_cast<std::size_t>(i0)] =
         sk.costalNotch[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)] +
@@ -200,16 +200,6 @@ DeepGrid pectoralGrid(const AnatomyParams& a, const Skeleton& sk, int side) {
       g.outward[static_cast<std::size_t>(i)] = -inward;
     }
   }
-  // the rows between the ribs: midway, tied to the rib (or the sternum) above
-  for (int r = 1; r < g.rows; r += 2)
-    for (int c = 0; c < g.cols; ++c) {
-      const std::size_t i = static_cast<std::size_t>(g.at(r, c)),
-                        a = static_cast<std::size_t>(g.at(r - 1, c)),
-                        b = static_cast<std::size_t>(g.at(r + 1, c));
-      g.point[i] = 0.5 * (g.point[a] + g.point[b]);
-      g.bone[i] = g.bone[a];
-      g.outward[i] = (g.outward[a] + g.outward[b]).normalized();
-    }
   return g;
 }
 

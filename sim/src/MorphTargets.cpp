@@ -13,6 +13,7 @@
 #include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/Scenario.h"
 #include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/Ties.h"
 #include "pneuma/sim/pattern/PatternController.h"
 
 namespace pneuma::sim {
@@ -214,7 +215,7 @@ Eigen::Matrix3Xd boneTips(const Model& model) {
   };
   const Elements& e = model.elements;
   for (int i = 0; i < e.size(); ++i) {
-    if (isApposition(e, i)) continue;
+    if (isTie(e, i)) continue;
     const auto k = static_cast<std::size_t>(i);
     consider(e.endA.body[k], e.endA.local.col(i));
     consider(e.endB.body[k], e.endB.local.col(i));

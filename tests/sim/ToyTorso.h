@@ -378,11 +378,12 @@ inline State randomVelocityState(const Model& m, double nodeSpeed, double spin, 
   State s = makeInitialState(m);
   std::mt19937 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
-  for (int i = 0; i < m.nodes.size(); ++i)
-    if (!m.nodes.isFixed(i)) s.nodeVelocity.col(i) = nodeSpeed * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  // the spins first: they do not change with the model's node count
   for (int b = 0; b < m.bodies.size(); ++b)
     if (!m.bodies.isFixed[static_cast<std::size_t>(b)])
       s.bodyAngularVelocity.col(b) = spin * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  for (int i = 0; i < m.nodes.size(); ++i)
+    if (!m.nodes.isFixed(i)) s.nodeVelocity.col(i) = nodeSpeed * Eigen::Vector3d(n(rng), n(rng), n(rng));
   return s;
 }
 

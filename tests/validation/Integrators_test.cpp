@@ -70,7 +70,10 @@ TEST(SymplecticEuler, UndrivenDefaultModelDoesNotGainEnergy) {
 // relaxed, no gravity, random spins of every moving body about the relaxed equilibrium, with the linear
 // velocities the joints imply: total energy must not grow (Eq. 3 is dissipative). Not from the rest pose:
 // there the lungs' recoil P0 is a sudden load, whose first linearly implicit step lands muscles that were
-// slack in the linearisation taut
+// slack in the linearisation taut. At a quarter of the default step: at 1/60 s the first step from such a
+// start (0.5 rad/s on every bone in a random direction, the nodes still) gains 0.65-4.3 times the spins'
+// kinetic energy in 7 of 8 draws, with the friction at 1x or 10x alike, and none of 8 at dt / 4: the error of
+// one large linearly implicit step, not the friction this test is about (docs/integrator.md)
 class StrongRibFriction : public ::testing::TestWithParam<bool> {};
 
 TEST_P(StrongRibFriction, OnlyDissipates) {
@@ -84,7 +87,7 @@ TEST_P(StrongRibFriction, OnlyDissipates) {
   o.integrator = IntegratorKind::ImplicitEulerJoints;
   o.gravity = false;
   o.jointFrictionScale = 10.0;  // 150 N m s/rad at the rib-spine joints, 10x the calibrated mu
-  const double dt = defaultTimeStep(o.integrator);
+  const double dt = 0.25 * defaultTimeStep(o.integrator);
   State start = test::randomVelocityState(m, 0.0, 0.5);
   double rest = 0.0;  // [J] energy of the equilibrium
   {

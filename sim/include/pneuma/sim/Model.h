@@ -179,15 +179,6 @@ struct Elements {
   double recruitmentOf(int e) const { return recruitment.size() == 0 ? 0.0 : recruitment(e); }
 };
 
-/// True for an apposition spring: a Cartilage element between a gut node (the dome in the zone of apposition)
-/// and a rib. It stands for the pleural fluid that holds the dome on the rib cage while letting it slide, so
-/// its rib end is anchored well beyond the rib face on the line from the node (docs/model-format.md): views
-/// draw no line for it.
-inline bool isApposition(const Elements& e, int i) {
-  const std::size_t k = static_cast<std::size_t>(i);
-  return e.group[k] == ElementGroup::Cartilage && (e.endA.body[k] < 0) != (e.endB.body[k] < 0);
-}
-
 /// Closed lung-cavity surface (Figure 6): its vertices are anchors, so its volume can be recomputed
 /// from the current bone poses and diaphragm nodes at every step.
 ///

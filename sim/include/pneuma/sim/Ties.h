@@ -1,9 +1,11 @@
 #pragma once
 /// @file Ties.h
-/// The two kinds of tie, a Cartilage element between a node and a rigid body (isApposition(const Elements&,
-/// int) in Model.h is true for both): an apposition spring, whose node is the gut's (the dome in the zone of
-/// apposition, held on a rib), and a soft-tissue volume body's tie, whose node (region Tissue) is a deep node
-/// of the body held on its bone (VolumeBodies). The body end of either lies off the bone's surface.
+/// The two kinds of tie, a Cartilage element between a node and a rigid body (isTie()): an apposition spring,
+/// whose node is the gut's (the dome in the zone of apposition, held on a rib: it stands for the pleural
+/// fluid that holds the dome on the rib cage while letting it slide), and a soft-tissue volume body's tie,
+/// whose node (region Tissue) is a deep node of the body held on its bone (VolumeBodies). The body end of
+/// either lies off the bone's surface, on the line from the node (docs/model-format.md), so views draw no
+/// line for it.
 
 #include <cstddef>
 #include <vector>
@@ -12,7 +14,13 @@
 
 namespace pneuma::sim {
 
-/// The node of tie `i` (isApposition(e, i) true).
+/// True for a tie: a Cartilage element between a node and a rigid body.
+inline bool isTie(const Elements& e, int i) {
+  const std::size_t k = static_cast<std::size_t>(i);
+  return e.group[k] == ElementGroup::Cartilage && (e.endA.body[k] < 0) != (e.endB.body[k] < 0);
+}
+
+/// The node of tie `i` (isTie(e, i) true).
 inline int tiedNode(const Elements& e, int i) {
   return e.endA.body[static_cast<std::size_t>(i)] < 0 ? e.endA.nodes(0, i) : e.endB.nodes(0, i);
 }
@@ -21,14 +29,13 @@ inline int tiedNode(const Elements& e, int i) {
 inline std::vector<char> tiedNodes(const Model& m) {
   std::vector<char> tied(static_cast<std::size_t>(m.nodes.size()), 0);
   for (int e = 0; e < m.elements.size(); ++e)
-    if (isApposition(m.elements, e)) tied[static_cast<std::size_t>(tiedNode(m.elements, e))] = 1;
+    if (isTie(m.elements, e)) tied[static_cast<std::size_t>(tiedNode(m.elements, e))] = 1;
   return tied;
 }
 
-/// True for an apposition spring proper: a tie whose node is the gut's, not a volume body's
-/// (docs/model-format.md; views draw no line for it).
+/// True for an apposition spring: a tie whose node is the gut's, not a volume body's.
 inline bool isApposition(const Model& m, int i) {
-  return isApposition(m.elements, i) &&
+  return isTie(m.elements, i) &&
          m.nodes.region[static_cast<std::size_t>(tiedNode(m.elements, i))] != NodeRegion::Tissue;
 }
 
