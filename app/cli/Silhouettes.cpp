@@ -122,6 +122,9 @@ nlohmann::json silhouetteJson(const sim::SilhouetteBreath& b) {
           {"umbilicus_lift_mm", jsonNumber(b.bellyLift * kMm)},
           {"chest_ap_change_mm", jsonNumber(b.chestChange * kMm)},
           {"belly_ap_change_mm", jsonNumber(b.bellyChange * kMm)},
+          {"chest_marker_ventral_mm", jsonNumber(b.chestMarker.y() * kMm)},
+          {"chest_marker_cranial_mm", jsonNumber(b.chestMarker.z() * kMm)},
+          {"chest_marker_mm", jsonNumber(b.chestMarker.norm() * kMm)},
           {"lung_volume_change_ml", jsonNumber(b.lungChange * 1e6)}};
 }
 

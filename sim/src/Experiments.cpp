@@ -432,6 +432,15 @@ SilhouetteBreath silhouetteBreath(const StyleRun& run) {
     return silhouetteWidth(x, t, SilhouetteView::Lateral, z, b.trunkBand);
   };
   b.chestChange = depth(b.skinInspiration, b.chestHeight) - depth(b.skinExpiration, b.chestHeight);
+  // a marker on the skin: the most anterior vertex at the chest line's front, near the midline
+  int marker = -1;
+  for (Eigen::Index v = 0; v < b.skinExpiration.cols(); ++v) {
+    const Eigen::Vector3d x = b.skinExpiration.col(v);
+    if (std::abs(x.z() - b.chestHeight) < kChestMarkerBand && std::abs(x.x()) < kChestMarkerHalfWidth &&
+        (marker < 0 || x.y() > b.skinExpiration(1, marker)))
+      marker = static_cast<int>(v);
+  }
+  if (marker >= 0) b.chestMarker = b.skinInspiration.col(marker) - b.skinExpiration.col(marker);
   b.bellyChange = depth(b.skinInspiration, b.bellyHeight) - depth(b.skinExpiration, b.bellyHeight);
   b.lungChange = run.endInspirationVolume - run.endExpirationVolume;
   return b;
@@ -468,6 +477,11 @@ std::vector<Check> silhouetteChecks(const std::vector<SilhouetteBreath>& breaths
   };
   if (calm) {
     add(*calm, true, "3 - 5 mm published; 1.5 - 10 mm accepted", deGroote, 1.5, 10.0);
+    const Eigen::Vector3d& m = calm->chestMarker;
+    out.push_back(check("silhouette.calm.chest_marker",
+                        "displacement of a skin marker at the front of the chest line (midline), calm",
+                        "3 - 5 mm published; 1.5 - 10 mm accepted", deGroote, "mm", m.norm() * kMm, 1.5,
+                        10.0));
     add(*calm, false, "> 0 mm (the umbilical section moves ventrally)", deGroote + "; Konno & Mead 1967",
         1e-9, kBig);
   }

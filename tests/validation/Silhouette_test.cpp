@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 
 #include "DefaultModel.h"
@@ -30,12 +31,24 @@ TEST(Silhouette, ChestAndBellyMoveAsPublishedInEveryStyle) {
   std::vector<SilhouetteBreath> breaths;
   for (const char* style : {"calm", "deep", "panting", "forced-exhale"}) breaths.push_back(breath(style));
   const std::vector<Check> checks = silhouetteChecks(breaths);
-  ASSERT_EQ(checks.size(), 8u) << "chest and belly of four styles";
+  ASSERT_EQ(checks.size(), 9u) << "chest and belly of four styles, and calm's chest marker";
   for (const Check& c : checks) {
     RecordProperty(c.id, std::to_string(c.measured));
     EXPECT_TRUE(c.isPassed()) << c.id << ": " << c.what << " = " << c.measured << " " << c.unit << ", target "
                               << c.target << " [" << c.lower << ", " << c.upper << "] (" << c.source << ")";
   }
+}
+
+// the chest marker is a material point on the front of the chest: on a calm inhale it moves ventrally and
+// cranially, as De Groote et al. 1997's markers at the costal cartilages do ("mostly ventrally and
+// cranially")
+TEST(Silhouette, ChestMarkerMovesVentrallyAndCranially) {
+  REQUIRE_DEFAULT_MODEL();
+  const SilhouetteBreath& b = breath("calm");
+  EXPECT_GT(b.chestMarker.y(), 0.001);
+  EXPECT_GT(b.chestMarker.z(), 0.001);
+  EXPECT_LT(std::abs(b.chestMarker.x()), 0.5 * b.chestMarker.y())
+      << "a midline marker moves in the sagittal plane";
 }
 
 // the lines sit where they are defined: the chest line between the jugular notch and the xiphoid, the belly

@@ -29,7 +29,8 @@ TEST(CliSilhouette, WritesOutlinesOverlaysAndFiguresOfACalmBreath) {
   EXPECT_GT(calm.at("chest_ap_change_mm").get<double>(), 0.0);
   EXPECT_GT(calm.at("chest_line_mm").get<double>(), calm.at("belly_line_mm").get<double>());
   EXPECT_GT(calm.at("lung_volume_change_ml").get<double>(), 300.0);
-  EXPECT_EQ(j.at("checks").size(), 2u) << "calm chest and belly";
+  EXPECT_GT(calm.at("chest_marker_ventral_mm").get<double>(), 0.0);
+  EXPECT_EQ(j.at("checks").size(), 3u) << "calm chest, chest marker and belly";
   std::istringstream csv(slurp(out + "/calm_lateral.csv"));
   std::string line;
   std::getline(csv, line);

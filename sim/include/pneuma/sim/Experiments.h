@@ -174,14 +174,28 @@ struct SilhouetteBreath {
   double chestChange = 0.0;  ///< [m] AP depth along the chest line, end-inspiration minus end-expiration
   double bellyChange = 0.0;  ///< [m] the same along the belly line
   double lungChange = 0.0;   ///< [m^3] lung volume, end-inspiration minus end-expiration
+  /// [m] motion of a marker on the skin, end-inspiration minus end-expiration: the most anterior skin vertex
+  /// within kChestMarkerHalfWidth of the midline and kChestMarkerBand of the chest line at end-expiration (a
+  /// material point, as optoelectronic plethysmography tracks, where chestChange is a section at a fixed
+  /// height that the skin rises through); zero when no vertex is there
+  Eigen::Vector3d chestMarker{0.0, 0.0, 0.0};
 };
+
+/// [m] the chest marker's search box (SilhouetteBreath::chestMarker): half-width about the midline (the
+/// sternum and the parasternal cartilages) and half-height about the chest line
+constexpr double kChestMarkerHalfWidth = 0.03;
+constexpr double kChestMarkerBand = 0.005;
 
 /// The silhouette breath of `run`. @throws Error when the run has no breath poses, its model no skin or no
 /// "jugular_notch", "xiphoid" and "umbilicus" landmarks.
 SilhouetteBreath silhouetteBreath(const StyleRun& run);
 
 /// The silhouette's anteroposterior change per style against published chest-wall motion (ids
-/// "silhouette.<style>.chest" and ".belly", in mm; checks whose styles are missing are left out):
+/// "silhouette.<style>.chest" and ".belly", in mm, and "silhouette.calm.chest_marker"; checks whose styles
+/// are missing are left out):
+///  - calm chest marker 1.5 - 10 mm: the displacement of a marker on the skin at the front of the chest
+///    line (SilhouetteBreath::chestMarker), the quantity De Groote et al. 1997 measured (3-5 mm at the 3rd
+///    and 5th costal cartilages), with the same band as the chest silhouette's;
 ///  - calm chest 1.5 - 10 mm: seated tidal breathing moves the chest wall at the 3rd and 5th costal
 ///  cartilages
 ///    3-5 mm, mostly ventrally and cranially (De Groote et al. 1997, J Appl Physiol 83:1531, optoelectronic
