@@ -380,6 +380,11 @@ struct ModelScene::Impl {
     std::vector<int> element;  // model element index of each line
     vtkSmartPointer<vtkPolyData> lines;
     vtkSmartPointer<vtkFloatArray> force;  // [N] contractive force, NaN when slack
+    // per line: 1 for an accessory muscle (a recruitment threshold), else 0; coloured through `kindTable`
+    // (the group's colour, kAccessoryColour) in the group colouring when the group has one
+    vtkSmartPointer<vtkFloatArray> kind;
+    vtkSmartPointer<vtkLookupTable> kindTable;
+    bool hasAccessory = false;
     vtkSmartPointer<vtkActor> actor;
   };
   std::array<Group, kGroups> groups;
@@ -621,9 +626,26 @@ struct ModelScene::Impl {
       g.force->SetNumberOfValues(n);
       g.force->Fill(std::numeric_limits<float>::quiet_NaN());
       g.lines->GetCellData()->SetScalars(g.force);
+      g.kind = vtkSmartPointer<vtkFloatArray>::New();
+      g.kind->SetName("accessory");
+      g.kind->SetNumberOfValues(n);
+      for (int k = 0; k < n; ++k) {
+        const bool accessory = model.elements.recruitmentOf(g.element[static_cast<std::size_t>(k)]) > 0.0;
+        g.kind->SetValue(k, accessory ? 1.0f : 0.0f);
+        g.hasAccessory = g.hasAccessory || accessory;
+      }
+      g.lines->GetCellData()->AddArray(g.kind);
+      g.kindTable = vtkSmartPointer<vtkLookupTable>::New();
+      g.kindTable->SetNumberOfTableValues(2);
+      g.kindTable->SetTableRange(0.0, 1.0);
+      const auto own = groupColour(static_cast<sim::ElementGroup>(gi));
+      g.kindTable->SetTableValue(0, own[0], own[1], own[2], 1.0);
+      g.kindTable->SetTableValue(1, kAccessoryColour[0], kAccessoryColour[1], kAccessoryColour[2], 1.0);
+      g.kindTable->Build();
       g.actor = actorFor(g.lines);
       g.actor->GetMapper()->SetLookupTable(forceTable);
-      g.actor->GetMapper()->SetScalarModeToUseCellData();
+      g.actor->GetMapper()->SetScalarModeToUseCellFieldData();
+      g.actor->GetMapper()->SelectColorArray("contractive_force_N");
       g.actor->GetMapper()->UseLookupTableScalarRangeOn();
       g.actor->GetProperty()->SetLineWidth(gi == static_cast<int>(sim::ElementGroup::Cartilage) ? 3.0f
                                                                                                 : 2.5f);
@@ -1032,8 +1054,14 @@ struct ModelScene::Impl {
       const auto group = static_cast<sim::ElementGroup>(gi);
       // structural springs keep their own colour: they carry no muscle force
       const bool colourByForce = byForce && sim::isMuscleGroup(group);
-      g.actor->GetMapper()->SetScalarVisibility(colourByForce);
-      g.actor->GetMapper()->SetLookupTable(byActivation ? activationTable : forceTable);
+      // the group colouring shows a group's accessory muscles apart (kindTable)
+      const bool colourByKind = !byForce && g.hasAccessory;
+      vtkMapper* mapper = g.actor->GetMapper();
+      mapper->SetScalarVisibility(colourByForce || colourByKind);
+      mapper->SelectColorArray(colourByKind ? "accessory" : "contractive_force_N");
+      mapper->SetLookupTable(colourByKind   ? g.kindTable.GetPointer()
+                             : byActivation ? activationTable.GetPointer()
+                                            : forceTable.GetPointer());
       const auto rgb = groupColour(group);
       g.actor->GetProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
       const bool shown = options.showGroup[static_cast<std::size_t>(gi)];
@@ -1464,7 +1492,10 @@ std::string ModelScene::describe(const Pick& pick) const {
   if (pick.kind == Pick::Kind::Body) return model.bodies.name[static_cast<std::size_t>(pick.index)];
   if (pick.kind == Pick::Kind::Element) {
     const auto g = model.elements.group[static_cast<std::size_t>(pick.index)];
-    return std::string(groupLabel(g)) + " element " + std::to_string(pick.index);
+    const std::string kind = model.elements.recruitmentOf(pick.index) > 0.0
+                                 ? std::string("Accessory muscle (") + groupLabel(g) + " drive)"
+                                 : groupLabel(g);
+    return kind + " element " + std::to_string(pick.index);
   }
   return {};
 }

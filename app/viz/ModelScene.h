@@ -78,6 +78,10 @@ const std::vector<std::pair<std::string, CameraPreset>>& cameraPresets();
 const char* groupLabel(sim::ElementGroup g);
 /// Display colour (RGB in [0, 1]) of an element group, after Figure 2 of Zordan et al. 2004.
 std::array<double, 3> groupColour(sim::ElementGroup g);
+/// Display colour (RGB in [0, 1]) of the accessory inspiratory muscles (elements with a recruitment
+/// threshold, sim::Elements::recruitment: the sternocleidomastoids and upper trapezius of a model with the
+/// shoulder girdle), which the external intercostals' drive recruits: amber, apart from that group's green.
+constexpr std::array<double, 3> kAccessoryColour{0.96, 0.72, 0.16};
 
 /// What is drawn and how. Defaults: the teaching view of Figure 3 (force-coloured muscles, slack grey).
 /// Reads a body's render mesh (.vtp, body-frame coordinates [m]) with point normals for shading.

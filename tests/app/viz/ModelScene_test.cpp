@@ -7,13 +7,17 @@
 #include <gtest/gtest.h>
 #include <vtkActor.h>
 #include <vtkActorCollection.h>
+#include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkDataSet.h>
 #include <vtkMapper.h>
 #include <vtkMatrix4x4.h>
 #include <vtkPointData.h>
+#include <vtkProperty.h>
 #include <vtkRenderer.h>
+#include <vtkUnsignedCharArray.h>
 
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -114,6 +118,72 @@ TEST(ModelScene, ActorsAreAtThePosedPositions) {
   int atRest = 0;
   for (int i = 0; i < model.nodes.size(); ++i) atRest += nearest(points, model.nodes.rest.col(i)) < tol;
   EXPECT_EQ(atRest, 0);
+}
+
+// the accessory inspiratory muscles (a recruitment threshold, driven with the external intercostals) are
+// drawn in their own colour when the muscles are coloured by group, and by their tension like every muscle
+// otherwise
+TEST(ModelScene, AccessoryMusclesHaveTheirOwnGroupColour) {
+  sim::Model model = sim::test::makeToyTorso(2);
+  model.elements.recruitment.setZero(model.elements.size());
+  std::vector<int> external;
+  for (int e = 0; e < model.elements.size(); ++e)
+    if (model.elements.group[static_cast<std::size_t>(e)] == sim::ElementGroup::IntercostalExternal)
+      external.push_back(e);
+  ASSERT_GE(external.size(), 3u);
+  model.elements.recruitment(external[0]) = 0.2;
+  model.elements.recruitment(external[1]) = 0.2;
+  viz::ModelScene scene;
+  scene.setModel(model, "");
+  const sim::State rest = sim::makeInitialState(model);
+  // the drawn colour of every line of the actor that holds the accessory lines: (kind, RGB) per line
+  const auto colours = [&](viz::MuscleColouring colouring) {
+    viz::DisplayOptions o = scene.options();
+    o.muscleColouring = colouring;
+    scene.setOptions(o);
+    scene.update(rest, test::someMetrics(model, rest, 3));
+    std::vector<std::pair<int, Eigen::Vector3i>> out;
+    vtkActorCollection* actors = scene.renderer()->GetActors();
+    actors->InitTraversal();
+    while (vtkActor* actor = actors->GetNextActor()) {
+      vtkMapper* mapper = actor->GetMapper();
+      vtkDataSet* data = mapper ? mapper->GetInput() : nullptr;
+      vtkDataArray* kind = data ? data->GetCellData()->GetArray("accessory") : nullptr;
+      if (!kind || kind->GetRange()[1] < 1.0) continue;
+      vtkUnsignedCharArray* rgba = mapper->GetScalarVisibility() ? mapper->MapScalars(1.0) : nullptr;
+      const double* c = actor->GetProperty()->GetColor();
+      for (vtkIdType k = 0; k < data->GetNumberOfCells(); ++k) {
+        Eigen::Vector3i shown(static_cast<int>(std::lround(255 * c[0])),
+                              static_cast<int>(std::lround(255 * c[1])),
+                              static_cast<int>(std::lround(255 * c[2])));
+        if (rgba)
+          shown =
+              Eigen::Vector3i(rgba->GetValue(4 * k), rgba->GetValue(4 * k + 1), rgba->GetValue(4 * k + 2));
+        out.emplace_back(static_cast<int>(kind->GetTuple1(k)), shown);
+      }
+    }
+    return out;
+  };
+  const auto toByte = [](const std::array<double, 3>& c) {
+    return Eigen::Vector3i(static_cast<int>(std::lround(255 * c[0])),
+                           static_cast<int>(std::lround(255 * c[1])),
+                           static_cast<int>(std::lround(255 * c[2])));
+  };
+  const auto byGroup = colours(viz::MuscleColouring::Group);
+  ASSERT_EQ(byGroup.size(), external.size()) << "one actor: the external intercostals";
+  int accessory = 0;
+  for (const auto& [kind, rgb] : byGroup) {
+    accessory += kind;
+    const Eigen::Vector3i want =
+        toByte(kind == 1 ? viz::kAccessoryColour : viz::groupColour(sim::ElementGroup::IntercostalExternal));
+    EXPECT_LE((rgb - want).cwiseAbs().maxCoeff(), 1) << "kind " << kind << ": " << rgb.transpose();
+  }
+  EXPECT_EQ(accessory, 2);
+  // by tension: no line is amber
+  for (const auto& [kind, rgb] : colours(viz::MuscleColouring::Force))
+    EXPECT_GT((rgb - toByte(viz::kAccessoryColour)).cwiseAbs().maxCoeff(), 8) << "kind " << kind;
+  EXPECT_EQ(scene.describe(viz::Pick{viz::Pick::Kind::Element, external[0]}).rfind("Accessory muscle", 0),
+            0u);
 }
 
 // legend labels: evenly spaced on a 1-2-5 step, no stray decimals or exponents
