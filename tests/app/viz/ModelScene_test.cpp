@@ -136,6 +136,11 @@ TEST(ModelScene, AccessoryMusclesHaveTheirOwnGroupColour) {
   viz::ModelScene scene;
   scene.setModel(model, "");
   const sim::State rest = sim::makeInitialState(model);
+  const auto toByte = [](const std::array<double, 3>& c) {
+    return Eigen::Vector3i(static_cast<int>(std::lround(255 * c[0])),
+                           static_cast<int>(std::lround(255 * c[1])),
+                           static_cast<int>(std::lround(255 * c[2])));
+  };
   // the drawn colour of every line of the actor that holds the accessory lines: (kind, RGB) per line
   const auto colours = [&](viz::MuscleColouring colouring) {
     viz::DisplayOptions o = scene.options();
@@ -153,21 +158,13 @@ TEST(ModelScene, AccessoryMusclesHaveTheirOwnGroupColour) {
       vtkUnsignedCharArray* rgba = mapper->GetScalarVisibility() ? mapper->MapScalars(1.0) : nullptr;
       const double* c = actor->GetProperty()->GetColor();
       for (vtkIdType k = 0; k < data->GetNumberOfCells(); ++k) {
-        Eigen::Vector3i shown(static_cast<int>(std::lround(255 * c[0])),
-                              static_cast<int>(std::lround(255 * c[1])),
-                              static_cast<int>(std::lround(255 * c[2])));
-        if (rgba)
-          shown =
-              Eigen::Vector3i(rgba->GetValue(4 * k), rgba->GetValue(4 * k + 1), rgba->GetValue(4 * k + 2));
+        const Eigen::Vector3i shown = rgba ? Eigen::Vector3i(rgba->GetValue(4 * k), rgba->GetValue(4 * k + 1),
+                                                             rgba->GetValue(4 * k + 2))
+                                           : toByte({c[0], c[1], c[2]});
         out.emplace_back(static_cast<int>(kind->GetTuple1(k)), shown);
       }
     }
     return out;
-  };
-  const auto toByte = [](const std::array<double, 3>& c) {
-    return Eigen::Vector3i(static_cast<int>(std::lround(255 * c[0])),
-                           static_cast<int>(std::lround(255 * c[1])),
-                           static_cast<int>(std::lround(255 * c[2])));
   };
   const auto byGroup = colours(viz::MuscleColouring::Group);
   ASSERT_EQ(byGroup.size(), external.size()) << "one actor: the external intercostals";
