@@ -378,8 +378,11 @@ TEST_P(BuiltPresets, GutSurfaceIsSealedAndHasItsRegions) {
             sim::NodeRegion::Diaphragm);
   EXPECT_EQ(m.nodes.region[static_cast<std::size_t>(m.landmarks.points.nodes(0, navel))],
             sim::NodeRegion::Wall);
-  for (int i = 0; i < m.nodes.size(); ++i)
-    if (isGut(i)) EXPECT_LE(m.nodes.rest(2, i), m.nodes.rest(2, m.landmarks.points.nodes(0, apex)) + 1e-12);
+  for (int i = 0; i < m.nodes.size(); ++i) {
+    if (isGut(i)) {
+      EXPECT_LE(m.nodes.rest(2, i), m.nodes.rest(2, m.landmarks.points.nodes(0, apex)) + 1e-12);
+    }
+  }
 }
 
 TEST_P(BuiltPresets, RoundTripsThroughModelJson) {
