@@ -145,7 +145,8 @@ Gains readGains(const Reader& r) {
   r.allowKeys({"description", "reference_length_m", "groups", "gut_kappa_pa", "gut_drag_per_s",
                "abdominal_wall_tone_upright", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
                "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
-               "diaphragm_mass_kg", "joints", "shoulder_springs", "accessory_muscles", "tissue_bodies"});
+               "diaphragm_mass_kg", "joints", "shoulder_springs", "accessory_muscles", "scapulothoracic",
+               "tissue_bodies"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -204,6 +205,13 @@ Gains readGains(const Reader& r) {
     acc.allowKeys({"description", "kac", "recruitment"});
     g.accessory.kac = acc.at("kac").numberIn(0.0, 1e9);
     g.accessory.recruitment = acc.at("recruitment").numberIn(0.0, 0.99);
+  }
+  // optional: no scapulothoracic springs when absent
+  if (r.has("scapulothoracic")) {
+    const Reader st = r.at("scapulothoracic");
+    st.allowKeys({"description", "kpe", "b"});
+    g.scapulothoracic.kpe = st.at("kpe").numberIn(0.0, 1e9);
+    g.scapulothoracic.damping = st.at("b").numberIn(0.0, 1e9);
   }
   // optional: no tissue bodies when absent
   if (r.has("tissue_bodies")) {

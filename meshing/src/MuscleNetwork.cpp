@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 #include <utility>
 
@@ -31,7 +32,8 @@ constexpr double kCostalSample = 0.01;     // [m] spacing of candidate costal-ma
 constexpr int kRectusHalfColumns = 4;      // rectus columns on each side of the linea alba
 constexpr double kScaleneLength = 0.06;    // [m] rib 1 to the scalene anchors above it (no cervical spine)
 constexpr double kScaleneNeckRise = 0.10;  // [m] rib 1 to the scalenes' cervical anchors, craniocaudal
-constexpr double kScaleneNeckOffset = 0.035;  // [m] the scalenes' cervical anchors off the midline
+constexpr double kScaleneNeckOffset = 0.035;     // [m] the scalenes' cervical anchors off the midline
+constexpr double kScapulothoracicLength = 0.10;  // [m] the scapulothoracic springs, blade to their rib points
 
 /// Angle of `p` round the ribcage's vertical axis through (0, axisY), from the posterior midline
 /// toward the sternum on either side [rad].
@@ -316,22 +318,47 @@ void addScalenes(const Skeleton& sk, ElementSink& sink) {
   }
 }
 
+/// The rib (body index) of levels 2-8 on `side` whose centreline passes nearest to `p` [m] (sampled every
+/// 2 mm).
+int ribUnder(const Skeleton& sk, int side, const Eigen::Vector3d& p) {
+  int best = -1;
+  double bestDistance = std::numeric_limits<double>::infinity();
+  for (int level = 2; level <= 8; ++level) {
+    const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+    for (double s = 0.0; s <= r.length(); s += 0.002)
+      if ((r.at(s) - p).norm() < bestDistance) {
+        bestDistance = (r.at(s) - p).norm();
+        best = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+      }
+  }
+  return best;
+}
+
 /// The neck and the shoulder girdle (AnatomyParams::hasShoulderGirdle), per side:
 ///  - scalenes: from the cervical transverse processes (kScaleneNeckOffset off the midline, kScaleneNeckRise
-///    above rib 1, C3-C4) to the front half of rib 1 (scalenus anterior, medius; the posterior to rib 2 is
-///    folded into them), structural springs with the cartilage group's gains like the model's scalenes
-///    without a neck (addScalenes()). Each runs in its rib point's sagittal plane, tilted inwards only: a
-///    fore-aft tilt braces rib 1, and with it the upper thoracic spine, against the fixed neck. From C3-C5
-///    (2.8 cm off the midline, level with the vertebral bodies, up to 12 deg forward) the backward sway of
-///    the spine in a deep inhale was -0.10 mm (validate's sway.backward, male, --quick; -0.71 mm without the
-///    girdle, -0.14 mm without scalenes), in the sagittal plane -0.15 mm. Vertical springs on the middle of
-///    rib 1 (the model without the girdle) give -0.73 mm but leave the skin at the base of the neck. On the
-///    back half of rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale;
+///    above rib 1, C3-C4) to the front half of rib 1
+///    (scalenus anterior, medius; the posterior to rib 2 is folded into them), structural springs with the
+///    cartilage group's gains like the model's scalenes without a neck (addScalenes()). Each runs in its rib
+///    point's sagittal plane, tilted inwards only: a fore-aft tilt braces rib 1, and with it the upper
+///    thoracic spine, against the fixed neck. From C3-C5 (2.8 cm off the midline, level with the vertebral
+///    bodies, up to 12 deg forward) the backward sway of the spine in a deep inhale was -0.10 mm (validate's
+///    sway.backward, male, --quick; -0.71 mm without the girdle, -0.14 mm without scalenes), in the sagittal
+///    plane -0.15 mm. Vertical springs on the middle of rib 1 (the model without the girdle) give -0.73 mm
+///    but leave the skin at the base of the neck. On the back half of rib 1 they pulled rib 1 and T1 forward
+///    and the spine swayed forward on a deep inhale. In a calm breath T1-T3 moves 3.0 mm forward (1.3 mm
+///    without the girdle); added to these, 6 cm vertical springs on the middle of rib 1 gave 1.1 mm but
+///    leave the skin, 2.5 cm ones (inside it, and stiffer) pulled T1-T3 1.1 mm back, and ones to the
+///    transverse processes of C5 2.3-3.6 mm forward;
 ///  - sternocleidomastoid: from the mastoid process to the manubrium (sternal head) and the medial clavicle
 ///    (clavicular head);
 ///  - Breathe Easy's 26 shoulder elements (Zordan et al. 2004, Table 1: 52 in all), passive at the shoulder
 ///    gains (kpe 10, b 1): upper (3), middle (2) and lower (2) trapezius, levator scapulae (2), rhomboids
 ///    (3), serratus anterior (5), pectoralis minor (3) and major (3), subclavius (1) and deltoid (2).
+///  - scapulothoracic gliding springs (muscle_gains.json `scapulothoracic`): six per blade, from its medial
+///    border and a line 40 % of the way to its lateral border along the blade's normal into the chest, to a
+///    point on the rib under them kScapulothoracicLength deep, so that the blade slides over the ribs and
+///    does not sink into them: without them it followed the clavicle, whose sternal end the sternum pushes
+///    forward, 8.1 mm forward in a calm breath, and the back's skin with it.
 /// Two-sided springs of the cartilage group, except the accessory inspiratory muscles (the
 /// sternocleidomastoids and the upper trapezius: 5 per side): muscles of the external intercostal group (the
 /// rib cage's inspiratory drive) with the shoulder gains' kpe and b, muscle_gains.json's `accessory_muscles`
@@ -432,6 +459,24 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
     // deltoid: acromion and lateral clavicle to the deltoid tuberosity
     spring(scapula(s.acromion), humerus(0.45));
     spring(clavicle(0.85), humerus(0.45));
+    // scapulothoracic gliding: springs from the blade along its normal to points on the rib under it (the
+    // nearest), kScapulothoracicLength deep, hold the blade off the ribs while it slides over them (the
+    // springs' length changes by the normal motion only; a tangential slide d lengthens them by
+    // d^2 / (2 kScapulothoracicLength), 1 mm for 15 mm)
+    Eigen::Vector3d inward =
+        (s.acromion - s.superiorAngle).cross(s.inferiorAngle - s.superiorAngle).normalized();
+    if (inward.y() < 0) inward = -inward;  // the blade's normal, into the chest
+    if (a.gains.scapulothoracic.kpe > 0.0)
+      for (double f : {0.15, 0.5, 0.85}) {
+        const Eigen::Vector3d medial = s.superiorAngle + f * (s.inferiorAngle - s.superiorAngle);
+        const Eigen::Vector3d lateral = s.acromion + f * (s.inferiorAngle - s.acromion);
+        for (double w : {0.0, 0.4}) {
+          const Eigen::Vector3d p = medial + w * (lateral - medial);
+          sink.add(ElementGroup::Cartilage, scapula(p),
+                   Endpoint::onBody(ribUnder(sk, side, p), p + kScapulothoracicLength * inward),
+                   a.gains.scapulothoracic, 0.0);
+        }
+      }
   }
 }
 

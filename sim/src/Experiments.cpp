@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -432,15 +433,24 @@ SilhouetteBreath silhouetteBreath(const StyleRun& run) {
     return silhouetteWidth(x, t, SilhouetteView::Lateral, z, b.trunkBand);
   };
   b.chestChange = depth(b.skinInspiration, b.chestHeight) - depth(b.skinExpiration, b.chestHeight);
-  // a marker on the skin: the most anterior vertex at the chest line's front, near the midline
-  int marker = -1;
-  for (Eigen::Index v = 0; v < b.skinExpiration.cols(); ++v) {
-    const Eigen::Vector3d x = b.skinExpiration.col(v);
-    if (std::abs(x.z() - b.chestHeight) < kChestMarkerBand && std::abs(x.x()) < kChestMarkerHalfWidth &&
-        (marker < 0 || x.y() > b.skinExpiration(1, marker)))
-      marker = static_cast<int>(v);
+  // a marker on the skin: the material point where the midline meets the front of the skin at the chest line
+  // (the front-most crossing of the line x = 0, z = chest line with a triangle, in barycentric coordinates)
+  double front = -std::numeric_limits<double>::infinity();
+  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+    const Eigen::Vector3d a = b.skinExpiration.col(t(0, f)), e1 = b.skinExpiration.col(t(1, f)) - a,
+                          e2 = b.skinExpiration.col(t(2, f)) - a;
+    // solve (0, chest) = a + u e1 + v e2 in the frontal (x, z) plane
+    const double det = e1.x() * e2.z() - e2.x() * e1.z();
+    if (det == 0.0) continue;
+    const double px = -a.x(), pz = b.chestHeight - a.z();
+    const double u = (px * e2.z() - e2.x() * pz) / det, v = (e1.x() * pz - px * e1.z()) / det;
+    if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+    const double y = a.y() + u * e1.y() + v * e2.y();
+    if (y <= front) continue;
+    front = y;
+    const auto moved = [&](int k) { return b.skinInspiration.col(t(k, f)) - b.skinExpiration.col(t(k, f)); };
+    b.chestMarker = (1.0 - u - v) * moved(0) + u * moved(1) + v * moved(2);
   }
-  if (marker >= 0) b.chestMarker = b.skinInspiration.col(marker) - b.skinExpiration.col(marker);
   b.bellyChange = depth(b.skinInspiration, b.bellyHeight) - depth(b.skinExpiration, b.bellyHeight);
   b.lungChange = run.endInspirationVolume - run.endExpirationVolume;
   return b;

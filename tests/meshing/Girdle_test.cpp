@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "pneuma/meshing/ModelSummary.h"
 #include "pneuma/sim/Experiments.h"
 #include "pneuma/sim/JsonReader.h"
+#include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
 
@@ -128,42 +130,98 @@ TEST_P(GirdlePresets, ArmsHangInTheAPose) {
   }
 }
 
-// Breathe Easy's 52 shoulder elements (Table 1), two sternocleidomastoids and six scalenes per body: the
-// scalenes run up and inwards from the front half of rib 1 to the cervical spine, with no fore-aft tilt (that
-// braces rib 1 and the upper thoracic spine, which then hardly sways back in a deep inhale)
+// Breathe Easy's 52 shoulder elements (Table 1), two sternocleidomastoids, six scalenes and twelve
+// scapulothoracic springs per body: the scalenes run up and inwards from the front half of rib 1 to the
+// cervical spine, with no fore-aft tilt (that braces rib 1 and the upper thoracic spine, which then hardly
+// sways back in a deep inhale); the scapulothoracic springs run from the blade along its normal into the
+// chest to a rib, so that they hold the blade on the ribs and leave it free to slide over them
 TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   const BuiltModel& built1 = built(GetParam());
   const sim::Model& m = built1.model;
-  int shoulder = 0, scalenes = 0;
+  int shoulder = 0, scalenes = 0, scapulothoracic = 0;
   const int head = body(m, "head"), cervical = body(m, "cervical_spine");
   const std::set<int> girdle = {body(m, "clavicle_right"), body(m, "clavicle_left"), body(m, "scapula_right"),
                                 body(m, "scapula_left"),   body(m, "humerus_right"), body(m, "humerus_left")};
+  std::set<int> ribs;
+  for (int b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies.name[static_cast<std::size_t>(b)].rfind("rib", 0) == 0) ribs.insert(b);
   const Eigen::Matrix3Xd from = restPoints(m.elements.endA, m), to = restPoints(m.elements.endB, m);
   for (int e = 0; e < m.elements.size(); ++e) {
     const int a = m.elements.endA.body[static_cast<std::size_t>(e)],
               b = m.elements.endB.body[static_cast<std::size_t>(e)];
+    const std::string& nameA = a >= 0 ? m.bodies.name[static_cast<std::size_t>(a)] : std::string();
+    const Eigen::Vector3d d = to.col(e) - from.col(e);
+    // the scapulothoracic springs: 100 mm from the blade to a rib (the serratus anterior's and pectoralis
+    // minor's are shoulder springs)
+    if (nameA.rfind("scapula", 0) == 0 && ribs.count(b) && std::abs(d.norm() - 0.1) < 1e-9) {
+      ++scapulothoracic;
+      // along the blade's normal, into the chest: square to the line from the blade to the acromion, and
+      // nearly horizontal
+      const std::string n = nameA == "scapula_right" ? "_right" : "_left";
+      const Eigen::Vector3d acromion =
+          restPoints(m.landmarks.points, m).col(m.landmarks.find("acromion" + n));
+      EXPECT_GT(d.y(), 0.0) << e;
+      EXPECT_LT(std::abs(d.normalized().z()), 0.3) << e;
+      EXPECT_LT(std::abs(d.normalized().dot((acromion - from.col(e)).normalized())), 0.3) << e;
+      continue;
+    }
     // springs between bones only: the deltoid volume bodies' ties (a node to the humerus or scapula) are not
     // muscles
     const bool onGirdle = a >= 0 && b >= 0 && (girdle.count(a) || girdle.count(b));
     if (onGirdle && a != head && b != head) ++shoulder;
     if (a == cervical && (b == body(m, "rib1_right") || b == body(m, "rib1_left"))) {
-      ++scalenes;
-      // up and inwards from rib 1 in the rib point's sagittal plane
-      const Eigen::Vector3d d = from.col(e) - to.col(e);
-      EXPECT_LT(d.x() * to(0, e), 0.0) << e;
-      EXPECT_NEAR(d.y(), 0.0, 1e-12) << e;
-      EXPECT_GT(d.z(), 2.0 * std::abs(d.x())) << e;
-      // the rib end lies in the front half of rib 1: in front of the middle between its head and its most
-      // anterior point
+      const Eigen::Vector3d up = -d;
+      EXPECT_NEAR(up.y(), 0.0, 1e-12) << e;
       const int rib = b;
       const int j = joint(m, std::string("costovertebral_") + m.bodies.name[static_cast<std::size_t>(rib)]);
       const double front =
           built1.bodyMeshes[static_cast<std::size_t>(rib)].vertices.row(1).maxCoeff() + m.bodies.com(1, rib);
+      ++scalenes;
+      // up and inwards from rib 1 in the rib point's sagittal plane, from its front half: in front of the
+      // middle between its head and its most anterior point
+      EXPECT_LT(up.x() * to(0, e), 0.0) << e;
+      EXPECT_GT(up.z(), 2.0 * std::abs(up.x())) << e;
       EXPECT_GT(to(1, e), 0.5 * (m.joints.anchor(1, j) + front)) << e;
     }
   }
   EXPECT_EQ(shoulder, 52);
   EXPECT_EQ(scalenes, 6);
+  EXPECT_EQ(scapulothoracic, 12);
+}
+
+// the shoulder blades slide on the ribs: in a calm breath each blade moves several millimetres with the
+// ribs under it, but its distance from them along the blade's normal (the scapulothoracic springs' length)
+// changes by a tenth of that at most (--quick, male: 0.60 mm against 10.0 mm; 2.6 mm with springs of kpe 1
+// N/m instead of 50000; without them the blade followed the clavicle 8.1 mm forward)
+TEST_P(GirdlePresets, ShoulderBladesSlideOnTheRibs) {
+  const auto model = std::make_shared<const sim::Model>(built(GetParam()).model);
+  const sim::StyleRun r =
+      sim::runBreathStyle(model, sim::loadBreathStyle("calm"), sim::ExperimentSettings::quick());
+  ASSERT_TRUE(r.hasBreathPoses);
+  sim::PosedGeometry in, out;
+  sim::poseGeometry(*model, r.endExpiration, out);
+  sim::poseGeometry(*model, r.endInspiration, in);
+  const Eigen::Matrix3Xd a = restPoints(model->elements.endA, *model),
+                         b = restPoints(model->elements.endB, *model);
+  int springs = 0;
+  double stretch = 0.0, moved = 0.0;
+  for (int e = 0; e < model->elements.size(); ++e) {
+    const int from = model->elements.endA.body[static_cast<std::size_t>(e)];
+    if (from < 0 || model->bodies.name[static_cast<std::size_t>(from)].rfind("scapula", 0) != 0 ||
+        std::abs((b.col(e) - a.col(e)).norm() - 0.1) > 1e-9)
+      continue;
+    ++springs;
+    const auto length = [&](const sim::PosedGeometry& g) {
+      return (g.elementB.col(e) - g.elementA.col(e)).norm();
+    };
+    stretch = std::max(stretch, std::abs(length(in) - length(out)));
+    moved = std::max(moved, (in.elementA.col(e) - out.elementA.col(e)).norm());
+  }
+  ASSERT_EQ(springs, 12);
+  RecordProperty("blade_moved_mm", std::to_string(moved * 1e3));
+  RecordProperty("blade_off_the_ribs_mm", std::to_string(stretch * 1e3));
+  EXPECT_GT(moved, 0.002);
+  EXPECT_LT(stretch, 0.1 * moved);
 }
 
 // The girdle's model with the default skin (built once per preset): the skin's arms registered to the bones.
@@ -235,7 +293,9 @@ TEST_P(GirdlePresets, NeckMusclesRunInsideTheSkin) {
 
 // a deep breath lifts the shoulders visibly, by at least 10 mm more than a calm one (validate's
 // physiology.deep.shoulder_lift_over_calm: the sternocleidomastoids and upper trapezius are recruited above
-// calm demand), and a calm one barely (under 6 mm: the girdle rides on the sternum); the clavicles stay in
+// calm demand), and a calm one less (under 8 mm: the girdle rides on the manubrium, whose top rises about
+// 4 mm in a calm breath, and the clavicle lifts its lateral end with it; 5.6 / 6.8 mm male / female, --quick,
+// since the blades slide on the ribs; 4.8 / 5.4 mm before); the clavicles stay in
 // their sockets on the manubrium (the sternoclavicular joints are in the implicit solver's joint tree from
 // the free sternum)
 TEST_P(GirdlePresets, AcromionRisesMoreInDeepThanInCalmBreathing) {
@@ -267,7 +327,7 @@ TEST_P(GirdlePresets, AcromionRisesMoreInDeepThanInCalmBreathing) {
   RecordProperty("acromion_deep_mm", std::to_string(lift["deep"] * 1e3));
   EXPECT_GT(lift["deep"], lift["calm"]);
   EXPECT_GE(lift["deep"] - lift["calm"], 0.010);
-  EXPECT_LT(lift["calm"], 0.006);
+  EXPECT_LT(lift["calm"], 0.008);
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, GirdlePresets, ::testing::Values("male", "female"));

@@ -177,6 +177,10 @@ struct Gains {
   /// sternocleidomastoids
   GroupGains shoulder{};
   AccessoryGains accessory{};  ///< the sternocleidomastoids' and upper trapezius' drive
+  /// [N/m], [N s/m] kpe and b (kac unused) of the scapulothoracic gliding springs that hold each scapula's
+  /// front face off the ribs under it (muscle_gains.json `scapulothoracic`; optional, kpe 0 and none when
+  /// absent)
+  GroupGains scapulothoracic{};
   TissueGains tissue{};        ///< the pectoral and shoulder volume bodies
   double wallMass = 0.0;       ///< [kg] total mass of the moving abdominal-wall nodes (8 kg, Section 6.1)
   double diaphragmMass = 0.0;  ///< [kg] total mass of the diaphragm dome nodes

@@ -174,17 +174,12 @@ struct SilhouetteBreath {
   double chestChange = 0.0;  ///< [m] AP depth along the chest line, end-inspiration minus end-expiration
   double bellyChange = 0.0;  ///< [m] the same along the belly line
   double lungChange = 0.0;   ///< [m^3] lung volume, end-inspiration minus end-expiration
-  /// [m] motion of a marker on the skin, end-inspiration minus end-expiration: the most anterior skin vertex
-  /// within kChestMarkerHalfWidth of the midline and kChestMarkerBand of the chest line at end-expiration (a
-  /// material point, as optoelectronic plethysmography tracks, where chestChange is a section at a fixed
-  /// height that the skin rises through); zero when no vertex is there
+  /// [m] motion of a marker on the skin, end-inspiration minus end-expiration: the material point where the
+  /// midline (x = 0) meets the front of the skin at the chest line at end-expiration, carried by its triangle
+  /// (a material point, as optoelectronic plethysmography tracks, where chestChange is a section at a fixed
+  /// height that the skin rises through); zero when the line misses the skin
   Eigen::Vector3d chestMarker{0.0, 0.0, 0.0};
 };
-
-/// [m] the chest marker's search box (SilhouetteBreath::chestMarker): half-width about the midline (the
-/// sternum and the parasternal cartilages) and half-height about the chest line
-constexpr double kChestMarkerHalfWidth = 0.03;
-constexpr double kChestMarkerBand = 0.005;
 
 /// The silhouette breath of `run`. @throws Error when the run has no breath poses, its model no skin or no
 /// "jugular_notch", "xiphoid" and "umbilicus" landmarks.
