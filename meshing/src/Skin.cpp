@@ -825,7 +825,8 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
 
   // each vertex's binding as weights over anchors (key -1: the still body): inverse-square distance through
   // the tissue, times the share of the motion it takes (all within kFollowNear of its nearest anchor, none
-  // beyond kFollowFar)
+  // beyond kFollowFar, except all when that anchor is on a limb: a body with a postural support, the shoulder
+  // girdle and arms, whose far tissue, the fingers, goes with it)
   using Binding = std::vector<std::pair<int, double>>;
   std::vector<Binding> binding(static_cast<std::size_t>(nV));
   for (int v = 0; v < nV; ++v) {
@@ -833,8 +834,12 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
     if (f.empty())
       throw sim::Error("skin: vertex " + std::to_string(v) +
                        " reaches no bone or gut node through the tissue");
+    const int nearestBody =
+        o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(f.front().second)])];
     const double share =
-        still < 0 ? 1.0 : std::clamp((kFollowFar - f.front().first) / (kFollowFar - kFollowNear), 0.0, 1.0);
+        still < 0 || (nearestBody >= 0 && m.bodies.supported(nearestBody))
+            ? 1.0
+            : std::clamp((kFollowFar - f.front().first) / (kFollowFar - kFollowNear), 0.0, 1.0);
     double sum = 0.0;
     for (const auto& [d, a] : f) sum += 1.0 / std::max(d * d, 1e-6);
     Binding& b = binding[static_cast<std::size_t>(v)];

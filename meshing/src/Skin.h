@@ -33,7 +33,8 @@ namespace pneuma::meshing {
 ///  5. TetGen tetrahedralises the volume inside the skin with bone-surface points and gut nodes as vertices;
 ///     each skin vertex takes its 3 nearest of those anchors through the tissue (Dijkstra on tetrahedron
 ///     edges) with inverse-square-distance weights, all of their motion within 6 cm and none beyond 12 cm
-///     (the rest of the weight on a fixed body), the weights averaged over the surface; a vertex bound to one
+///     (the rest of the weight on a fixed body; all at any distance when the nearest is on a limb, a body
+///     with a postural support), the weights averaged over the surface; a vertex bound to one
 ///     bone only follows it rigidly.
 /// Fills out.model.skin and out.report's skin figures.
 /// @throws sim::Error "<file>: <problem>" when the file cannot be read, is not closed, a landmark cannot be

@@ -1,13 +1,14 @@
 // Checks that a .glb's animation moves the skeleton: rib nodes have translation and rotation channels (the
 // fixed ones, such as floating ribs a model holds still, have none), and at the deepest inspiration (largest summed morph weight) the ribs are posed differently from half a breath
 // earlier: their anterior ends (the node's mesh vertex farthest from its rest centre, posed by the node's TRS)
-// move, in the mean over the ribs, by more than 1 mm.
-// Usage: node bones.mjs FILE.glb HALF_BREATH_S
+// move, in the mean over the ribs, by more than 1 mm. Each node named after HALF_BREATH_S (a shoulder girdle's
+// scapulae, say) must be animated and rise (+Y) by at least 3 mm over the same half breath.
+// Usage: node bones.mjs FILE.glb HALF_BREATH_S [RISING_NODE...]
 import fs from 'node:fs';
 
-const [file, halfBreath] = process.argv.slice(2);
+const [file, halfBreath, ...rising] = process.argv.slice(2);
 if (!file || !halfBreath) {
-  console.error('usage: node bones.mjs FILE.glb HALF_BREATH_S');
+  console.error('usage: node bones.mjs FILE.glb HALF_BREATH_S [RISING_NODE...]');
   process.exit(2);
 }
 
@@ -101,5 +102,16 @@ console.log(`${file}: ${ribs} animated rib nodes (${still} still), frames at ${t
             ` the rib tips move ${(1e3 * mean).toFixed(2)} mm on average, ${moved} ribs by more than 0.1 mm`);
 if (ribs < 2) failures.push(`only ${ribs} animated rib nodes`);
 if (mean < 1e-3) failures.push(`rib tips move ${(1e3 * mean).toFixed(2)} mm on average half a breath apart (< 1 mm)`);
+for (const name of rising) {
+  const index = gltf.nodes.findIndex((node) => node.name === name);
+  const tr = animation.channels.find((c) => c.target.node === index && c.target.path === 'translation');
+  if (index < 0 || !tr) {
+    failures.push(`${name}: ${index < 0 ? 'no such node' : 'no translation channel'}`);
+    continue;
+  }
+  const rise = sample(animation.samplers[tr.sampler], t1)[1] - sample(animation.samplers[tr.sampler], t0)[1];
+  console.log(`${file}: ${name} rises ${(1e3 * rise).toFixed(2)} mm`);
+  if (rise < 3e-3) failures.push(`${name} rises ${(1e3 * rise).toFixed(2)} mm half a breath apart (< 3 mm)`);
+}
 for (const f of failures) console.error(`FAIL ${f}`);
 process.exit(failures.length === 0 ? 0 : 1);
