@@ -196,9 +196,11 @@ Gains readGains(const Reader& r) {
     j.lockStiffness = row.at("lock_stiffness").numberIn(0.0, 1e6);
   }
   const Reader shoulder = r.at("shoulder_springs");
-  shoulder.allowKeys({"kpe", "b"});
+  shoulder.allowKeys({"kpe", "b", "suspension_kpe"});
   g.shoulder.kpe = shoulder.at("kpe").numberIn(0.0, 1e9);
   g.shoulder.damping = shoulder.at("b").numberIn(0.0, 1e9);
+  g.shoulderSuspension =
+      shoulder.has("suspension_kpe") ? shoulder.at("suspension_kpe").numberIn(0.0, 1e9) : g.shoulder.kpe;
   // optional: the accessory muscles are passive shoulder springs when absent
   if (r.has("accessory_muscles")) {
     const Reader acc = r.at("accessory_muscles");

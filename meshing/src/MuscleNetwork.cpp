@@ -364,7 +364,11 @@ int ribUnder(const Skeleton& sk, int side, const Eigen::Vector3d& p) {
 /// rib cage's inspiratory drive) with the shoulder gains' kpe and b, muscle_gains.json's `accessory_muscles`
 /// kac and a recruitment threshold above calm demand (sim::recruitedActivation()), so that a deep breath
 /// lifts the shoulders and a calm one barely (Hudson, Gandevia & Butler 2007, J Physiol 584:261; Raper et al.
-/// 1966, J Appl Physiol 21:497).
+/// 1966, J Appl Physiol 21:497). The springs that hang the girdle from the neck (levator scapulae, the
+/// rhomboid from C7, and the upper trapezius' passive part) take the suspension's kpe
+/// (Gains::shoulderSuspension), the tone that holds the shoulders' height: the postural support cancels the
+/// girdle's weight, and without it the chest, expanding under the blades, lifted the acromion 5.6 mm in a
+/// calm breath (3.2 mm with it, male, validate --quick).
 void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
   if (!sk.hasGirdle) return;
   const GroupGains& shoulder = a.gains.shoulder;
@@ -406,12 +410,18 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
     auto spring = [&](const Endpoint& p, const Endpoint& q) {
       sink.add(ElementGroup::Cartilage, p, q, shoulder, 0.0);
     };
-    // an accessory inspiratory muscle: the shoulder springs' passive gains, driven with the external
-    // intercostals above its recruitment threshold (passive springs when muscle_gains.json has no
-    // accessory_muscles block)
-    auto accessory = [&](const Endpoint& p, const Endpoint& q) {
-      if (!(a.gains.accessory.kac > 0.0)) return spring(p, q);
-      const GroupGains g{a.gains.accessory.kac, shoulder.kpe, shoulder.damping};
+    // the girdle's suspension from the neck (levator scapulae, the rhomboid from C7): the tone that holds the
+    // shoulders' height, kpe AnatomyParams::Gains::shoulderSuspension
+    const GroupGains suspension{0.0, a.gains.shoulderSuspension, shoulder.damping};
+    auto suspend = [&](const Endpoint& p, const Endpoint& q) {
+      sink.add(ElementGroup::Cartilage, p, q, suspension, 0.0);
+    };
+    // an accessory inspiratory muscle, driven with the external intercostals above its recruitment threshold,
+    // with the passive gains `passive` (passive springs when muscle_gains.json has no accessory_muscles
+    // block)
+    auto accessory = [&](const Endpoint& p, const Endpoint& q, const GroupGains& passive) {
+      if (!(a.gains.accessory.kac > 0.0)) return sink.add(ElementGroup::Cartilage, p, q, passive, 0.0);
+      const GroupGains g{a.gains.accessory.kac, passive.kpe, passive.damping};
       sink.add(ElementGroup::IntercostalExternal, p, q, g, 1.0, 1.0, a.gains.accessory.recruitment);
     };
 
@@ -424,24 +434,26 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
                rib);
     }
     const Endpoint mastoid = Endpoint::onBody(sk.head, s.mastoid);
-    accessory(mastoid, Endpoint::onBody(sk.sternum, sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) +
-                                                        0.01 * sk.sternumAxis));
-    accessory(mastoid, clavicle(0.08));
+    accessory(mastoid,
+              Endpoint::onBody(sk.sternum,
+                               sk.jugularNotch + Eigen::Vector3d(sx * 0.012, 0, 0) + 0.01 * sk.sternumAxis),
+              shoulder);
+    accessory(mastoid, clavicle(0.08), shoulder);
 
     // trapezius: upper (accessory) from the neck to the clavicle and acromion, middle and lower from T1-T7
     // to the scapular spine
-    accessory(cervical(2, 0.0), clavicle(0.75));
-    accessory(cervical(4, 0.0), scapula(s.acromion));
-    accessory(cervical(7, 0.0), superiorBorder(0.8));
+    accessory(cervical(2, 0.0), clavicle(0.75), suspension);
+    accessory(cervical(4, 0.0), scapula(s.acromion), suspension);
+    accessory(cervical(7, 0.0), superiorBorder(0.8), suspension);
     spring(spinous(1), superiorBorder(0.3));
     spring(spinous(3), superiorBorder(0.5));
     spring(spinous(5), scapula(s.spineRoot));
     spring(spinous(7), medialBorder(0.2));
     // levator scapulae: C1 and C3 transverse processes to the superior angle
-    spring(cervical(1, sx * 0.03), scapula(s.superiorAngle));
-    spring(cervical(3, sx * 0.03), medialBorder(0.1));
+    suspend(cervical(1, sx * 0.03), scapula(s.superiorAngle));
+    suspend(cervical(3, sx * 0.03), medialBorder(0.1));
     // rhomboids: C7-T4 to the medial border
-    spring(cervical(7, 0.0), medialBorder(0.1));
+    suspend(cervical(7, 0.0), medialBorder(0.1));
     spring(spinous(2), medialBorder(0.5));
     spring(spinous(4), medialBorder(0.9));
     // serratus anterior: the medial border round the chest wall to ribs 2-8 laterally

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -146,14 +147,18 @@ TEST(AnatomyParams, OverlappingRibsAreRejectedNamingTheLevels) {
 }
 
 TEST(AnatomyParams, BadGainsAreRejectedNamingTheFile) {
-  nlohmann::json g = nlohmann::json::parse(read(kDir + "muscle_gains.json"));
-  g["groups"]["diaphragm"]["kpe"] = -1;
-  try {
-    parseAnatomy(read(kDir + "male.json"), g.dump(), "male.json", "muscle_gains.json");
-    FAIL() << "negative gain accepted";
-  } catch (const sim::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("muscle_gains.json: groups.diaphragm.kpe"), std::string::npos)
-        << e.what();
+  for (const char* field :
+       {"/groups/diaphragm/kpe", "/shoulder_springs/suspension_kpe", "/scapulothoracic/kpe"}) {
+    nlohmann::json g = nlohmann::json::parse(read(kDir + "muscle_gains.json"));
+    g[nlohmann::json::json_pointer(field)] = -1;
+    std::string name = std::string(field).substr(1);
+    std::replace(name.begin(), name.end(), '/', '.');
+    try {
+      parseAnatomy(read(kDir + "male.json"), g.dump(), "male.json", "muscle_gains.json");
+      ADD_FAILURE() << "negative gain accepted: " << field;
+    } catch (const sim::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("muscle_gains.json: " + name), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -176,6 +176,10 @@ struct Gains {
   /// length: Zordan et al. 2004, Table 1, the 52 shoulder elements (kpe 10, b 1), and the
   /// sternocleidomastoids
   GroupGains shoulder{};
+  /// [N/m] kpe of the shoulder springs that hang the girdle from the neck (levator scapulae, the rhomboid
+  /// from C7, and the passive part of the upper trapezius): the postural tone that holds the shoulders'
+  /// height (muscle_gains.json `shoulder_springs.suspension_kpe`; optional, the shoulder kpe when absent)
+  double shoulderSuspension = 0.0;
   AccessoryGains accessory{};  ///< the sternocleidomastoids' and upper trapezius' drive
   /// [N/m], [N s/m] kpe and b (kac unused) of the scapulothoracic gliding springs that hold each scapula's
   /// front face off the ribs under it (muscle_gains.json `scapulothoracic`; optional, kpe 0 and none when
