@@ -336,19 +336,18 @@ int ribUnder(const Skeleton& sk, int side, const Eigen::Vector3d& p) {
 
 /// The neck and the shoulder girdle (AnatomyParams::hasShoulderGirdle), per side:
 ///  - scalenes: from the cervical transverse processes (kScaleneNeckOffset off the midline, kScaleneNeckRise
-///    above rib 1, C3-C4) to the front half of rib 1
-///    (scalenus anterior, medius; the posterior to rib 2 is folded into them), structural springs with the
-///    cartilage group's gains like the model's scalenes without a neck (addScalenes()). Each runs in its rib
-///    point's sagittal plane, tilted inwards only: a fore-aft tilt braces rib 1, and with it the upper
-///    thoracic spine, against the fixed neck. From C3-C5 (2.8 cm off the midline, level with the vertebral
-///    bodies, up to 12 deg forward) the backward sway of the spine in a deep inhale was -0.10 mm (validate's
-///    sway.backward, male, --quick; -0.71 mm without the girdle, -0.14 mm without scalenes), in the sagittal
-///    plane -0.15 mm. Vertical springs on the middle of rib 1 (the model without the girdle) give -0.73 mm
-///    but leave the skin at the base of the neck. On the back half of rib 1 they pulled rib 1 and T1 forward
-///    and the spine swayed forward on a deep inhale. In a calm breath T1-T3 moves 3.0 mm forward (1.3 mm
-///    without the girdle); added to these, 6 cm vertical springs on the middle of rib 1 gave 1.1 mm but
-///    leave the skin, 2.5 cm ones (inside it, and stiffer) pulled T1-T3 1.1 mm back, and ones to the
-///    transverse processes of C5 2.3-3.6 mm forward;
+///    above rib 1, C3-C4) to the front half of rib 1 (scalenus anterior, medius; the posterior to rib 2 is
+///    folded into them), structural springs with the cartilage group's gains like the model's scalenes
+///    without a neck (addScalenes()). Each runs in its rib point's sagittal plane, tilted inwards only: a
+///    fore-aft tilt braces rib 1, and with it the upper thoracic spine, against the fixed neck. From C3-C5
+///    (2.8 cm off the midline, level with the vertebral bodies, up to 12 deg forward) the backward sway of
+///    the spine in a deep inhale was -0.10 mm (validate's sway.backward, male, --quick; -0.71 mm without the
+///    girdle, -0.14 mm without scalenes), in the sagittal plane -0.15 mm. Vertical springs on the middle of
+///    rib 1 (the model without the girdle) give -0.73 mm but leave the skin at the base of the neck. On the
+///    back half of rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale. In a
+///    calm breath T1-T3 moves 3.0 mm forward (1.3 mm without the girdle); added to these, 6 cm vertical
+///    springs on the middle of rib 1 gave 1.1 mm but leave the skin, 2.5 cm ones (inside it, and stiffer)
+///    pulled T1-T3 1.1 mm back, and ones to the transverse processes of C5 2.3-3.6 mm forward;
 ///  - sternocleidomastoid: from the mastoid process to the manubrium (sternal head) and the medial clavicle
 ///    (clavicular head);
 ///  - Breathe Easy's 26 shoulder elements (Zordan et al. 2004, Table 1: 52 in all), passive at the shoulder
@@ -475,10 +474,10 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
     // nearest), kScapulothoracicLength deep, hold the blade off the ribs while it slides over them (the
     // springs' length changes by the normal motion only; a tangential slide d lengthens them by
     // d^2 / (2 kScapulothoracicLength), 1 mm for 15 mm)
-    Eigen::Vector3d inward =
-        (s.acromion - s.superiorAngle).cross(s.inferiorAngle - s.superiorAngle).normalized();
-    if (inward.y() < 0) inward = -inward;  // the blade's normal, into the chest
-    if (a.gains.scapulothoracic.kpe > 0.0)
+    if (a.gains.scapulothoracic.kpe > 0.0) {
+      Eigen::Vector3d inward =
+          (s.acromion - s.superiorAngle).cross(s.inferiorAngle - s.superiorAngle).normalized();
+      if (inward.y() < 0) inward = -inward;  // the blade's normal, into the chest
       for (double f : {0.15, 0.5, 0.85}) {
         const Eigen::Vector3d medial = s.superiorAngle + f * (s.inferiorAngle - s.superiorAngle);
         const Eigen::Vector3d lateral = s.acromion + f * (s.inferiorAngle - s.acromion);
@@ -489,6 +488,7 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
                    a.gains.scapulothoracic, 0.0);
         }
       }
+    }
   }
 }
 
