@@ -172,7 +172,10 @@ TEST(SeriesRange, CountIsWhatTheSelectorKeeps) {
       if (!selector.take(t)) continue;
       EXPECT_GE(t, r.from - 1e-9);
       EXPECT_LE(t, r.to + 1e-9);
-      if (kept > 0) EXPECT_NEAR(t - previous, r.stride / rate, 1e-9);  // every stride-th frame
+      // every stride-th frame
+      if (kept > 0) {
+        EXPECT_NEAR(t - previous, r.stride / rate, 1e-9);
+      }
       previous = t;
       ++kept;
     }
