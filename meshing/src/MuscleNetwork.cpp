@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <tuple>
 #include <utility>
 
@@ -318,22 +317,6 @@ void addScalenes(const Skeleton& sk, ElementSink& sink) {
   }
 }
 
-/// The rib (body index) of levels 2-8 on `side` whose centreline passes nearest to `p` [m] (sampled every
-/// 2 mm).
-int ribUnder(const Skeleton& sk, int side, const Eigen::Vector3d& p) {
-  int best = -1;
-  double bestDistance = std::numeric_limits<double>::infinity();
-  for (int level = 2; level <= 8; ++level) {
-    const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
-    for (double s = 0.0; s <= r.length(); s += 0.002)
-      if ((r.at(s) - p).norm() < bestDistance) {
-        bestDistance = (r.at(s) - p).norm();
-        best = sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
-      }
-  }
-  return best;
-}
-
 /// The neck and the shoulder girdle (AnatomyParams::hasShoulderGirdle), per side:
 ///  - scalenes: from the cervical transverse processes (kScaleneNeckOffset off the midline, kScaleneNeckRise
 ///    above rib 1, C3-C4) to the front half of rib 1 (scalenus anterior, medius; the posterior to rib 2 is
@@ -478,13 +461,21 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
       Eigen::Vector3d inward =
           (s.acromion - s.superiorAngle).cross(s.inferiorAngle - s.superiorAngle).normalized();
       if (inward.y() < 0) inward = -inward;  // the blade's normal, into the chest
+      // the centrelines of ribs 2-8 on this side, every 2 mm: the nearest is the rib under a blade point
+      std::vector<Endpoint> ribs;
+      for (int level = 2; level <= 8; ++level) {
+        const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
+        for (double t = 0.0; t <= r.length(); t += 0.002)
+          ribs.push_back(Endpoint::onBody(
+              sk.rib[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)], r.at(t)));
+      }
       for (double f : {0.15, 0.5, 0.85}) {
         const Eigen::Vector3d medial = s.superiorAngle + f * (s.inferiorAngle - s.superiorAngle);
         const Eigen::Vector3d lateral = s.acromion + f * (s.inferiorAngle - s.acromion);
         for (double w : {0.0, 0.4}) {
           const Eigen::Vector3d p = medial + w * (lateral - medial);
           sink.add(ElementGroup::Cartilage, scapula(p),
-                   Endpoint::onBody(ribUnder(sk, side, p), p + kScapulothoracicLength * inward),
+                   Endpoint::onBody(nearest(ribs, p).body, p + kScapulothoracicLength * inward),
                    a.gains.scapulothoracic, 0.0);
         }
       }
