@@ -10,6 +10,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "SurfaceCrossings.h"
 #include "TissueChecks.h"
@@ -55,6 +56,22 @@ int joint(const sim::Model& m, const std::string& name) {
   for (int j = 0; j < m.joints.size(); ++j)
     if (m.joints.name[static_cast<std::size_t>(j)] == name) return j;
   return -1;
+}
+
+/// The scapulothoracic springs of `m`: 100 mm from a scapula to a rib (the serratus anterior's and pectoralis
+/// minor's also run from a scapula to a rib, and are shoulder springs).
+std::vector<int> scapulothoracicSprings(const sim::Model& m) {
+  const Eigen::Matrix3Xd from = restPoints(m.elements.endA, m), to = restPoints(m.elements.endB, m);
+  const auto named = [&](int b, const char* prefix) {
+    return b >= 0 && m.bodies.name[static_cast<std::size_t>(b)].rfind(prefix, 0) == 0;
+  };
+  std::vector<int> springs;
+  for (int e = 0; e < m.elements.size(); ++e)
+    if (named(m.elements.endA.body[static_cast<std::size_t>(e)], "scapula") &&
+        named(m.elements.endB.body[static_cast<std::size_t>(e)], "rib") &&
+        std::abs((to.col(e) - from.col(e)).norm() - 0.1) < 1e-9)
+      springs.push_back(e);
+  return springs;
 }
 
 class GirdlePresets : public ::testing::TestWithParam<std::string> {};
@@ -142,19 +159,15 @@ TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   const int head = body(m, "head"), cervical = body(m, "cervical_spine");
   const std::set<int> girdle = {body(m, "clavicle_right"), body(m, "clavicle_left"), body(m, "scapula_right"),
                                 body(m, "scapula_left"),   body(m, "humerus_right"), body(m, "humerus_left")};
-  std::set<int> ribs;
-  for (int b = 0; b < m.bodies.size(); ++b)
-    if (m.bodies.name[static_cast<std::size_t>(b)].rfind("rib", 0) == 0) ribs.insert(b);
+  const std::vector<int> glide = scapulothoracicSprings(m);
   const Eigen::Matrix3Xd from = restPoints(m.elements.endA, m), to = restPoints(m.elements.endB, m);
   for (int e = 0; e < m.elements.size(); ++e) {
     const int a = m.elements.endA.body[static_cast<std::size_t>(e)],
               b = m.elements.endB.body[static_cast<std::size_t>(e)];
-    const std::string& nameA = a >= 0 ? m.bodies.name[static_cast<std::size_t>(a)] : std::string();
     const Eigen::Vector3d d = to.col(e) - from.col(e);
-    // the scapulothoracic springs: 100 mm from the blade to a rib (the serratus anterior's and pectoralis
-    // minor's are shoulder springs)
-    if (nameA.rfind("scapula", 0) == 0 && ribs.count(b) && std::abs(d.norm() - 0.1) < 1e-9) {
+    if (std::find(glide.begin(), glide.end(), e) != glide.end()) {
       ++scapulothoracic;
+      const std::string& nameA = m.bodies.name[static_cast<std::size_t>(a)];
       // along the blade's normal, into the chest: square to the line from the blade to the acromion, and
       // nearly horizontal
       const std::string n = nameA == "scapula_right" ? "_right" : "_left";
@@ -201,15 +214,9 @@ TEST_P(GirdlePresets, ShoulderBladesSlideOnTheRibs) {
   sim::PosedGeometry in, out;
   sim::poseGeometry(*model, r.endExpiration, out);
   sim::poseGeometry(*model, r.endInspiration, in);
-  const Eigen::Matrix3Xd a = restPoints(model->elements.endA, *model),
-                         b = restPoints(model->elements.endB, *model);
   int springs = 0;
   double stretch = 0.0, moved = 0.0;
-  for (int e = 0; e < model->elements.size(); ++e) {
-    const int from = model->elements.endA.body[static_cast<std::size_t>(e)];
-    if (from < 0 || model->bodies.name[static_cast<std::size_t>(from)].rfind("scapula", 0) != 0 ||
-        std::abs((b.col(e) - a.col(e)).norm() - 0.1) > 1e-9)
-      continue;
+  for (int e : scapulothoracicSprings(*model)) {
     ++springs;
     const auto length = [&](const sim::PosedGeometry& g) {
       return (g.elementB.col(e) - g.elementA.col(e)).norm();
