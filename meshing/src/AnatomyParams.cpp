@@ -146,7 +146,7 @@ Gains readGains(const Reader& r) {
                "abdominal_wall_tone_upright", "lung_recoil_cmh2o", "lung_compliance_l_per_cmh2o",
                "apposition_stiffness_fraction", "intercostal_external_space_scale", "gut_wall_mass_kg",
                "diaphragm_mass_kg", "joints", "shoulder_springs", "accessory_muscles", "scapulothoracic",
-               "tissue_bodies"});
+               "first_costal_cartilage_stiffness_scale", "scalenes", "tissue_bodies"});
   Gains g;
   g.referenceLength = r.at("reference_length_m").positiveAtMost(1.0);
   const Reader groups = r.at("groups");
@@ -172,6 +172,19 @@ Gains readGains(const Reader& r) {
   g.lungRecoil = r.at("lung_recoil_cmh2o").numberIn(0.0, 30.0) * kPaPerCmH2O;
   g.lungCompliance = r.at("lung_compliance_l_per_cmh2o").numberIn(0.0, 2.0) * 1e-3 / kPaPerCmH2O;
   g.appositionFraction = r.at("apposition_stiffness_fraction").numberIn(0.0, 10.0);
+  // optional: the cartilage group's stiffness when absent
+  if (r.has("first_costal_cartilage_stiffness_scale"))
+    g.firstCartilageScale = r.at("first_costal_cartilage_stiffness_scale").numberIn(0.01, 100.0);
+  // optional: passive springs with the cartilage group's gains when absent
+  g.scalenes = g.group[static_cast<std::size_t>(sim::ElementGroup::Cartilage)];
+  g.scalenes.kac = 0.0;
+  if (r.has("scalenes")) {
+    const Reader sc = r.at("scalenes");
+    sc.allowKeys({"description", "kac", "kpe", "b"});
+    g.scalenes.kac = sc.at("kac").numberIn(0.0, 1e9);
+    g.scalenes.kpe = sc.at("kpe").numberIn(0.0, 1e9);
+    g.scalenes.damping = sc.at("b").numberIn(0.0, 1e9);
+  }
   // optional: 1 in every space when absent
   if (r.has("intercostal_external_space_scale")) {
     const Reader spaces = r.at("intercostal_external_space_scale");

@@ -268,8 +268,9 @@ std::array<Eigen::Vector3d, 3> triad(const Eigen::Vector3d& p, const Eigen::Vect
 }
 
 /// Costal cartilage: a 3 x 3 bipartite spring truss (structurally stable) from each rib tip to the
-/// sternum (ribs 1-7) or to the tip of the rib above (ribs 8-10).
-void addCartilage(const Skeleton& sk, ElementSink& sink) {
+/// sternum (ribs 1-7) or to the tip of the rib above (ribs 8-10); rib 1's (the synchondrosis with the
+/// manubrium) `a.gains.firstCartilageScale` times stiffer.
+void addCartilage(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
   for (int level = 1; level <= 10; ++level) {
     for (int side : {kRight, kLeft}) {
       const RibCurve& r = sk.ribCurve[static_cast<std::size_t>(level - 1)][static_cast<std::size_t>(side)];
@@ -289,13 +290,22 @@ void addCartilage(const Skeleton& sk, ElementSink& sink) {
         const double sa = above.length() - 0.01;
         otherPts = triad(above.at(sa), above.normal.back(), -above.tangent(sa));
       }
+      const double stiffness = level == 1 ? a.gains.firstCartilageScale : 1.0;
       for (const Eigen::Vector3d& p : ribPts) {
         for (const Eigen::Vector3d& q : otherPts) {
-          sink.add(ElementGroup::Cartilage, Endpoint::onBody(b, p), Endpoint::onBody(other, q));
+          sink.add(ElementGroup::Cartilage, Endpoint::onBody(b, p), Endpoint::onBody(other, q), 1.0,
+                   stiffness);
         }
       }
     }
   }
+}
+
+/// One scalene from `neck` to `rib` (on rib 1) with the gains `a.gains.scalenes`: an inspiratory muscle of
+/// the external intercostal group (driven with them) when it has a kac, else a passive spring.
+void addScalene(const AnatomyParams& a, const Endpoint& neck, const Endpoint& rib, ElementSink& sink) {
+  const GroupGains& g = a.gains.scalenes;
+  sink.add(g.kac > 0.0 ? ElementGroup::IntercostalExternal : ElementGroup::Cartilage, neck, rib, g);
 }
 
 /// Scalenes: rib 1 hangs from the cervical spine (scalenus anterior, medius, posterior), which holds it
@@ -303,16 +313,15 @@ void addCartilage(const Skeleton& sk, ElementSink& sink) {
 /// together instead of lifting them (Hamberger's lever needs rib 1 held; De Troyer et al. 2005,
 /// Physiol Rev 85:717). The model has no cervical spine, so three passive structural springs per side
 /// run from rib 1 up by kScaleneLength to anchors on the fixed lumbar-spine body (a fixed world point).
-void addScalenes(const Skeleton& sk, ElementSink& sink) {
+void addScalenes(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
   if (sk.hasGirdle) return;  // addNeckAndShoulders() hangs rib 1 from the cervical spine
   for (int side : {kRight, kLeft}) {
     const RibCurve& r = sk.ribCurve[0][static_cast<std::size_t>(side)];
     const int b = sk.rib[0][static_cast<std::size_t>(side)];
     for (double f : {0.3, 0.5, 0.7}) {
       const Eigen::Vector3d p = r.at(f * r.length());
-      sink.add(ElementGroup::Cartilage,
-               Endpoint::onBody(sk.lumbar, p + kScaleneLength * Eigen::Vector3d::UnitZ()),
-               Endpoint::onBody(b, p));
+      addScalene(a, Endpoint::onBody(sk.lumbar, p + kScaleneLength * Eigen::Vector3d::UnitZ()),
+                 Endpoint::onBody(b, p), sink);
     }
   }
 }
@@ -410,10 +419,10 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
     // scalenes, each in its rib point's sagittal plane, and sternocleidomastoid
     for (double f : {0.8, 0.88, 0.96}) {
       const Endpoint rib = ribAt(1, side, f);
-      sink.add(ElementGroup::Cartilage,
-               Endpoint::onBody(sk.cervical, Eigen::Vector3d(sx * kScaleneNeckOffset, rib.world.y(),
-                                                             rib.world.z() + kScaleneNeckRise)),
-               rib);
+      addScalene(a,
+                 Endpoint::onBody(sk.cervical, Eigen::Vector3d(sx * kScaleneNeckOffset, rib.world.y(),
+                                                               rib.world.z() + kScaleneNeckRise)),
+                 rib, sink);
     }
     const Endpoint mastoid = Endpoint::onBody(sk.head, s.mastoid);
     accessory(mastoid,
@@ -492,8 +501,8 @@ void buildElements(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   addApposition(a, sk, gut, sink);
   addRectus(sk, gut, sink);
   addTransversusObliques(gut, sink);
-  addCartilage(sk, sink);
-  addScalenes(sk, sink);
+  addCartilage(a, sk, sink);
+  addScalenes(a, sk, sink);
   addNeckAndShoulders(a, sk, sink);
 }
 

@@ -215,6 +215,48 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
   return out;
 }
 
+namespace {
+
+// the ribs' motion from end-expiration to end-inspiration of a run (as Wilson et al. 1987 measured it, FRC to
+// TLC, from the bones' poses)
+struct RibTurn {
+  double firstRibCranial = kNaN;  // [m] cranial motion of rib 1's centre of mass, mean of both sides
+  double axisFromMidsagittal =
+      kNaN;  // [rad] angle between the rotation axis and the midsagittal plane, mean of ribs 3-7
+};
+
+RibTurn ribTurn(const StyleRun& r) {
+  RibTurn out;
+  if (!r.hasBreathPoses || !r.model) return out;
+  const Model& m = *r.model;
+  const State& a = r.endExpiration;
+  const State& b = r.endInspiration;
+  double lift = 0.0;
+  double angle = 0.0;
+  int nLift = 0;
+  int nAngle = 0;
+  for (int j = 0; j < m.joints.size(); ++j) {
+    int level = 0;
+    if (std::sscanf(m.joints.name[static_cast<std::size_t>(j)].c_str(), "costovertebral_rib%d_", &level) != 1)
+      continue;
+    const int c = m.joints.child[static_cast<std::size_t>(j)];
+    const Eigen::AngleAxisd turn(b.bodyOrientation[static_cast<std::size_t>(c)] *
+                                 a.bodyOrientation[static_cast<std::size_t>(c)].inverse());
+    if (level == 1) {
+      lift += b.bodyPosition(2, c) - a.bodyPosition(2, c);
+      ++nLift;
+    } else if (level >= 3 && level <= 7 && turn.angle() > 0.0) {
+      angle += std::asin(std::min(1.0, std::abs(turn.axis().x())));
+      ++nAngle;
+    }
+  }
+  if (nLift > 0) out.firstRibCranial = lift / nLift;
+  if (nAngle > 0) out.axisFromMidsagittal = angle / nAngle;
+  return out;
+}
+
+}  // namespace
+
 std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
   const StyleRun* calm = nullptr;
   const StyleRun* deep = nullptr;
@@ -248,6 +290,33 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
     out.push_back(check("physiology.calm.phase", "rib-cage / abdomen phase angle, calm", "< 30 deg",
                         "12-23 deg in healthy young adults (Chen et al. 2015)", "deg",
                         m.phaseAngle * 180.0 / M_PI, 0.0, 30.0));
+    // the sternum moves forward and up at both ends (pump handle), the ribs turn about axes near their necks,
+    // and rib 1 rises with them instead of being pulled down by the first space's intercostals
+    out.push_back(check("physiology.calm.sternum_forward_up",
+                        "sternum motion, calm: the smallest of the jugular notch's and the xiphoid's "
+                        "anterior and cranial motion",
+                        "> 0 mm (forward and up at both ends)",
+                        "the pump-handle motion: ribs 2-9 rotate up, out and forward about their neck axes "
+                        "(Jordanoglou 1969, "
+                        "Thorax 24:407)",
+                        "mm",
+                        kMm * std::min(std::min(m.sternumAnterior, m.sternumCranial),
+                                       std::min(m.xiphoidAnterior, m.xiphoidCranial)),
+                        1e-9, kBig));
+    const RibTurn turn = ribTurn(*calm);
+    if (std::isfinite(turn.firstRibCranial))
+      out.push_back(check("physiology.calm.first_rib_cranial",
+                          "rib 1's cranial motion (centre of mass, mean of both sides), calm",
+                          "> 0 mm (rises; no paradoxical motion)",
+                          "the scalenes fire with every quiet breath; without them the upper rib cage moves "
+                          "paradoxically (J Appl Physiol 1984, 57:899)",
+                          "mm", turn.firstRibCranial * kMm, 1e-9, kBig));
+    if (std::isfinite(turn.axisFromMidsagittal))
+      out.push_back(check("physiology.calm.rib_axis_angle",
+                          "ribs 3-7: angle of their rotation axes from the midsagittal plane, mean, calm",
+                          "20 - 50 deg",
+                          "about 35 deg for ribs 3-7 (CT, Wilson et al. 1987, J Appl Physiol 62:1872)", "deg",
+                          turn.axisFromMidsagittal * 180.0 / M_PI, 20.0, 50.0));
     out.push_back(check("physiology.calm.flow_reversals", "flow (dV/dt) sign changes per breath, calm", "2",
                         "a spirogram: one inspiration, one expiration", "-", m.flowSignChanges, 2.0, 2.0));
     out.push_back(check("physiology.calm.flow_jump", "largest frame-to-frame flow change, calm",

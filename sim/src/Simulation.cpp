@@ -13,7 +13,8 @@
 namespace pneuma::sim {
 
 namespace {
-constexpr long long kCheckpointVersion = 3;  // 2 adds simulation.posture, 3 the volume bodies
+constexpr long long kCheckpointVersion = 4;  // 2 adds simulation.posture, 3 the volume bodies, 4 the pattern
+                                             // drive's internal intercostal lag
 }  // namespace
 
 void validateSimulationOptions(const SimulationOptions& o) {

@@ -148,7 +148,8 @@ TEST(AnatomyParams, OverlappingRibsAreRejectedNamingTheLevels) {
 
 TEST(AnatomyParams, BadGainsAreRejectedNamingTheFile) {
   for (const char* field :
-       {"/groups/diaphragm/kpe", "/shoulder_springs/suspension_kpe", "/scapulothoracic/kpe"}) {
+       {"/groups/diaphragm/kpe", "/shoulder_springs/suspension_kpe", "/scapulothoracic/kpe", "/scalenes/kac",
+        "/first_costal_cartilage_stiffness_scale"}) {
     nlohmann::json g = nlohmann::json::parse(read(kDir + "muscle_gains.json"));
     g[nlohmann::json::json_pointer(field)] = -1;
     std::string name = std::string(field).substr(1);

@@ -99,9 +99,12 @@ constexpr bool kEnforceWallCrossings = false;
 // session 17; 19 and 92 with the dome's cap triangulated Delaunay (meshing/src/GutSurface.cpp: in total 175
 // -> 111; the gut's and the cavity's own 2 -> 0, the lungs with the cavity 93 -> 66, with the gut 40 -> 11; a
 // sliver beside the apex turned over at calm end-inspiration, and a fifth of the lung crossings were with the
-// cavity's floor triangles on it). The budgets leave about 10 % for the run-to-run spread of other changes.
+// cavity's floor triangles on it); 16 and 127 with the rib necks' lock at 300 N m/rad, the driven scalenes
+// and the stiff first costal cartilage (resources/anatomy/README.md, "Rib motion"): the upper ribs now rise,
+// and at joy's deep end-inspiration the left lung's own crossings went 6 -> 14, the lungs' with the cavity 17
+// -> 38. The budgets leave about 10 % for the run-to-run spread of other changes.
 constexpr int kStyleCrossingBudget = 21;
-constexpr int kAffectCrossingBudget = 101;
+constexpr int kAffectCrossingBudget = 140;
 
 // runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
 // settling: the two lungs never cross each other nor does a mediastinal face cross anything; the other

@@ -60,9 +60,12 @@ struct Channel {
 struct Levers {
   Channel chest, belly;
 };
-Levers levers(const DriveCalibration& c) {
-  auto lever = [&c](ElementGroup g, double sign) {
-    return Lever{reach(c.response[idx(g)], sign), c.timeConstant[idx(g)]};
+// the levers of calibration `c`; `internalLag` [s] (PatternControllerOptions::internalIntercostalLag) is
+// added to the internal intercostals' lag
+Levers levers(const DriveCalibration& c, double internalLag = 0.0) {
+  auto lever = [&c, internalLag](ElementGroup g, double sign) {
+    const double lag = g == ElementGroup::IntercostalInternal ? internalLag : 0.0;
+    return Lever{reach(c.response[idx(g)], sign), c.timeConstant[idx(g)] + lag};
   };
   Levers l;
   l.chest = {lever(ElementGroup::IntercostalExternal, 1.0), lever(ElementGroup::IntercostalInternal, -1.0)};
@@ -247,7 +250,7 @@ PatternController::PatternController(LayerStack stack, DriveCalibration calibrat
   if (!(c.contractionR > 0.0 && c.contractionR <= 1.5))
     throw Error("calibration.contractionR: must be in (0, 1.5]");
   if (!(options.kp >= 0.0 && options.ki >= 0.0 && options.integralLimit >= 0.0 &&
-        options.balanceTimeConstant > 0.0))
+        options.balanceTimeConstant > 0.0 && options.internalIntercostalLag >= 0.0))
     throw Error("pattern controller options: gains and times must be >= 0 (balanceTimeConstant > 0)");
   m_balance = m_stack.balance();
 }
@@ -285,7 +288,7 @@ void PatternController::restart() {
   m_restVolumeSeen = 0.0;
   m_lastTime = m_lastFrameControlTime = m_startTime = 0.0;
   m_lastFrameTime = -1.0;
-  m_target = m_targetRate = m_measured = m_error = m_integral = m_traceStart = 0.0;
+  m_target = m_targetRate = m_measured = m_error = m_integral = m_traceStart = m_internalAlpha = 0.0;
   m_balance = m_stack.balance();
   m_tracking = TrackingStats();
 }
@@ -329,7 +332,7 @@ Activations PatternController::activations(double t, const Metrics& latest) {
     m_error = m_target - m_measured;
     // anti-windup: integrate only while the muscles can still give what the error asks for
     const double demand = feedForward + m_options.kp * m_error + m_integral;
-    const Levers l = levers(m_calibration);
+    const Levers l = levers(m_calibration, m_options.internalIntercostalLag);
     const bool isSaturated = m_error > 0.0 ? demand >= l.chest.in.capacity() + l.belly.in.capacity()
                                            : -demand >= l.chest.out.capacity() + l.belly.out.capacity();
     if (!isSaturated)
@@ -348,13 +351,20 @@ Activations PatternController::activations(double t, const Metrics& latest) {
   m_balance += (m_stack.balance() - m_balance) * (1.0 - std::exp(-dt / m_options.balanceTimeConstant));
 
   // feed-forward plus PI feedback, in volume-fraction units
-  return distribute(feedForward + m_options.kp * m_error + m_integral, m_targetRate, m_balance);
+  Activations a = distribute(feedForward + m_options.kp * m_error + m_integral, m_targetRate, m_balance);
+  // the internal intercostals follow their drive with a first-order lag (internalIntercostalLag)
+  double& internal = a[idx(ElementGroup::IntercostalInternal)].alpha;
+  const double lag = m_options.internalIntercostalLag;
+  m_internalAlpha =
+      lag > 0.0 ? m_internalAlpha + (internal - m_internalAlpha) * (1.0 - std::exp(-dt / lag)) : internal;
+  internal = m_internalAlpha;
+  return a;
 }
 
 Activations PatternController::distribute(double demand, double rate, double balance) const {
   Activations a = relaxedActivations();
   for (ElementGroup group : kDrivenGroups) a[idx(group)].r = m_calibration.contractionR;
-  const Levers l = levers(m_calibration);
+  const Levers l = levers(m_calibration, m_options.internalIntercostalLag);
   // split the target by the balance, each channel with its own lag compensation; a saturated channel
   // hands part of its share to the other
   const double chestWhole = channelDemand(demand, rate, l.chest),
@@ -386,9 +396,10 @@ std::unique_ptr<Controller> PatternController::clone() const {
 void PatternController::saveState(CheckpointWriter& out) const {
   out.write("pattern.description", m_description);
   out.write("pattern.isControlling", m_isControlling);
-  Eigen::Matrix<double, 12, 1> v;
+  Eigen::Matrix<double, 13, 1> v;
   v << m_calibration.restVolume, m_restVolumeSeen, m_lastTime, m_startTime, m_lastFrameTime,
-      m_lastFrameControlTime, m_target, m_targetRate, m_measured, m_error, m_integral, m_balance;
+      m_lastFrameControlTime, m_target, m_targetRate, m_measured, m_error, m_integral, m_balance,
+      m_internalAlpha;
   out.write("pattern.values", v);
   out.write("pattern.tracking.frames", m_tracking.frames);
   Eigen::Vector3d t(m_tracking.sumSquaredError, m_tracking.targetMin, m_tracking.targetMax);
@@ -403,7 +414,7 @@ void PatternController::loadState(CheckpointReader& in) {
     in.fail("pattern.description", "saved for pattern '" + description.substr(0, 60) + "', not '" +
                                        m_description.substr(0, 60) + "'");
   m_isControlling = in.readBool("pattern.isControlling");
-  Eigen::Matrix<double, 12, 1> v;
+  Eigen::Matrix<double, 13, 1> v;
   in.read("pattern.values", v);
   m_calibration.restVolume = v(0);
   m_restVolumeSeen = v(1);
@@ -417,6 +428,7 @@ void PatternController::loadState(CheckpointReader& in) {
   m_error = v(9);
   m_integral = v(10);
   m_balance = v(11);
+  m_internalAlpha = v(12);
   m_tracking.frames = in.readInt("pattern.tracking.frames");
   Eigen::Vector3d t;
   in.read("pattern.tracking.values", t);

@@ -170,6 +170,17 @@ struct Gains {
   /// Troyer, Kirkwood & Wilson 2005, Physiol Rev 85:717; De Troyer, Gorman & Gandevia 2002, J Physiol
   /// 546:943)
   std::array<double, 11> externalIntercostalSpaceScale{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  /// [-] stiffness of rib 1's costal cartilage as a multiple of the cartilage group's: the first sternocostal
+  /// joint is a synchondrosis, rib 1 and the manubrium move as one, while joints 2-7 are synovial (Gray's
+  /// Anatomy, the sternocostal joints). muscle_gains.json `first_costal_cartilage_stiffness_scale`
+  /// (optional, 1 when absent)
+  double firstCartilageScale = 1.0;
+  /// [N/m], [N s/m] kac, kpe and b of the scalenes (rib 1 to the neck) at the reference length. They are
+  /// inspiratory muscles driven with the external intercostals: they fire with every quiet breath and hold
+  /// rib 1 up against the pull of the first space's external intercostals; without them the upper rib cage
+  /// moves paradoxically (J Appl Physiol 1984, 57:899). muscle_gains.json `scalenes` (optional: passive
+  /// springs with the cartilage group's kpe and b when absent)
+  GroupGains scalenes{};
   /// gains per kind of joint, indexed by JointKind
   std::array<JointGains, kJointKinds.size()> joints{};
   /// [N/m], [N s/m] kpe and damping (kac unused) of the shoulder girdle's passive springs at the reference

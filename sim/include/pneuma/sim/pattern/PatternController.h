@@ -101,6 +101,14 @@ struct PatternControllerOptions {
   double ki = 50.0;                  ///< [1/s] integral gain
   double integralLimit = 0.2;        ///< [-] clamp of the integral term I, in fraction units
   double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
+  /// [s] first-order lag between the drive and the internal intercostals' activation, added to their lever's
+  /// lag in the feed-forward. They move the chest within one step (their calibrated lag is 0), and with the
+  /// rib necks' costotransverse lock of 300 N m/rad (resources/anatomy/README.md) the chest answers them in
+  /// an inflated breath several times as strongly as the calibration from rest says: without the lag the loop
+  /// chattered through focus's, panic's and startle's expirations (frame-to-frame flow jumps of 99-121 % of
+  /// peak flow, 3-4 reversals per breath). 0.05 s left focus at 52 % and panic at 61 %, 0.08 s and 0.1 s give
+  /// 37 / 43 and 33 / 44 % (docs/patterns.md, "Feedback"). 0: no lag.
+  double internalIntercostalLag = 0.1;
 };
 
 /// Target-versus-measured statistics over the frames seen after control started.
@@ -204,6 +212,7 @@ class PatternController : public Controller {
   double m_error = 0.0;                 // [-] e of the last frame
   double m_integral = 0.0;              // [-] I = ki * integral(e dt), clamped
   double m_balance = 0.5;               // [-] smoothed balance
+  double m_internalAlpha = 0.0;         // [-] the internal intercostals' lagged activation
   TrackingStats m_tracking;
   std::shared_ptr<const VolumeTrace> m_trace;  // the trace followed instead of m_stack; null for a pattern
   double m_traceStart = 0.0;                   // [-] fraction measured when control started (trace blend)
