@@ -260,6 +260,43 @@ void flipMediastinalFaces(TriangleMesh& lung, double faceX) {
   delaunayFlips(lung.triangles, lung.vertices.bottomRows<2>(), isFlat);  // the face's y-z coordinates
 }
 
+/// The flat mediastinal face of a lung (the plane x = faceX): its triangles and its boundary edges (the
+/// edges of one face triangle).
+struct MediastinalFace {
+  std::vector<int> flat;
+  std::vector<std::pair<int, int>> boundary;
+};
+
+MediastinalFace mediastinalFace(const TriangleMesh& lung, double faceX) {
+  MediastinalFace face;
+  for (int f = 0; f < lung.triangleCount(); ++f) {
+    bool isFlat = true;
+    for (int k = 0; k < 3; ++k)
+      isFlat = isFlat && std::abs(lung.vertices(0, lung.triangles(k, f)) - faceX) < kOnSurface;
+    if (isFlat) face.flat.push_back(f);
+  }
+  std::map<std::pair<int, int>, int> edgeCount;
+  for (const int f : face.flat)
+    for (int k = 0; k < 3; ++k) {
+      const int u = lung.triangles(k, f), v = lung.triangles((k + 1) % 3, f);
+      ++edgeCount[{std::min(u, v), std::max(u, v)}];
+    }
+  for (const auto& [e, n] : edgeCount)
+    if (n == 1) face.boundary.push_back(e);
+  return face;
+}
+
+/// [m] distance in the face's plane (y-z) from q to the boundary of `face`.
+double boundaryDistance(const TriangleMesh& lung, const MediastinalFace& face, const Eigen::Vector2d& q) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [u, v] : face.boundary) {
+    const Eigen::Vector2d p0 = lung.vertices.col(u).tail<2>(), d = lung.vertices.col(v).tail<2>() - p0;
+    const double s = std::clamp((q - p0).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (p0 + s * d - q).norm());
+  }
+  return best;
+}
+
 /// [m] spacing of the points added inside each lung's mediastinal face (addFacePoints()). Measured on the
 /// default model (crossing pairs summed over every style and affect, tests/validation/Surfaces_test.cpp):
 /// 669 without them; at 7, 10, 12, 15, 18, 20, 22, 25, 28, 30, 35 mm: 847, 594, 436, 227, 196, 285, 201, 177,
@@ -276,37 +313,13 @@ constexpr double kFacePointSpacing = 0.025;
 /// face's inside follows the walls above and below each point.
 void addFacePoints(TriangleMesh& lung, double faceX) {
   const auto yz = [&](int v) { return Eigen::Vector2d(lung.vertices(1, v), lung.vertices(2, v)); };
-  std::vector<int> flat;  // the face's triangles
-  for (int f = 0; f < lung.triangleCount(); ++f) {
-    bool isFlat = true;
-    for (int k = 0; k < 3; ++k)
-      isFlat = isFlat && std::abs(lung.vertices(0, lung.triangles(k, f)) - faceX) < kOnSurface;
-    if (isFlat) flat.push_back(f);
-  }
-  // the face's boundary: the edges of one flat triangle
-  std::map<std::pair<int, int>, int> edgeCount;
-  for (const int f : flat)
-    for (int k = 0; k < 3; ++k) {
-      const int u = lung.triangles(k, f), v = lung.triangles((k + 1) % 3, f);
-      ++edgeCount[{std::min(u, v), std::max(u, v)}];
-    }
-  std::vector<std::pair<int, int>> boundary;
+  MediastinalFace face = mediastinalFace(lung, faceX);
+  std::vector<int>& flat = face.flat;
   Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
-  for (const auto& [e, n] : edgeCount) {
-    if (n != 1) continue;
-    boundary.push_back(e);
-    lo = lo.cwiseMin(yz(e.first)).cwiseMin(yz(e.second));
-    hi = hi.cwiseMax(yz(e.first)).cwiseMax(yz(e.second));
+  for (const auto& [u, v] : face.boundary) {
+    lo = lo.cwiseMin(yz(u)).cwiseMin(yz(v));
+    hi = hi.cwiseMax(yz(u)).cwiseMax(yz(v));
   }
-  const auto boundaryDistance = [&](const Eigen::Vector2d& q) {
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& [u, v] : boundary) {
-      const Eigen::Vector2d p0 = yz(u), d = yz(v) - p0;
-      const double s = std::clamp((q - p0).dot(d) / d.squaredNorm(), 0.0, 1.0);
-      best = std::min(best, (p0 + s * d - q).norm());
-    }
-    return best;
-  };
   // true when q lies strictly inside face triangle f
   const auto isInside = [&](const Eigen::Vector2d& q, int f) {
     const Eigen::Vector2d a = yz(lung.triangles(0, f)), b = yz(lung.triangles(1, f)),
@@ -322,7 +335,7 @@ void addFacePoints(TriangleMesh& lung, double faceX) {
     for (double y = std::ceil(lo.x() / h) * h; y < hi.x(); y += h) {
       const Eigen::Vector2d q(y, z);
       const auto host = std::find_if(flat.begin(), flat.end(), [&](int f) { return isInside(q, f); });
-      if (host == flat.end() || boundaryDistance(q) < 0.5 * h) continue;
+      if (host == flat.end() || boundaryDistance(lung, face, q) < 0.5 * h) continue;
       // split the host triangle (a, b, c) into (a, b, n), (b, c, n), (c, a, n)
       const int n = lung.vertexCount(), f = *host, nf = lung.triangleCount();
       lung.vertices.conservativeResize(3, n + 1);
@@ -335,6 +348,62 @@ void addFacePoints(TriangleMesh& lung, double faceX) {
       flat.push_back(nf);
       flat.push_back(nf + 1);
     }
+}
+
+/// [m] a triangle of the mediastinal face whose three corners all lie on the face's boundary and whose
+/// longest edge is longer than this gets a point at its centroid, unless a point added so is closer than half
+/// this (addBoundaryFanPoints()): about the face points' spacing, the strip addFacePoints() leaves along the
+/// boundary. Measured on the default model (crossing pairs summed over the breath styles / the affects,
+/// tests/validation/Surfaces_test.cpp): 16 / 127 without the points; 6 / 79 at 0.6 and 0.8 times the spacing,
+/// 6 / 100 at 1.0. A point in every such triangle (no spacing between them) gave 6 / 83 at 15-30 mm, and two
+/// points 0.4 mm apart made the mediastinal faces cross each other; points in the short slivers along the
+/// floor (4 and 10 mm: 36 / 170 and 22 / 131) sit a fraction of a millimetre above the floor and cross it as
+/// the dome moves.
+constexpr double kFanEdge = 0.8 * kFacePointSpacing;
+
+/// Splits, at its centroid, every triangle of the flat mediastinal face of `lung` (the plane x = `faceX` [m])
+/// whose three corners lie on the face's boundary and whose longest edge exceeds kFanEdge, then makes the
+/// face Delaunay again (flipMediastinalFaces()), until none is left (at most a few rounds). Where the face
+/// meets the dome beside the vertebral bodies, a strip narrower than addFacePoints()'s margin is left as a
+/// fan of slivers between points on the floor: three points on a curve that bends as the dome descends, so a
+/// sliver turns over through its neighbours, the floor and the gut at deep end-inspirations. A centroid is
+/// bound between the cavity points above and below it (embed()) and holds each half of the fan off the floor.
+void addBoundaryFanPoints(TriangleMesh& lung, double faceX) {
+  const int firstAdded = lung.vertexCount();
+  for (int round = 0; round < 4; ++round) {
+    const MediastinalFace face = mediastinalFace(lung, faceX);
+    std::vector<char> onBoundary(static_cast<std::size_t>(lung.vertexCount()), 0);
+    for (const auto& [u, v] : face.boundary)
+      onBoundary[static_cast<std::size_t>(u)] = onBoundary[static_cast<std::size_t>(v)] = 1;
+    int added = 0;
+    for (const int f : face.flat) {
+      const Eigen::Vector3i t = lung.triangles.col(f);
+      double longest = 0.0;
+      bool allBoundary = true;
+      for (int k = 0; k < 3; ++k) {
+        allBoundary = allBoundary && onBoundary[static_cast<std::size_t>(t(k))];
+        longest = std::max(longest, (lung.vertices.col(t(k)) - lung.vertices.col(t((k + 1) % 3))).norm());
+      }
+      const Eigen::Vector3d c =
+          (lung.vertices.col(t(0)) + lung.vertices.col(t(1)) + lung.vertices.col(t(2))) / 3.0;
+      if (!allBoundary || longest <= kFanEdge) continue;
+      // one point per fan: none within half a fan edge of a point added before
+      bool crowded = false;
+      for (int v = firstAdded; v < lung.vertexCount(); ++v)
+        crowded = crowded || (lung.vertices.col(v) - c).norm() < 0.5 * kFanEdge;
+      if (crowded) continue;
+      const int n = lung.vertexCount(), nf = lung.triangleCount();
+      lung.vertices.conservativeResize(3, n + 1);
+      lung.vertices.col(n) = Eigen::Vector3d(faceX, c.y(), c.z());
+      lung.triangles.conservativeResize(3, nf + 2);
+      lung.triangles.col(f) << t(0), t(1), n;
+      lung.triangles.col(nf) << t(1), t(2), n;
+      lung.triangles.col(nf + 1) << t(2), t(0), n;
+      ++added;
+    }
+    if (added == 0) return;
+    flipMediastinalFaces(lung, faceX);
+  }
 }
 
 /// The cavity minus the mediastinum shifted `shift` [m] from the cavity's midline (x > 0: right).
@@ -435,6 +504,8 @@ void buildLungs(const TriangleMesh& cavity, sim::Model& model) {
   addFacePoints(l1.left, l1.leftFaceX);
   flipMediastinalFaces(l1.right, l1.rightFaceX);
   flipMediastinalFaces(l1.left, l1.leftFaceX);
+  addBoundaryFanPoints(l1.right, l1.rightFaceX);
+  addBoundaryFanPoints(l1.left, l1.leftFaceX);
 
   sim::Lungs& lungs = model.lungs;
   lungs.right = embed(l1.right, cavity, "lungs.right");
