@@ -309,7 +309,7 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
                           "rib 1's cranial motion (centre of mass, mean of both sides), calm",
                           "> 0 mm (rises; no paradoxical motion)",
                           "the scalenes fire with every quiet breath; without them the upper rib cage moves "
-                          "paradoxically (J Appl Physiol 1984, 57:899)",
+                          "paradoxically (De Troyer & Estenne 1984, J Appl Physiol 57:899)",
                           "mm", turn.firstRibCranial * kMm, 1e-9, kBig));
     if (std::isfinite(turn.axisFromMidsagittal))
       out.push_back(check("physiology.calm.rib_axis_angle",

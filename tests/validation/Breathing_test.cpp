@@ -71,9 +71,10 @@ TEST(Breathing, CalmExpirationFallsWithoutRebound) {
 // distance grows >= 2 mm, the rib cage gives 55-85 % of the tidal volume upright, the rib cage and the
 // abdomen move within 30 deg of each other (Chen et al. 2015), and the flow is a spirogram's (two reversals
 // per breath, no jump above 20 % of peak flow), the sternum moves forward and up at both ends (the pump
-// handle), rib 1 rises (no paradoxical upper rib cage: J Appl Physiol 1984, 57:899) and ribs 3-7 turn about
-// axes 20-50 deg from the midsagittal plane (about 35 deg by CT, Wilson et al. 1987). Deep: the dome descends
-// at least twice as far as in a calm breath, 20-35 mm per litre inspired, and rib 8 widens >= 10 mm.
+// handle), rib 1 rises (no paradoxical upper rib cage: De Troyer & Estenne 1984, J Appl Physiol 57:899) and
+// ribs 3-7 turn about axes 20-50 deg from the midsagittal plane (about 35 deg by CT, Wilson et al. 1987).
+// Deep: the dome descends at least twice as far as in a calm breath, 20-35 mm per litre inspired, and rib 8
+// widens >= 10 mm.
 TEST(Breathing, MotionWithinPublishedPhysiology) {
   REQUIRE_DEFAULT_MODEL();
   const std::vector<Check> checks = physiologyChecks(runs({"calm", "deep"}));

@@ -178,8 +178,8 @@ struct Gains {
   /// [N/m], [N s/m] kac, kpe and b of the scalenes (rib 1 to the neck) at the reference length. They are
   /// inspiratory muscles driven with the external intercostals: they fire with every quiet breath and hold
   /// rib 1 up against the pull of the first space's external intercostals; without them the upper rib cage
-  /// moves paradoxically (J Appl Physiol 1984, 57:899). muscle_gains.json `scalenes` (optional: passive
-  /// springs with the cartilage group's kpe and b when absent)
+  /// moves paradoxically (De Troyer & Estenne 1984, J Appl Physiol 57:899). muscle_gains.json `scalenes`
+  /// (optional: passive springs with the cartilage group's kpe and b when absent)
   GroupGains scalenes{};
   /// gains per kind of joint, indexed by JointKind
   std::array<JointGains, kJointKinds.size()> joints{};
