@@ -311,8 +311,8 @@ void addScalene(const AnatomyParams& a, const Endpoint& neck, const Endpoint& ri
 /// Scalenes: rib 1 hangs from the cervical spine (scalenus anterior, medius, posterior), which holds it
 /// while the intercostals act; without this reference the external intercostals crowd the free ribs
 /// together instead of lifting them (Hamberger's lever needs rib 1 held; De Troyer et al. 2005,
-/// Physiol Rev 85:717). The model has no cervical spine, so three passive structural springs per side
-/// run from rib 1 up by kScaleneLength to anchors on the fixed lumbar-spine body (a fixed world point).
+/// Physiol Rev 85:717). The model has no cervical spine, so three scalenes per side (addScalene()) run from
+/// rib 1 up by kScaleneLength to anchors on the fixed lumbar-spine body (a fixed world point).
 void addScalenes(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) {
   if (sk.hasGirdle) return;  // addNeckAndShoulders() hangs rib 1 from the cervical spine
   for (int side : {kRight, kLeft}) {
@@ -329,17 +329,17 @@ void addScalenes(const AnatomyParams& a, const Skeleton& sk, ElementSink& sink) 
 /// The neck and the shoulder girdle (AnatomyParams::hasShoulderGirdle), per side:
 ///  - scalenes: from the cervical transverse processes (kScaleneNeckOffset off the midline, kScaleneNeckRise
 ///    above rib 1, C3-C4) to the front half of rib 1 (scalenus anterior, medius; the posterior to rib 2 is
-///    folded into them), structural springs with the cartilage group's gains like the model's scalenes
-///    without a neck (addScalenes()). Each runs in its rib point's sagittal plane, tilted inwards only: a
-///    fore-aft tilt braces rib 1, and with it the upper thoracic spine, against the fixed neck. From C3-C5
-///    (2.8 cm off the midline, level with the vertebral bodies, up to 12 deg forward) the backward sway of
-///    the spine in a deep inhale was -0.10 mm (validate's sway.backward, male, --quick; -0.71 mm without the
-///    girdle, -0.14 mm without scalenes), in the sagittal plane -0.15 mm. Vertical springs on the middle of
-///    rib 1 (the model without the girdle) give -0.73 mm but leave the skin at the base of the neck. On the
-///    back half of rib 1 they pulled rib 1 and T1 forward and the spine swayed forward on a deep inhale. In a
-///    calm breath T1-T3 moves 3.0 mm forward (1.3 mm without the girdle); added to these, 6 cm vertical
-///    springs on the middle of rib 1 gave 1.1 mm but leave the skin, 2.5 cm ones (inside it, and stiffer)
-///    pulled T1-T3 1.1 mm back, and ones to the transverse processes of C5 2.3-3.6 mm forward;
+///    folded into them), with the gains of the model's scalenes without a neck (addScalene()). Each runs in
+///    its rib point's sagittal plane, tilted inwards only: a fore-aft tilt braces rib 1, and with it the
+///    upper thoracic spine, against the fixed neck. From C3-C5 (2.8 cm off the midline, level with the
+///    vertebral bodies, up to 12 deg forward) the backward sway of the spine in a deep inhale was -0.10 mm
+///    (validate's sway.backward, male, --quick; -0.71 mm without the girdle, -0.14 mm without scalenes), in
+///    the sagittal plane -0.15 mm. Vertical springs on the middle of rib 1 (the model without the girdle)
+///    give -0.73 mm but leave the skin at the base of the neck. On the back half of rib 1 they pulled rib 1
+///    and T1 forward and the spine swayed forward on a deep inhale. In a calm breath T1-T3 moves 3.0 mm
+///    forward (1.3 mm without the girdle); added to these, 6 cm vertical springs on the middle of rib 1
+///    gave 1.1 mm but leave the skin, 2.5 cm ones (inside it, and stiffer) pulled T1-T3 1.1 mm back, and ones
+///    to the transverse processes of C5 2.3-3.6 mm forward;
 ///  - sternocleidomastoid: from the mastoid process to the manubrium (sternal head) and the medial clavicle
 ///    (clavicular head);
 ///  - Breathe Easy's 26 shoulder elements (Zordan et al. 2004, Table 1: 52 in all), passive at the shoulder
