@@ -93,6 +93,7 @@ viz::Plot figure6(const std::vector<sim::StyleRun>& runs) {
   return plot;
 }
 
+constexpr double kDegPerRad = 180.0 / M_PI;   // [deg/rad]
 constexpr double kSilhouetteSpacing = 0.002;  // [m] outline grid of the report's silhouettes
 
 void runValidate(const ValidateArgs& args) {
@@ -278,6 +279,13 @@ void runValidate(const ValidateArgs& args) {
              {"max_gut_volume_error_pct", r.summary.maxGutVolumeError * 100.0},
              {"real_time_factor", r.summary.realTimeFactor}};
     writeMotion(r.summary.motion, style);
+    for (const sim::RibMotion& rm : sim::ribMotions(r))
+      style["rib_motion"].push_back(
+          {{"rib", rm.rib},
+           {"turn_deg", rm.turn * kDegPerRad},
+           {"axis_from_midsagittal_deg", rm.axisFromMidsagittal * kDegPerRad},
+           {"about_neck_deg", rm.aboutNeck * kDegPerRad},
+           {"com_motion_mm", {rm.comMotion.x() * 1e3, rm.comMotion.y() * 1e3, rm.comMotion.z() * 1e3}}});
     for (const sim::SilhouetteBreath& b : breaths)
       if (b.style == r.style.name) style["silhouette"] = silhouetteJson(b);
   }
@@ -319,6 +327,40 @@ void runValidate(const ValidateArgs& args) {
                << "</td></tr>\n";
     }
   };
+  // the calm breath's rib motion, rib by rib (the figures behind physiology.calm.rib_axis_angle)
+  std::ostringstream ribMd, ribHtml;
+  for (const sim::StyleRun& r : runs) {
+    if (r.style.name != "calm" || r.frictionScale != 1.0) continue;
+    for (const sim::RibMotion& rm : sim::ribMotions(r)) {
+      const double outward =
+          rm.rib.find("_left") != std::string::npos ? -1.0 : 1.0;  // lateral: away from x = 0
+      const std::string cells[] = {
+          rm.rib, number(rm.turn * kDegPerRad), number(rm.axisFromMidsagittal * kDegPerRad),
+          number(rm.aboutNeck * kDegPerRad),
+          number(outward * rm.comMotion.x() * 1e3) + " / " + number(rm.comMotion.y() * 1e3) + " / " +
+              number(rm.comMotion.z() * 1e3)};
+      ribMd << "|";
+      ribHtml << "<tr>";
+      for (const std::string& c : cells) {
+        ribMd << " " << c << " |";
+        ribHtml << "<td>" << htmlEscape(c) << "</td>";
+      }
+      ribMd << "\n";
+      ribHtml << "</tr>\n";
+    }
+  }
+  const std::string ribIntro =
+      "Each rib's turn from end-expiration to end-inspiration of the calm breath, from the bones' poses: its "
+      "angle, the angle between its axis and the midsagittal plane (0 deg: an anteroposterior axis, the "
+      "bucket "
+      "handle; 90 deg: a left-right axis, the pump handle; about 35 deg for ribs 3-7 by CT, Wilson et al. "
+      "1987, "
+      "J Appl Physiol 62:1872), its part about the rib's neck axis (> 0 lifts the rib), and the motion of "
+      "its "
+      "centre of mass outward / forward / up.";
+  const char* ribHeader =
+      "| rib | turn [deg] | axis from midsagittal [deg] | about the neck axis [deg] | centre of mass, out / "
+      "forward / up [mm] |\n|---|---|---|---|---|\n";
   std::ostringstream physMd, physHtml, silMd, silHtml, teachMd, teachHtml;
   rangeRows(physiology, physMd, physHtml);
   rangeRows(silhouette, silMd, silHtml);
@@ -347,6 +389,8 @@ void runValidate(const ValidateArgs& args) {
       " within range. Reported beside the papers' checks; not part of the exit status.";
   const char* rangeHeader = "| check | what | measured | published | | source |\n|---|---|---|---|---|---|\n";
   md << "## Physiology\n\n" << physIntro << "\n\n" << rangeHeader << physMd.str() << "\n";
+  if (!ribMd.str().empty())
+    md << "## Rib motion, calm\n\n" << ribIntro << "\n\n" << ribHeader << ribMd.str() << "\n";
   md << "## Silhouette\n\n" << silIntro << "\n\n";
   if (!silhouette.empty()) md << rangeHeader << silMd.str() << "\n";
   md << "## Teaching presets\n\n" << teachIntro << "\n\n" << rangeHeader << teachMd.str() << "\n";
@@ -370,8 +414,14 @@ void runValidate(const ValidateArgs& args) {
        << "<h2>Physiology</h2>\n<p>" << htmlEscape(physIntro)
        << "</p>\n<table><tr><th>check</th><th>what</th><th>measured</th>"
        << "<th>published</th><th></th><th>source</th></tr>\n"
-       << physHtml.str() << "</table>\n"
-       << "<h2>Silhouette</h2>\n<p>" << htmlEscape(silIntro) << "</p>\n";
+       << physHtml.str() << "</table>\n";
+  if (!ribHtml.str().empty())
+    html << "<h2>Rib motion, calm</h2>\n<p>" << htmlEscape(ribIntro)
+         << "</p>\n<table><tr><th>rib</th><th>turn [deg]</th><th>axis from midsagittal [deg]</th><th>about "
+            "the "
+            "neck axis [deg]</th><th>centre of mass, out / forward / up [mm]</th></tr>\n"
+         << ribHtml.str() << "</table>\n";
+  html << "<h2>Silhouette</h2>\n<p>" << htmlEscape(silIntro) << "</p>\n";
   if (!silhouette.empty())
     html << "<table><tr><th>check</th><th>what</th><th>measured</th><th>published</th><th></th><th>source</"
             "th></tr>\n"

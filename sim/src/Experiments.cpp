@@ -215,47 +215,31 @@ std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs) {
   return out;
 }
 
-namespace {
-
-// the ribs' motion from end-expiration to end-inspiration of a run (as Wilson et al. 1987 measured it, FRC to
-// TLC, from the bones' poses)
-struct RibTurn {
-  double firstRibCranial = kNaN;  // [m] cranial motion of rib 1's centre of mass, mean of both sides
-  double axisFromMidsagittal =
-      kNaN;  // [rad] angle between the rotation axis and the midsagittal plane, mean of ribs 3-7
-};
-
-RibTurn ribTurn(const StyleRun& r) {
-  RibTurn out;
+std::vector<RibMotion> ribMotions(const StyleRun& r) {
+  std::vector<RibMotion> out;
   if (!r.hasBreathPoses || !r.model) return out;
   const Model& m = *r.model;
   const State& a = r.endExpiration;
   const State& b = r.endInspiration;
-  double lift = 0.0;
-  double angle = 0.0;
-  int nLift = 0;
-  int nAngle = 0;
   for (int j = 0; j < m.joints.size(); ++j) {
-    int level = 0;
-    if (std::sscanf(m.joints.name[static_cast<std::size_t>(j)].c_str(), "costovertebral_rib%d_", &level) != 1)
-      continue;
-    const int c = m.joints.child[static_cast<std::size_t>(j)];
+    const auto jj = static_cast<std::size_t>(j);
+    RibMotion rm;
+    if (std::sscanf(m.joints.name[jj].c_str(), "costovertebral_rib%d_", &rm.level) != 1) continue;
+    const int c = m.joints.child[jj], p = m.joints.parent[jj];
+    rm.rib = m.bodies.name[static_cast<std::size_t>(c)];
     const Eigen::AngleAxisd turn(b.bodyOrientation[static_cast<std::size_t>(c)] *
                                  a.bodyOrientation[static_cast<std::size_t>(c)].inverse());
-    if (level == 1) {
-      lift += b.bodyPosition(2, c) - a.bodyPosition(2, c);
-      ++nLift;
-    } else if (level >= 3 && level <= 7 && turn.angle() > 0.0) {
-      angle += std::asin(std::min(1.0, std::abs(turn.axis().x())));
-      ++nAngle;
-    }
+    rm.turn = turn.angle();
+    rm.axisFromMidsagittal = std::asin(std::min(1.0, std::abs(turn.axis().x())));
+    // the neck axis, signed so that turning about it lifts the rib's centre of mass (in front of the joint)
+    Eigen::Vector3d neck = a.bodyOrientation[static_cast<std::size_t>(p)] * m.joints.axis.col(j);
+    if (neck.cross(a.bodyPosition.col(c) - m.joints.anchor.col(j)).z() < 0.0) neck = -neck;
+    rm.aboutNeck = turn.angle() * turn.axis().dot(neck);
+    rm.comMotion = b.bodyPosition.col(c) - a.bodyPosition.col(c);
+    out.push_back(rm);
   }
-  if (nLift > 0) out.firstRibCranial = lift / nLift;
-  if (nAngle > 0) out.axisFromMidsagittal = angle / nAngle;
   return out;
 }
-
-}  // namespace
 
 std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
   const StyleRun* calm = nullptr;
@@ -303,20 +287,26 @@ std::vector<Check> physiologyChecks(const std::vector<StyleRun>& runs) {
                         kMm * std::min(std::min(m.sternumAnterior, m.sternumCranial),
                                        std::min(m.xiphoidAnterior, m.xiphoidCranial)),
                         1e-9, kBig));
-    const RibTurn turn = ribTurn(*calm);
-    if (std::isfinite(turn.firstRibCranial))
+    // rib 1's cranial motion, and the mean axis of ribs 3-7 (about 35 deg by CT)
+    double firstRibCranial = 0.0, axisAngle = 0.0;
+    int nFirst = 0, nAxis = 0;
+    for (const RibMotion& rm : ribMotions(*calm)) {
+      if (rm.level == 1) firstRibCranial += rm.comMotion.z(), ++nFirst;
+      if (rm.level >= 3 && rm.level <= 7) axisAngle += rm.axisFromMidsagittal, ++nAxis;
+    }
+    if (nFirst > 0)
       out.push_back(check("physiology.calm.first_rib_cranial",
                           "rib 1's cranial motion (centre of mass, mean of both sides), calm",
                           "> 0 mm (rises; no paradoxical motion)",
                           "the scalenes fire with every quiet breath; without them the upper rib cage moves "
                           "paradoxically (De Troyer & Estenne 1984, J Appl Physiol 57:899)",
-                          "mm", turn.firstRibCranial * kMm, 1e-9, kBig));
-    if (std::isfinite(turn.axisFromMidsagittal))
+                          "mm", firstRibCranial / nFirst * kMm, 1e-9, kBig));
+    if (nAxis > 0)
       out.push_back(check("physiology.calm.rib_axis_angle",
                           "ribs 3-7: angle of their rotation axes from the midsagittal plane, mean, calm",
                           "20 - 50 deg",
                           "about 35 deg for ribs 3-7 (CT, Wilson et al. 1987, J Appl Physiol 62:1872)", "deg",
-                          turn.axisFromMidsagittal * 180.0 / M_PI, 20.0, 50.0));
+                          axisAngle / nAxis * 180.0 / M_PI, 20.0, 50.0));
     out.push_back(check("physiology.calm.flow_reversals", "flow (dV/dt) sign changes per breath, calm", "2",
                         "a spirogram: one inspiration, one expiration", "-", m.flowSignChanges, 2.0, 2.0));
     out.push_back(check("physiology.calm.flow_jump", "largest frame-to-frame flow change, calm",

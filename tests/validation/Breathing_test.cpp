@@ -88,6 +88,24 @@ TEST(Breathing, MotionWithinPublishedPhysiology) {
                 "physiology.deep.dome_per_litre", "physiology.deep.lower_rib_expansion"});
 }
 
+// the ribs turn about their necks: in a calm breath every rib rises (its turn about its neck axis lifts it)
+// and the upper ribs turn about axes nearer the left-right axis (pump handle) than the lower ones (bucket
+// handle): rib 3's axis at least 10 deg further from the midsagittal plane than rib 8's (CT: about 35 deg for
+// ribs 3-7 and a pump-handle component falling caudally, Wilson et al. 1987, J Appl Physiol 62:1872)
+TEST(Breathing, UpperRibsTurnNearerThePumpHandleEveryRibRises) {
+  REQUIRE_DEFAULT_MODEL();
+  const std::vector<RibMotion> ribs = ribMotions(run("calm"));
+  ASSERT_EQ(ribs.size(), 20u);  // ribs 1-10, both sides
+  std::map<std::string, double> axis;
+  for (const RibMotion& r : ribs) {
+    EXPECT_GT(r.aboutNeck, 0.0) << r.rib;
+    axis[r.rib] = r.axisFromMidsagittal * 180.0 / M_PI;
+    RecordProperty(r.rib + "_axis_deg", std::to_string(axis[r.rib]));
+  }
+  for (const char* side : {"_right", "_left"})
+    EXPECT_GT(axis[std::string("rib3") + side], axis[std::string("rib8") + side] + 10.0) << side;
+}
+
 // every shipped periodic style breathes with a smooth flow: dV/dt changes sign exactly twice per breath after
 // settling (one inspiration, one expiration) and no frame-to-frame jump exceeds 20 % of peak flow, or twice a
 // pure sinusoid's own frame-to-frame change where that is larger (panting at the experiments' 30 frames/s:

@@ -86,6 +86,16 @@ TEST(CliValidate, ReportHoldsEveryCheckAndExitCodeMatches) {
               1e-3 * std::max(1.0, std::abs(report["styles"]["calm"]["dome_descent_mm"].get<double>())));
   EXPECT_NE(md.find("12 - 25 mm"), std::string::npos);
   EXPECT_NE(html.find("<h2>Physiology</h2>"), std::string::npos);
+  // the calm breath's rib motion: a row per rib of report.json in both reports (the motion itself is
+  // tested on the default model: Breathing.UpperRibsTurnNearerThePumpHandleEveryRibRises)
+  const nlohmann::json& ribs = report["styles"]["calm"]["rib_motion"];
+  ASSERT_FALSE(ribs.empty());
+  for (const auto& rm : ribs) {
+    const std::string rib = rm["rib"].get<std::string>();
+    EXPECT_NE(md.find("| " + rib + " | "), std::string::npos) << rib;
+    EXPECT_NE(html.find("<td>" + rib + "</td>"), std::string::npos) << rib;
+  }
+  EXPECT_NE(html.find("<h2>Rib motion, calm</h2>"), std::string::npos);
   // stdout carries the table
   EXPECT_NE(r.out.find("calm.tidal_volume"), std::string::npos);
 }

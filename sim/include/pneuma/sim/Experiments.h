@@ -103,6 +103,25 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
 /// posterior, xiphoid down.
 std::vector<Check> breathStyleChecks(const std::vector<StyleRun>& runs);
 
+/// One rib's turn from end-expiration to end-inspiration of a run, from the bones' poses (the way Wilson et
+/// al. 1987, J Appl Physiol 62:1872, measured ribs by CT from FRC to TLC).
+struct RibMotion {
+  std::string rib;    ///< body name, e.g. "rib3_right"
+  int level = 0;      ///< 1 (top) .. 10
+  double turn = 0.0;  ///< [rad] angle of the rotation R_insp R_exp^-1
+  /// [rad] angle between the rotation axis and the midsagittal plane, asin |a_x|: 0 an anteroposterior axis
+  /// (bucket handle), pi/2 a left-right axis (pump handle)
+  double axisFromMidsagittal = 0.0;
+  /// [rad] the rotation vector's component along the rib's neck axis (its costovertebral joint's axis, turned
+  /// with the parent at end-expiration), signed so that > 0 lifts the rib's centre of mass
+  double aboutNeck = 0.0;
+  Eigen::Vector3d comMotion = Eigen::Vector3d::Zero();  ///< [m] its centre of mass's motion, world (RAS)
+};
+
+/// Every rib with a costovertebral joint (a joint named "costovertebral_rib<level>_<side>") of `run`'s model,
+/// in joint order; empty when the run has no breath poses.
+std::vector<RibMotion> ribMotions(const StyleRun& run);
+
 /// The breath's motion in anatomical axes (Summary::motion) against published physiology, on runs named
 /// "calm" and "deep" (ids "physiology.<style>.<figure>"; checks whose runs are missing are left out), each
 /// with its source: calm dome descent 12-25 mm (M-mode ultrasound, Boussuges et al. 2009); deep dome descent
