@@ -239,6 +239,13 @@ struct LungMeshes {
   double rightFaceX = 0.0, leftFaceX = 0.0;  // [m] the central block's sides: each lung's flat medial face
 };
 
+/// True when triangle f of `lung` lies in the plane x = `faceX` [m], the lung's flat mediastinal face.
+bool isOnFace(const TriangleMesh& lung, int f, double faceX) {
+  for (int k = 0; k < 3; ++k)
+    if (!(std::abs(lung.vertices(0, lung.triangles(k, f)) - faceX) < kOnSurface)) return false;
+  return true;
+}
+
 /// Delaunay edge flips (Lawson 1977, "Software for C1 surface interpolation") of the triangles of `lung` that
 /// lie in the plane x = `faceX` [m], the lung's flat face on the central mediastinal block. The corefinement
 /// leaves that face as long slivers fanning across it between the points where the block's side meets the
@@ -251,12 +258,8 @@ struct LungMeshes {
 /// summed over every style and affect, tests/validation/Surfaces_test.cpp): 1558 before, 877 after.
 void flipMediastinalFaces(TriangleMesh& lung, double faceX) {
   std::vector<char> isFlat(static_cast<std::size_t>(lung.triangleCount()), 0);
-  for (int f = 0; f < lung.triangleCount(); ++f) {
-    bool flat = true;
-    for (int k = 0; k < 3; ++k)
-      flat = flat && std::abs(lung.vertices(0, lung.triangles(k, f)) - faceX) < kOnSurface;
-    isFlat[static_cast<std::size_t>(f)] = flat;
-  }
+  for (int f = 0; f < lung.triangleCount(); ++f)
+    isFlat[static_cast<std::size_t>(f)] = isOnFace(lung, f, faceX);
   delaunayFlips(lung.triangles, lung.vertices.bottomRows<2>(), isFlat);  // the face's y-z coordinates
 }
 
@@ -269,12 +272,8 @@ struct MediastinalFace {
 
 MediastinalFace mediastinalFace(const TriangleMesh& lung, double faceX) {
   MediastinalFace face;
-  for (int f = 0; f < lung.triangleCount(); ++f) {
-    bool isFlat = true;
-    for (int k = 0; k < 3; ++k)
-      isFlat = isFlat && std::abs(lung.vertices(0, lung.triangles(k, f)) - faceX) < kOnSurface;
-    if (isFlat) face.flat.push_back(f);
-  }
+  for (int f = 0; f < lung.triangleCount(); ++f)
+    if (isOnFace(lung, f, faceX)) face.flat.push_back(f);
   std::map<std::pair<int, int>, int> edgeCount;
   for (const int f : face.flat)
     for (int k = 0; k < 3; ++k) {
