@@ -62,6 +62,7 @@ sim::Model thinned(const sim::Model& model, int stride) {
   el.kpe.resize(el.restLength.size());
   el.damping.resize(el.restLength.size());
   if (src.recruitment.size() > 0) el.recruitment.resize(el.restLength.size());
+  el.isGliding.clear();
   for (std::size_t k = 0; k < keep.size(); ++k) {
     const int e = keep[k];
     const auto i = static_cast<Eigen::Index>(k);
@@ -71,6 +72,7 @@ sim::Model thinned(const sim::Model& model, int stride) {
     el.kpe(i) = src.kpe(e);
     el.damping(i) = src.damping(e);
     if (src.recruitment.size() > 0) el.recruitment(i) = src.recruitment(e);
+    if (!src.isGliding.empty()) el.isGliding.push_back(src.isGliding[static_cast<std::size_t>(e)]);
   }
   el.endA = subset(src.endA, keep);
   el.endB = subset(src.endB, keep);

@@ -597,15 +597,10 @@ struct ModelScene::Impl {
   void build(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes) {
     buildBones(meshes);
 
-    // muscle elements by group; the apposition springs (the pleural fluid's hold) are not drawn, nor the
-    // volume bodies' springs and ties (a node of region Tissue at an end: the body is drawn as its surface)
-    const auto isTissueEnd = [&](const sim::AnchorSet& a, int e) {
-      return a.body[static_cast<std::size_t>(e)] < 0 &&
-             model.nodes.region[static_cast<std::size_t>(a.nodes(0, e))] == sim::NodeRegion::Tissue;
-    };
+    // muscle elements by group, those that views draw (sim::isDrawn: no ties, volume-body springs or
+    // gliding springs)
     for (int e = 0; e < model.elements.size(); ++e)
-      if (!sim::isApposition(model, e) && !isTissueEnd(model.elements.endA, e) &&
-          !isTissueEnd(model.elements.endB, e))
+      if (sim::isDrawn(model, e))
         groups[static_cast<std::size_t>(model.elements.group[static_cast<std::size_t>(e)])].element.push_back(
             e);
     for (int gi = 0; gi < kGroups; ++gi) {

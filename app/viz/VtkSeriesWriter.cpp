@@ -251,6 +251,8 @@ struct VtkSeriesWriter::Impl {
     slack->SetName("is_slack");
     vtkNew<vtkUnsignedCharArray> apposition;  // 1: an apposition spring, anchored beyond the rib face
     apposition->SetName("is_apposition");
+    vtkNew<vtkUnsignedCharArray> gliding;  // 1: a gliding spring, its far end a virtual anchor off the bone
+    gliding->SetName("is_gliding");
     for (int e = 0; e < el.size(); ++e) {
       x.col(2 * e) = a.col(e);
       x.col(2 * e + 1) = b.col(e);
@@ -261,6 +263,7 @@ struct VtkSeriesWriter::Impl {
       tension->SetValue(e, f < 0.0 ? -f : 0.0);
       group->InsertNextValue(static_cast<int>(el.group[static_cast<std::size_t>(e)]));
       apposition->InsertNextValue(sim::isApposition(model, e) ? 1 : 0);
+      gliding->InsertNextValue(el.glides(e) ? 1 : 0);
       slack->InsertNextValue(static_cast<std::size_t>(e) < metrics.isSlack.size()
                                  ? metrics.isSlack[static_cast<std::size_t>(e)]
                                  : 0);
@@ -272,6 +275,7 @@ struct VtkSeriesWriter::Impl {
     pd->GetCellData()->AddArray(tension);
     pd->GetCellData()->AddArray(group);
     pd->GetCellData()->AddArray(apposition);
+    pd->GetCellData()->AddArray(gliding);
     pd->GetCellData()->AddArray(slack);
     return pd;
   }

@@ -67,6 +67,13 @@ class ElementSink {
       e.recruitment.tail(n - before).setZero();
       e.recruitment(n - 1) = recruitment;
     }
+    if (!e.isGliding.empty()) e.isGliding.push_back(0);
+  }
+  /// Marks the element added last as a gliding spring (sim::Elements::isGliding).
+  void markGliding() {
+    sim::Elements& e = m_model.elements;
+    e.isGliding.resize(e.group.size(), 0);
+    e.isGliding.back() = 1;
   }
 
  private:

@@ -486,6 +486,7 @@ void addNeckAndShoulders(const AnatomyParams& a, const Skeleton& sk, ElementSink
           sink.add(ElementGroup::Cartilage, scapula(p),
                    Endpoint::onBody(nearest(ribs, p).body, p + kScapulothoracicLength * inward),
                    a.gains.scapulothoracic, 0.0);
+          sink.markGliding();
         }
       }
     }

@@ -469,7 +469,8 @@ void validateModel(const Model& m) {
   const int nE = m.elements.size();
   if (m.elements.endA.size() != nE || m.elements.endB.size() != nE || m.elements.restLength.size() != nE ||
       m.elements.kac.size() != nE || m.elements.kpe.size() != nE || m.elements.damping.size() != nE ||
-      (m.elements.recruitment.size() != 0 && m.elements.recruitment.size() != nE))
+      (m.elements.recruitment.size() != 0 && m.elements.recruitment.size() != nE) ||
+      (!m.elements.isGliding.empty() && static_cast<int>(m.elements.isGliding.size()) != nE))
     invalid("elements", "inconsistent array sizes");
   validateAnchors(m.elements.endA, "elements.a", nB, nN);
   validateAnchors(m.elements.endB, "elements.b", nB, nN);
@@ -487,6 +488,8 @@ void validateModel(const Model& m) {
     if (!(c0 >= 0.0 && c0 < 1.0)) invalid(f + ".recruitment", "must be in [0, 1), got " + num(c0));
     if (c0 > 0.0 && !isMuscleGroup(m.elements.group[static_cast<std::size_t>(i)]))
       invalid(f + ".recruitment", "only a muscle is recruited; a cartilage spring is passive");
+    if (m.elements.glides(i) && m.elements.group[static_cast<std::size_t>(i)] != ElementGroup::Cartilage)
+      invalid(f + ".gliding", "only a cartilage spring glides; a muscle pulls its two bones together");
   }
   if (m.elements.kpe.maxCoeff() <= 0.0)
     invalid("elements.kpe",
@@ -689,7 +692,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     v->resize(static_cast<Eigen::Index>(nE));
   for (std::size_t i = 0; i < nE; ++i) {
     const Reader e = elements[i];
-    e.allowKeys({"group", "a", "b", "rest_length", "kac", "kpe", "damping", "recruitment"});
+    e.allowKeys({"group", "a", "b", "rest_length", "kac", "kpe", "damping", "recruitment", "gliding"});
     const auto k = static_cast<Eigen::Index>(i);
     ElementGroup g;
     const std::string group = e.at("group").string();
@@ -705,6 +708,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     if (e.has("recruitment")) {
       if (m.elements.recruitment.size() == 0) m.elements.recruitment.setZero(static_cast<Eigen::Index>(nE));
       m.elements.recruitment[k] = e.at("recruitment").number();
+    }
+    // optional: not a gliding spring when absent
+    if (e.has("gliding") && e.at("gliding").boolean()) {
+      m.elements.isGliding.resize(nE, 0);
+      m.elements.isGliding[i] = 1;
     }
   }
 
@@ -844,6 +852,7 @@ std::string serializeModel(const Model& m) {
                         {"kpe", m.elements.kpe[i]},
                         {"damping", m.elements.damping[i]}});
     if (m.elements.recruitmentOf(i) > 0.0) elements.back()["recruitment"] = m.elements.recruitment[i];
+    if (m.elements.glides(i)) elements.back()["gliding"] = true;
   }
   doc["elements"] = std::move(elements);
 

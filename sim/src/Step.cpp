@@ -262,8 +262,6 @@ StepWork makeStepWork(const Model& model) {
       }
     }
   }
-  w.scratch.bodyNodeBlock =
-      Eigen::MatrixXd::Zero(6 * nb, 3 * static_cast<Eigen::Index>(w.constants.attachedNodes.size()));
   for (Eigen::VectorXd* v : {&w.scratch.cgX, &w.scratch.cgR, &w.scratch.cgZ, &w.scratch.cgP, &w.scratch.cgQ,
                              &w.scratch.cgB, &w.scratch.cgT})
     *v = Eigen::VectorXd::Zero(n);

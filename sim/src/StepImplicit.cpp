@@ -229,9 +229,25 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
                         double dt) {
   const int nb = model.bodies.size();
   Eigen::MatrixXd& a = w.scratch.bodyBlock;
-  Eigen::MatrixXd& c = w.scratch.bodyNodeBlock;
   a.setZero();
-  c.setZero();
+  std::fill(w.scratch.couplingBlock.begin(), w.scratch.couplingBlock.end(), Matrix3d::Zero());
+  // the coupling of body b's force f and torque t (3 x 3 blocks, one column per coordinate of attached node
+  // `column`) to that node, gathered along the joint tree as gatherJointForces() gathers a force: up the tree
+  // the force moves to the parent with the torque of its levers about both coms
+  const auto couple = [&](int b, int column, const Matrix3d& f, const Matrix3d& t) {
+    const auto add = [&](int row, const Matrix3d& block) {
+      const int slot = w.constants.couplingSlot(row, column);
+      if (slot >= 0) w.scratch.couplingBlock[at(slot)] += block;
+    };
+    add(2 * b + 1, t);
+    int x = b;
+    for (int j = w.constants.treeJointOfChild[at(x)]; j >= 0; j = w.constants.treeJointOfChild[at(x)]) {
+      add(2 * x + 1, -skew(w.scratch.treeLeverChild.col(j)) * f);
+      x = model.joints.parent[at(j)];
+      add(2 * x + 1, skew(w.scratch.treeLeverParent.col(j)) * f);
+    }
+    add(2 * x, f);
+  };
   for (int b = 0; b < nb; ++b) {
     const Matrix3d& r = w.scratch.rotation[at(b)];
     a.block<3, 3>(6 * b, 6 * b) = model.bodies.mass(b) * Matrix3d::Identity();
@@ -263,11 +279,11 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     const int b = movingA ? ba : bb;
     const AnchorSet& nodes = movingA ? el.endB : el.endA;
     const Matrix3d ke = (ka - kg) * d * d.transpose() + kg * Matrix3d::Identity();
-    Eigen::Matrix<double, 6, 3> jk;
-    jk << ke, skew(movingA ? ra : rb) * ke;
+    const Matrix3d te = skew(movingA ? ra : rb) * ke;
     for (int k = 0; k < 3; ++k) {
       const int n = nodes.nodes(k, e);
-      if (n >= 0) c.block<6, 3>(6 * b, 3 * w.constants.attachedColumn(n)) -= nodes.weights(k, e) * jk;
+      if (n >= 0)
+        couple(b, w.constants.attachedColumn(n), -nodes.weights(k, e) * ke, -nodes.weights(k, e) * te);
     }
   }
   // joint springs and friction on relative angular velocity
@@ -281,8 +297,8 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     a.block<3, 3>(6 * ch + 3, 6 * p + 3) -= kj;
     a.block<3, 3>(6 * p + 3, 6 * ch + 3) -= kj;
   }
-  // restrict to the joint tree's coordinates: J^T A by columns (fixed bodies' columns are not needed), then
-  // J^T A J as the gathered columns of its transpose (the free columns only)
+  // restrict the body block to the joint tree's coordinates: J^T A by columns (fixed bodies' columns are not
+  // needed), then J^T A J as the gathered columns of its transpose (the free columns only)
   if (!tree.empty()) {
     for (int b = 0; b < nb; ++b)
       for (int k = 6 * b; k < 6 * b + 6 && !model.bodies.isFixed[at(b)]; ++k)
@@ -291,7 +307,6 @@ void assembleBodyBlocks(const Model& model, const StepOptions& o, const std::vec
     for (Eigen::Index k = 0;
          k < w.constants.freeCoordinates.size() && w.constants.freeCoordinates(k) < a.rows(); ++k)
       gatherJointForces(model.joints, w, tree, a.col(w.constants.freeCoordinates(k)));
-    for (Eigen::Index k = 0; k < c.cols(); ++k) gatherJointForces(model.joints, w, tree, c.col(k));
   }
 }
 
@@ -305,12 +320,10 @@ void streamSystem(const Model& model, const StepOptions& o, const StepWork& w, d
   for (Eigen::Index i = 0; i < w.constants.bodyEntries.cols(); ++i)
     add(w.constants.bodyEntries(0, i), w.constants.bodyEntries(1, i),
         w.scratch.bodyBlock.block<3, 3>(w.constants.bodyEntries(0, i), w.constants.bodyEntries(1, i)));
-  // attached nodes and bodies, where they can couple (bodyNodeBlock holds body rows, node columns)
+  // attached nodes and bodies, where they can couple (couplingBlock holds body rows, node columns)
   for (Eigen::Index i = 0; i < w.constants.couplingEntries.cols(); ++i)
     add(w.constants.couplingEntries(0, i), w.constants.couplingEntries(1, i),
-        w.scratch.bodyNodeBlock
-            .block<3, 3>(w.constants.couplingEntries(1, i), w.constants.couplingEntries(2, i))
-            .transpose());
+        w.scratch.couplingBlock[static_cast<std::size_t>(i)].transpose());
   // node masses and the visceral drag, (1 + dt beta) m I
   const double dragScale = 1.0 + dt * effectiveDrag(model, o);
   for (int n = 0; n < model.nodes.size(); ++n)
@@ -522,7 +535,11 @@ void analyzeSystem(const Model& model, StepWork& w) {
   // itself and its ancestors (its motion is theirs plus its own)
   const int nb = model.bodies.size();
   std::vector<int> parentOf(at(nb), -1);
-  for (int j : tree) parentOf[at(model.joints.child[at(j)])] = model.joints.parent[at(j)];
+  w.constants.treeJointOfChild.assign(at(nb), -1);
+  for (int j : tree) {
+    parentOf[at(model.joints.child[at(j)])] = model.joints.parent[at(j)];
+    w.constants.treeJointOfChild[at(model.joints.child[at(j)])] = j;
+  }
   Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> bodyMask, couplingMask;  // #B x #B, #B x #attached
   bodyMask.setZero(nb, nb);
   const auto coupleBodies = [&](int b1, int b2) {
@@ -553,17 +570,22 @@ void analyzeSystem(const Model& model, StepWork& w) {
   for (std::size_t c = 0; c < freeBodies; c += 3)
     for (std::size_t r = c; r < freeBodies; r += 3)
       if (bodyMask(free[r] / 6, free[c] / 6)) bodyEntries.insert(bodyEntries.end(), {free[r], free[c]});
-  for (std::size_t k = 0; k < w.constants.attachedNodes.size(); ++k) {
-    const int column = 3 * static_cast<int>(k),
-              row = static_cast<int>(nodeOffset(model, w.constants.attachedNodes[k]));
+  const auto attached = static_cast<Eigen::Index>(w.constants.attachedNodes.size());
+  w.constants.couplingSlot.setConstant(2 * nb, attached, -1);
+  for (Eigen::Index k = 0; k < attached; ++k) {
+    const int row =
+        static_cast<int>(nodeOffset(model, w.constants.attachedNodes[static_cast<std::size_t>(k)]));
     for (std::size_t c = 0; c < freeBodies; c += 3)
-      if (couplingMask(free[c] / 6, static_cast<Eigen::Index>(k)))
-        couplingEntries.insert(couplingEntries.end(), {row, free[c], column});
+      if (couplingMask(free[c] / 6, k)) {
+        w.constants.couplingSlot(free[c] / 3, k) = static_cast<int>(couplingEntries.size() / 2);
+        couplingEntries.insert(couplingEntries.end(), {row, free[c]});
+      }
   }
   w.constants.bodyEntries = Eigen::Map<const Eigen::Matrix2Xi>(
       bodyEntries.data(), 2, static_cast<Eigen::Index>(bodyEntries.size() / 2));
-  w.constants.couplingEntries = Eigen::Map<const Eigen::Matrix3Xi>(
-      couplingEntries.data(), 3, static_cast<Eigen::Index>(couplingEntries.size() / 3));
+  w.constants.couplingEntries = Eigen::Map<const Eigen::Matrix2Xi>(
+      couplingEntries.data(), 2, static_cast<Eigen::Index>(couplingEntries.size() / 2));
+  w.scratch.couplingBlock.assign(couplingEntries.size() / 2, Matrix3d::Zero());
   // every streamed block in free blocks, (-1, -1) when fixed or dependent (free coordinates come in whole
   // blocks: a node's three, a jointed body's rotation, a free body's translation and rotation)
   std::vector<std::array<int, 2>> blocks;

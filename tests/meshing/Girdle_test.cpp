@@ -23,6 +23,7 @@
 #include "pneuma/sim/PosedGeometry.h"
 #include "pneuma/sim/State.h"
 #include "pneuma/sim/Step.h"
+#include "pneuma/sim/Ties.h"
 
 namespace pneuma::meshing {
 namespace {
@@ -160,6 +161,12 @@ TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   const std::set<int> girdle = {body(m, "clavicle_right"), body(m, "clavicle_left"), body(m, "scapula_right"),
                                 body(m, "scapula_left"),   body(m, "humerus_right"), body(m, "humerus_left")};
   const std::vector<int> glide = scapulothoracicSprings(m);
+  // they, and they alone, are gliding springs, which views do not draw
+  for (int e = 0; e < m.elements.size(); ++e) {
+    const bool isGlide = std::find(glide.begin(), glide.end(), e) != glide.end();
+    EXPECT_EQ(m.elements.glides(e), isGlide) << e;
+    if (isGlide) EXPECT_FALSE(sim::isDrawn(m, e)) << e;
+  }
   const Eigen::Matrix3Xd from = restPoints(m.elements.endA, m), to = restPoints(m.elements.endB, m);
   for (int e = 0; e < m.elements.size(); ++e) {
     const int a = m.elements.endA.body[static_cast<std::size_t>(e)],

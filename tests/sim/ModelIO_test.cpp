@@ -11,6 +11,7 @@
 #include "pneuma/sim/BreathStyleController.h"
 #include "pneuma/sim/Error.h"
 #include "pneuma/sim/Simulation.h"
+#include "pneuma/sim/Ties.h"
 
 using namespace pneuma::sim;
 
@@ -243,6 +244,28 @@ TEST(ModelIO, RecruitmentIsOptionalAndChecked) {
               j["elements"][0]["recruitment"] = 0.2;
             }),
             "model.json: elements[0].recruitment: only a muscle is recruited; a cartilage spring is passive");
+}
+
+// a gliding spring (sim::Elements::isGliding) is marked only where there is one, read back and drawn by no
+// view; only a cartilage spring glides
+TEST(ModelIO, GlidingIsOptionalAndChecked) {
+  const std::string plain = serializeModel(tinyModel());
+  EXPECT_EQ(plain.find("gliding"), std::string::npos);
+  EXPECT_TRUE(parseModel(plain).elements.isGliding.empty());
+  nlohmann::json j = nlohmann::json::parse(plain);
+  j["elements"][0]["group"] = "cartilage";
+  const Model spring = parseModel(j.dump());
+  EXPECT_FALSE(spring.elements.glides(0));
+  j["elements"][0]["gliding"] = true;
+  const Model back = parseModel(j.dump());
+  ASSERT_EQ(back.elements.isGliding.size(), 1u);
+  EXPECT_TRUE(back.elements.glides(0));
+  EXPECT_TRUE(isDrawn(parseModel(plain), 0));
+  EXPECT_FALSE(isDrawn(back, 0));
+  EXPECT_EQ(parseModel(serializeModel(back)).elements.isGliding, back.elements.isGliding);
+  EXPECT_EQ(rejectionOf([](nlohmann::json& m) { m["elements"][0]["gliding"] = true; }),
+            "model.json: elements[0].gliding: only a cartilage spring glides; a muscle pulls its two bones "
+            "together");
 }
 
 TEST(ModelIO, RejectsTruncatedJson) {

@@ -173,10 +173,17 @@ struct Elements {
   /// c - c0) (recruitedActivation(), Elements.h). The shoulder girdle's accessory inspiratory muscles use it
   /// (docs/model-format.md).
   Eigen::VectorXd recruitment;
+  /// 1 for a gliding spring (#E, or empty: none): a cartilage spring that holds one bone on another while
+  /// letting it slide, like the scapulothoracic springs that hold the shoulder blade on the ribs. Its far end
+  /// is a virtual anchor deep inside the other bone's side, on the spring's line (a slide s lengthens it by
+  /// about s^2 / 2 l), so views draw no line for it (isDrawn(), Ties.h).
+  std::vector<std::uint8_t> isGliding;
 
   int size() const { return static_cast<int>(group.size()); }
   /// [-] recruitment threshold c0 of element `e` (0 when the model has none).
   double recruitmentOf(int e) const { return recruitment.size() == 0 ? 0.0 : recruitment(e); }
+  /// Whether element `e` is a gliding spring.
+  bool glides(int e) const { return !isGliding.empty() && isGliding[static_cast<std::size_t>(e)] != 0; }
 };
 
 /// Closed lung-cavity surface (Figure 6): its vertices are anchors, so its volume can be recomputed

@@ -167,9 +167,13 @@ struct StepConstants {
   /// (row, col) of the 3 x 3 blocks of bodyBlock that can be nonzero, first entries in free coordinates,
   /// lower triangle (2 x #blocks)
   Eigen::Matrix2Xi bodyEntries;
-  /// (node entry, body entry, bodyNodeBlock column) of the 3 x 3 body-node coupling blocks that can be
-  /// nonzero (3 x #blocks)
-  Eigen::Matrix3Xi couplingEntries;
+  /// (node entry, body entry) of the 3 x 3 body-node coupling blocks that can be nonzero, the body entry in
+  /// free coordinates (2 x #coupling blocks)
+  Eigen::Matrix2Xi couplingEntries;
+  /// the coupling block of body block row r (entries 3 r .. 3 r + 2: a body's translation at 2 b, its
+  /// rotation at 2 b + 1) and attached node k, as a column of couplingEntries, or -1 ((2 #B) x #attached)
+  Eigen::MatrixXi couplingSlot;
+  std::vector<int> treeJointOfChild;  ///< body -> the tree joint it is the child of, or -1 (#B)
   /// implicit solver entry -> free coordinate, or -1 (fixed or dependent)
   Eigen::VectorXi freeIndex;
   Eigen::VectorXi freeCoordinates;  ///< free coordinate -> implicit solver entry (#free)
@@ -255,8 +259,9 @@ struct StepScratch {
   std::vector<Eigen::Matrix3d> jointMassInverse;
   /// [kg, kg m, kg m^2] body block of the implicit system, J^T . J (6 #B x 6 #B)
   Eigen::MatrixXd bodyBlock;
-  /// [kg, kg m] its coupling to the attached nodes, J^T . (6 #B x 3 #attached)
-  Eigen::MatrixXd bodyNodeBlock;
+  /// [kg, kg m] its coupling to the attached nodes, J^T ., by 3 x 3 blocks (body rows, node columns), one per
+  /// column of couplingEntries (#coupling blocks)
+  std::vector<Eigen::Matrix3d> couplingBlock;
   Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
   /// implicit solver vectors (6 #B + 3 #N); cgX starts each solve at P^-1 b and ends as dv' of the step
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;

@@ -39,4 +39,17 @@ inline bool isApposition(const Model& m, int i) {
          m.nodes.region[static_cast<std::size_t>(tiedNode(m.elements, i))] != NodeRegion::Tissue;
 }
 
+/// True for an element that views draw as a line: every element but the ties (apposition springs and the
+/// volume bodies' ties), the volume bodies' own springs (a node of region Tissue at an end: the body is drawn
+/// as its surface) and the gliding springs (Elements::isGliding), whose far ends are virtual anchors off the
+/// bones.
+inline bool isDrawn(const Model& m, int i) {
+  const auto tissueEnd = [&](const AnchorSet& a) {
+    const std::size_t k = static_cast<std::size_t>(i);
+    return a.body[k] < 0 && m.nodes.region[static_cast<std::size_t>(a.nodes(0, i))] == NodeRegion::Tissue;
+  };
+  return !isApposition(m, i) && !tissueEnd(m.elements.endA) && !tissueEnd(m.elements.endB) &&
+         !m.elements.glides(i);
+}
+
 }  // namespace pneuma::sim
