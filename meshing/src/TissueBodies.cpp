@@ -28,8 +28,8 @@ constexpr int kPectoralColumns = 5;    // [-] sternal border, costochondral junc
 // [-] the pectoral's lateral edge: this share of the way from the costochondral junction back to the rib's
 // most lateral point (about the anterior axillary line)
 constexpr double kPectoralLateralShare = 0.35;
-constexpr int kDeltoidRows = 6;     // [-] from above the acromion down to the deltoid tuberosity
-constexpr int kDeltoidColumns = 7;  // [-] round the arm from the front to the back
+constexpr int kDeltoidRows = 5;     // [-] from above the acromion down to the deltoid tuberosity
+constexpr int kDeltoidColumns = 5;  // [-] round the arm from the front to the back
 // [rad] the cap's sweep round the upper arm, centred on its lateral side (front and back of the shoulder)
 constexpr double kDeltoidSweep = 200.0 * kPi / 180.0;
 // [-] share of the upper arm the cap covers below the glenohumeral joint (the deltoid tuberosity)

@@ -72,7 +72,7 @@ void BlockLdlt::analyze(int blocks, const std::vector<std::array<int, 2>>& patte
   m_y.assign(at(blocks), Block::Zero());
   setVectorKernel(true);
   m_pattern.assign(at(blocks), 0);
-  m_x.setZero(3 * blocks + 1);  // + 1: the AVX2 backward substitution reads one entry past a segment
+  m_x.setZero(3 * blocks + 1, 1);
 }
 
 int BlockLdlt::slot(int r, int c) const {
@@ -148,34 +148,52 @@ bool BlockLdlt::factorize() {
   return true;
 }
 
-void BlockLdlt::solve(Eigen::VectorXd& x) const {
+void BlockLdlt::solve(Eigen::VectorXd& x) const { substitute(x.data(), x.size(), 1); }
+
+void BlockLdlt::solveColumns(Eigen::Ref<Eigen::MatrixXd> x) const {
+  substitute(x.data(), x.outerStride(), x.cols());
+}
+
+void BlockLdlt::substitute(double* x, Eigen::Index stride, Eigen::Index columns) const {
   const int n = m_n;
-  for (int k = 0; k < n; ++k) m_x.segment<3>(3 * k) = x.segment<3>(3 * m_perm[at(k)]);
+  if (m_x.cols() < columns) m_x.setZero(3 * n + 1, columns);
+  const auto in = [&](Eigen::Index c) { return Eigen::Map<Eigen::VectorXd>(x + c * stride, 3 * n); };
+  for (Eigen::Index c = 0; c < columns; ++c)
+    for (int k = 0; k < n; ++k) m_x.col(c).segment<3>(3 * k) = in(c).segment<3>(3 * m_perm[at(k)]);
   // L z = b (column by column), then D
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d zi = m_x.segment<3>(3 * i);
     const int begin = m_lp[at(i)], end = m_lp[at(i) + 1];
-    if (m_avx2)
-      kernels::forwardColumnAvx2(m_x.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
-                                 end - begin, zi.data());
-    else
-      for (int p = begin; p < end; ++p)
-        m_x.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
+    for (Eigen::Index c = 0; c < columns; ++c) {
+      auto z = m_x.col(c);
+      const Eigen::Vector3d zi = z.segment<3>(3 * i);
+      if (m_avx2)
+        kernels::forwardColumnAvx2(z.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
+                                   end - begin, zi.data());
+      else
+        for (int p = begin; p < end; ++p)
+          z.segment<3>(3 * m_li[at(p)]).noalias() -= m_l[at(p)].topRows<3>() * zi;
+    }
   }
-  for (int i = 0; i < n; ++i) m_x.segment<3>(3 * i) = m_dInverse[at(i)] * m_x.segment<3>(3 * i).eval();
+  for (Eigen::Index c = 0; c < columns; ++c)
+    for (int i = 0; i < n; ++i)
+      m_x.col(c).segment<3>(3 * i) = m_dInverse[at(i)] * m_x.col(c).segment<3>(3 * i).eval();
   // L^T x = z
   for (int i = n - 1; i >= 0; --i) {
-    Eigen::Vector3d xi = m_x.segment<3>(3 * i);
     const int begin = m_lp[at(i)], end = m_lp[at(i) + 1];
-    if (m_avx2)
-      kernels::backwardColumnAvx2(xi.data(), m_x.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
-                                  end - begin);
-    else
-      for (int p = begin; p < end; ++p)
-        xi.noalias() -= m_l[at(p)].topRows<3>().transpose() * m_x.segment<3>(3 * m_li[at(p)]);
-    m_x.segment<3>(3 * i) = xi;
+    for (Eigen::Index c = 0; c < columns; ++c) {
+      auto z = m_x.col(c);
+      Eigen::Vector3d xi = z.segment<3>(3 * i);
+      if (m_avx2)
+        kernels::backwardColumnAvx2(xi.data(), z.data(), m_l.data()->data() + 12 * begin, m_li.data() + begin,
+                                    end - begin);
+      else
+        for (int p = begin; p < end; ++p)
+          xi.noalias() -= m_l[at(p)].topRows<3>().transpose() * z.segment<3>(3 * m_li[at(p)]);
+      z.segment<3>(3 * i) = xi;
+    }
   }
-  for (int k = 0; k < n; ++k) x.segment<3>(3 * m_perm[at(k)]) = m_x.segment<3>(3 * k);
+  for (Eigen::Index c = 0; c < columns; ++c)
+    for (int k = 0; k < n; ++k) in(c).segment<3>(3 * m_perm[at(k)]) = m_x.col(c).segment<3>(3 * k);
 }
 
 }  // namespace pneuma::sim

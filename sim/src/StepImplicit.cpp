@@ -386,56 +386,58 @@ void factorSystem(const Model& model, const StepOptions& o, const std::vector<in
     throw Error(
         "implicit solve: the system matrix is not positive definite (likely cause: a negative stiffness or "
         "mass)");
-  // the gut pressure's rank-one stiffness kp g g^T = u u^T by Sherman-Morrison:
-  // (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1 u)
+  // the rank-one terms on top, by Sherman-Morrison, (A + u u^T)^-1 = A^-1 - A^-1 u u^T A^-1 / (1 + u^T A^-1
+  // u): the gut pressure's kp g g^T = u u^T, then each volume body's u_k u_k^T, then the pleural v v^T with v
+  // = dt J^T g_c / sqrt(C); their solves with A0 first, together (columns 0, 1 .. #K, #K + 1 of factorRhs)
   const Eigen::Index nf = w.constants.freeCoordinates.size();
-  w.memory.rankOne.setZero(nf);
-  if (w.constants.restGutVolume > 0.0) {
-    const double su =
-        dt * std::sqrt(effectiveKappa(model, o) * w.constants.restGutVolume) / w.outputs.gutVolume;
-    for (Eigen::Index k = 0; k < nf; ++k) {
-      const Eigen::Index i =
-          w.constants.freeCoordinates(k) - 6 * static_cast<Eigen::Index>(model.bodies.size());
-      if (i >= 0) w.memory.rankOne(k) = su * w.scratch.gutGradient(i % 3, i / 3);
-    }
-  }
-  w.memory.rankOneSolve = w.memory.rankOne;
-  w.memory.system.solve(w.memory.rankOneSolve);
-  w.memory.rankOneScale = 1.0 / (1.0 + w.memory.rankOne.dot(w.memory.rankOneSolve));
-  // each volume body's u_k u_k^T likewise, on top of the gut's and the bodies' before it
   const int nk = model.volumes.size();
-  w.memory.volumeRank.setZero(nf, nk);
+  const auto bodyEntries = 6 * static_cast<Eigen::Index>(model.bodies.size());
+  Eigen::MatrixXd& rhs = w.scratch.factorRhs;
+  rhs.setZero();
+  const auto gather = [&](Eigen::Index column, double scale, const Eigen::Matrix3Xd& gradient) {
+    for (Eigen::Index k = 0; k < nf; ++k) {
+      const Eigen::Index i = w.constants.freeCoordinates(k) - bodyEntries;
+      if (i >= 0) rhs(k, column) = scale * gradient(i % 3, i / 3);
+    }
+  };
+  if (w.constants.restGutVolume > 0.0)
+    gather(0, dt * std::sqrt(effectiveKappa(model, o) * w.constants.restGutVolume) / w.outputs.gutVolume,
+           w.scratch.gutGradient);
+  for (int b = 0; b < nk; ++b)
+    gather(1 + b,
+           dt * std::sqrt(model.volumes.kappa(b) * w.constants.restBodyVolume(b)) /
+               w.outputs.volumeBodyVolume(b),
+           w.scratch.volumeGradient[at(b)]);
+  const bool pleural = w.scratch.pleuralStiffness > 0.0;
+  if (pleural) {
+    Eigen::VectorXd& v = w.scratch.cavityReduced;
+    v = w.scratch.cavityGeneralized;
+    gatherJointForces(model.joints, w, tree, v);
+    maskReduced(model.joints, w, tree, v);
+    const double sv = dt * std::sqrt(w.scratch.pleuralStiffness);
+    for (Eigen::Index k = 0; k < nf; ++k) rhs(k, nk + 1) = sv * v(w.constants.freeCoordinates(k));
+  }
+  w.memory.rankOne = rhs.col(0);
+  w.memory.volumeRank = rhs.middleCols(1, nk);
+  if (pleural)
+    w.memory.rankTwo = rhs.col(nk + 1);
+  else
+    w.memory.rankTwo.resize(0);
+  w.memory.system.solveColumns(rhs.leftCols(nk + (pleural ? 2 : 1)));
+  w.memory.rankOneSolve = rhs.col(0);
+  w.memory.rankOneScale = 1.0 / (1.0 + w.memory.rankOne.dot(w.memory.rankOneSolve));
   w.memory.volumeRankSolve.setZero(nf, nk);
   w.memory.volumeRankScale.setZero(nk);
   for (int b = 0; b < nk; ++b) {
-    const double su = dt * std::sqrt(model.volumes.kappa(b) * w.constants.restBodyVolume(b)) /
-                      w.outputs.volumeBodyVolume(b);
-    for (Eigen::Index k = 0; k < nf; ++k) {
-      const Eigen::Index i =
-          w.constants.freeCoordinates(k) - 6 * static_cast<Eigen::Index>(model.bodies.size());
-      if (i >= 0) w.memory.volumeRank(k, b) = su * w.scratch.volumeGradient[at(b)](i % 3, i / 3);
-    }
-    w.scratch.compactZ = w.memory.volumeRank.col(b);
-    w.memory.system.solve(w.scratch.compactZ);
+    w.scratch.compactZ = rhs.col(1 + b);
     w.scratch.compactZ -=
         (w.memory.rankOneScale * w.memory.rankOne.dot(w.scratch.compactZ)) * w.memory.rankOneSolve;
     applyVolumeCorrections(w, b, w.scratch.compactZ);
     w.memory.volumeRankSolve.col(b) = w.scratch.compactZ;
     w.memory.volumeRankScale(b) = 1.0 / (1.0 + w.memory.volumeRank.col(b).dot(w.scratch.compactZ));
   }
-  // and the pleural one, v v^T with v = dt J^T g_c / sqrt(C), on top: (A1 + v v^T)^-1 = A1^-1 - A1^-1 v v^T
-  // A1^-1 / (1 + v^T A1^-1 v), A1 = A0 + u u^T
-  w.memory.rankTwo.resize(0);
-  if (w.scratch.pleuralStiffness > 0.0) {
-    Eigen::VectorXd& v = w.scratch.cavityReduced;
-    v = w.scratch.cavityGeneralized;
-    gatherJointForces(model.joints, w, tree, v);
-    maskReduced(model.joints, w, tree, v);
-    const double sv = dt * std::sqrt(w.scratch.pleuralStiffness);
-    w.memory.rankTwo.resize(nf);
-    for (Eigen::Index k = 0; k < nf; ++k) w.memory.rankTwo(k) = sv * v(w.constants.freeCoordinates(k));
-    w.memory.rankTwoSolve = w.memory.rankTwo;
-    w.memory.system.solve(w.memory.rankTwoSolve);
+  if (pleural) {
+    w.memory.rankTwoSolve = rhs.col(nk + 1);
     w.memory.rankTwoSolve -=
         (w.memory.rankOneScale * w.memory.rankOne.dot(w.memory.rankTwoSolve)) * w.memory.rankOneSolve;
     applyVolumeCorrections(w, nk, w.memory.rankTwoSolve);
@@ -604,6 +606,7 @@ void analyzeSystem(const Model& model, StepWork& w) {
     w.constants.systemPattern.push_back(r >= 0 ? w.memory.system.slot(r, c) : -1);
   w.scratch.compactR.setZero(nf);
   w.scratch.compactZ.setZero(nf);
+  w.scratch.factorRhs.setZero(nf, model.volumes.size() + 2);
 }
 
 // linearly implicit Euler (Baraff & Witkin 1998): (M + dt D + dt^2 K) dv = dt (f - dt K v), by PCG, in the

@@ -165,7 +165,9 @@ TEST_P(GirdlePresets, ShoulderAndNeckSprings) {
   for (int e = 0; e < m.elements.size(); ++e) {
     const bool isGlide = std::find(glide.begin(), glide.end(), e) != glide.end();
     EXPECT_EQ(m.elements.glides(e), isGlide) << e;
-    if (isGlide) EXPECT_FALSE(sim::isDrawn(m, e)) << e;
+    if (isGlide) {
+      EXPECT_FALSE(sim::isDrawn(m, e)) << e;
+    }
   }
   const Eigen::Matrix3Xd from = restPoints(m.elements.endA, m), to = restPoints(m.elements.endB, m);
   for (int e = 0; e < m.elements.size(); ++e) {

@@ -53,6 +53,10 @@ class BlockLdlt {
   bool factorize();
   /// x <- A^-1 x (3 #blocks).
   void solve(Eigen::VectorXd& x) const;
+  /// X <- A^-1 X for several right-hand sides at once (3 #blocks x k): each block column of L is read once
+  /// for all k, which is where the substitutions spend their time; every column gets exactly solve()'s
+  /// result. Allocates when k exceeds that of every earlier call.
+  void solveColumns(Eigen::Ref<Eigen::MatrixXd> x) const;
 
   int blocks() const { return m_n; }
   /// Number of 3x3 blocks of L below the diagonal.
@@ -75,7 +79,11 @@ class BlockLdlt {
   std::vector<Block> m_y;
   bool m_avx2 = false;  ///< run the AVX2 + FMA kernel (BlockLdltKernels.h)
   std::vector<int> m_flag, m_pattern, m_lnz;
-  mutable Eigen::VectorXd m_x;  ///< permuted right-hand side of solve()
+  /// the substitutions of `columns` right-hand sides, column c at x + c * stride
+  void substitute(double* x, Eigen::Index stride, Eigen::Index columns) const;
+  /// permuted right-hand sides of solve() (3 #blocks + 1 rows, the last 0: the AVX2 backward substitution
+  /// reads one entry past a segment)
+  mutable Eigen::MatrixXd m_x;
 };
 
 }  // namespace pneuma::sim

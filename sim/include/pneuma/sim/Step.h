@@ -263,6 +263,9 @@ struct StepScratch {
   /// column of couplingEntries (#coupling blocks)
   std::vector<Eigen::Matrix3d> couplingBlock;
   Eigen::VectorXd compactR, compactZ;  ///< preconditioner scratch over the free coordinates (#free)
+  /// [kg^1/2] the factorization's right-hand sides, solved together: the gut's u, each volume body's u_k and
+  /// the pleural v (#free x (#K + 2))
+  Eigen::MatrixXd factorRhs;
   /// implicit solver vectors (6 #B + 3 #N); cgX starts each solve at P^-1 b and ends as dv' of the step
   Eigen::VectorXd cgX, cgR, cgZ, cgP, cgQ, cgB, cgT;
   /// [m] joint anchor minus com, world, at the step start (3 x #J)
