@@ -55,6 +55,10 @@ void buildBodies(const AnatomyParams& a, const Skeleton& sk, BuiltModel& out) {
       b.isSupported.resize(static_cast<std::size_t>(n), 0);
       b.isSupported[static_cast<std::size_t>(i)] = 1;
     }
+    if (bone.hangsFrom) {
+      if (b.supportHeight.size() == 0) b.supportHeight.setZero(n);
+      b.supportHeight(i) = (*bone.hangsFrom - mp.com).norm();
+    }
     b.mass(i) = scale * mp.mass;
     b.com.col(i) = mp.com;
     b.inertia.push_back(scale * mp.inertia);

@@ -169,7 +169,7 @@ Skeleton buildSkeleton(const AnatomyParams& a) {
     return vert[static_cast<std::size_t>(4 + 13 - t)];
   };  // T1..T12
   auto addBone = [&](const std::string& name, bool isFixed, TriangleMesh mesh) {
-    sk.bones.push_back({name, isFixed, std::move(mesh), 0.0, false});
+    sk.bones.push_back({name, isFixed, std::move(mesh), 0.0, false, std::nullopt});
     return static_cast<int>(sk.bones.size()) - 1;
   };
 
@@ -368,7 +368,7 @@ Eigen::Vector3d sideX(int side, double x) { return Eigen::Vector3d(side == kRigh
 void addGirdle(const AnatomyParams& a, Skeleton& sk) {
   const GirdleParams& g = a.girdle;
   auto addBone = [&](const std::string& name, bool isFixed, TriangleMesh mesh, double mass = 0.0) {
-    sk.bones.push_back({name, isFixed, std::move(mesh), mass, !isFixed});
+    sk.bones.push_back({name, isFixed, std::move(mesh), mass, !isFixed, std::nullopt});
     return static_cast<int>(sk.bones.size()) - 1;
   };
   sk.hasGirdle = true;
@@ -511,6 +511,13 @@ void addGirdle(const AnatomyParams& a, Skeleton& sk) {
       (part == 0 ? s.clavicle : part == 1 ? s.scapula : part == 2 ? s.humerus : s.forearm) = b;
     }
   }
+
+  // the arms hang from the shoulder joint: carried there, each segment turns back to its rest pose under its
+  // weight as a pendulum from that joint would (sim::Bodies::supportHeight), so that a blade turning under an
+  // arm in a deep breath does not swing it out
+  for (const GirdleSide& s : sk.girdle)
+    for (int part : {s.humerus, s.forearm})
+      sk.bones[static_cast<std::size_t>(part)].hangsFrom = s.glenohumeral;
 
   // joints: sternum - clavicle - scapula - humerus - forearm
   for (int side : {kRight, kLeft}) {

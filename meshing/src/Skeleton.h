@@ -3,6 +3,7 @@
 /// Procedural bones of the torso (world frame, rest pose) before remeshing and mass properties.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct Bone {
   TriangleMesh mesh;         ///< [m] world frame, closed, outward
   double mass = 0.0;         ///< [kg] segment mass; 0: the mesh's volume at the bone density
   bool isSupported = false;  ///< held against gravity by a postural support (sim::Bodies::isSupported)
+  /// [m] world, rest pose: the joint a supported segment hangs from (an arm's shoulder joint), or none; its
+  /// support height (sim::Bodies::supportHeight) is the distance from its centre of mass to this point
+  std::optional<Eigen::Vector3d> hangsFrom;
 };
 
 /// A ball joint between two bones.

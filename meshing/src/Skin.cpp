@@ -905,18 +905,30 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
       out.weights(0, v) = 1.0;
       continue;
     }
+    // the still body and each limb (a body with a postural support: the shoulder girdle and arms) carry
+    // their share of the vertex rigidly, as a point of theirs at the vertex itself (linear blend skinning);
+    // the torso's bones and the gut move the vertex with their anchors' displacement, so that the tissue
+    // over a turning rib moves as the rib's surface does. With every anchor plus offset, a limb's skin did
+    // not turn with the limb: the hand's and the elbow's small triangles folded over at the view's 5x
     Eigen::Vector3d blend = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < b.size(); ++k) {
-      const auto [a, w] = b[k];
-      if (a < 0) {
-        out.anchor(static_cast<int>(k), v) = out.anchors.size();
-        out.anchors.addBodyPoint(still, x - m.bodies.com.col(still));
+    std::map<int, int> slotOfBody;  // rigid carrier -> its slot
+    int slots = 0;
+    for (const auto& [a, w] : b) {
+      const int body =
+          a < 0 ? still : o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(a)])];
+      if (a < 0 || (body >= 0 && m.bodies.supported(body))) {
+        auto [it, isNew] = slotOfBody.emplace(body, slots);
+        if (isNew) {
+          out.anchor(slots++, v) = out.anchors.size();
+          out.anchors.addBodyPoint(body, x - m.bodies.com.col(body));
+        }
+        out.weights(it->second, v) += w;
         blend += w * x;
       } else {
-        out.anchor(static_cast<int>(k), v) = useAnchor(a);
+        out.anchor(slots, v) = useAnchor(a);
+        out.weights(slots++, v) = w;
         blend += w * o.point[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(a)])];
       }
-      out.weights(static_cast<int>(k), v) = w;
     }
     out.offset.col(v) = x - blend;
   }

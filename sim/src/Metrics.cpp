@@ -280,9 +280,12 @@ void computeMetrics(const Model& model, const State& state, const Activations& a
     const Vector3d om = r.transpose() * state.bodyAngularVelocity.col(b);
     kinetic += 0.5 * model.bodies.mass(b) * state.bodyVelocity.col(b).squaredNorm() +
                0.5 * om.dot(model.bodies.inertia[at(b)] * om);
-    // a supported body's weight is carried (postureSupport()): no gravity energy
-    if (!model.bodies.supported(b))
-      gravity -= model.bodies.mass(b) * g.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
+    gravity -= model.bodies.mass(b) * g.dot(state.bodyPosition.col(b) - model.bodies.com.col(b));
+    // the postural support: a constant force f at the body point p (postureSupport(), postureSupportPoint())
+    if (model.bodies.supported(b)) {
+      const Vector3d f = postureSupport(model, b, options), p = postureSupportPoint(model, b, options);
+      gravity -= f.dot(state.bodyPosition.col(b) - model.bodies.com.col(b) + r * p - p);
+    }
   }
   for (int n = 0; n < model.nodes.size(); ++n) {
     if (model.nodes.isFixed(n)) continue;

@@ -371,6 +371,8 @@ void validateModel(const Model& m) {
     invalid("bodies", "inconsistent array sizes");
   if (!m.bodies.isSupported.empty() && static_cast<int>(m.bodies.isSupported.size()) != nB)
     invalid("bodies", "inconsistent supported list");
+  if (m.bodies.supportHeight.size() != 0 && m.bodies.supportHeight.size() != nB)
+    invalid("bodies", "inconsistent support_height list");
   std::set<std::string> names;
   for (int i = 0; i < nB; ++i) {
     const std::string f = "bodies[" + std::to_string(i) + "]";
@@ -379,6 +381,10 @@ void validateModel(const Model& m) {
     if (!names.insert(name).second) invalid(f + ".name", "duplicate body name '" + name + "'");
     requirePositive(m.bodies.mass[i], f + ".mass");
     requireFinite(m.bodies.com.col(i), f + ".com");
+    if (const double h = m.bodies.supportHeightOf(i); h != 0.0) {
+      if (!(h > 0.0 && h <= 2.0)) invalid(f + ".support_height", "must be in (0, 2] m, got " + num(h));
+      if (!m.bodies.supported(i)) invalid(f + ".support_height", "needs \"supported\": true");
+    }
     const Eigen::Matrix3d& I = m.bodies.inertia[static_cast<std::size_t>(i)];
     if (!I.allFinite() || (I - I.transpose()).norm() > 1e-9 * (1.0 + I.norm()))
       invalid(f + ".inertia", "must be a finite symmetric 3x3 matrix");
@@ -605,7 +611,7 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
   m.bodies.com.resize(3, static_cast<Eigen::Index>(nB));
   for (std::size_t i = 0; i < nB; ++i) {
     const Reader b = bodies[i];
-    b.allowKeys({"name", "fixed", "mass", "com", "inertia", "mesh", "supported"});
+    b.allowKeys({"name", "fixed", "mass", "com", "inertia", "mesh", "supported", "support_height"});
     m.bodies.name.push_back(b.at("name").string());
     m.bodies.isFixed.push_back(b.at("fixed").boolean() ? 1 : 0);
     m.bodies.mass[static_cast<Eigen::Index>(i)] = b.at("mass").number();
@@ -620,6 +626,11 @@ Model parseModel(const std::string& jsonText, const std::string& sourceName) {
     if (b.has("supported") && b.at("supported").boolean()) {
       m.bodies.isSupported.resize(nB, 0);
       m.bodies.isSupported[i] = 1;
+    }
+    // optional: the support acts at the centre of mass when absent
+    if (b.has("support_height")) {
+      if (m.bodies.supportHeight.size() == 0) m.bodies.supportHeight.setZero(static_cast<Eigen::Index>(nB));
+      m.bodies.supportHeight(static_cast<Eigen::Index>(i)) = b.at("support_height").number();
     }
   }
 
@@ -798,6 +809,7 @@ std::string serializeModel(const Model& m) {
     b["inertia"] = {vec(I.row(0).transpose()), vec(I.row(1).transpose()), vec(I.row(2).transpose())};
     b["mesh"] = m.bodies.mesh[static_cast<std::size_t>(i)];
     if (m.bodies.supported(i)) b["supported"] = true;
+    if (m.bodies.supportHeightOf(i) != 0.0) b["support_height"] = m.bodies.supportHeightOf(i);
     bodies.push_back(std::move(b));
   }
   doc["bodies"] = std::move(bodies);

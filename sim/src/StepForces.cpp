@@ -201,13 +201,17 @@ void accumulateVisceralDrag(const Model& model, const State& s, const StepOption
 }
 
 // gravity (the posture's, postureGravity()) on moving bodies and nodes, and the postural supports
-// (postureSupport()); gyroscopic torque -w x (I w)
+// (postureSupport(), at postureSupportPoint()); gyroscopic torque -w x (I w)
 void accumulateGravityAndGyroscopic(const Model& model, const State& s, const StepOptions& o, StepWork& w) {
   const Vector3d g = postureGravity(model, o);
   for (int b = 0; b < model.bodies.size(); ++b) {
     if (model.bodies.isFixed[at(b)]) continue;
-    if (o.gravity) w.scratch.bodyForce.col(b) += model.bodies.mass(b) * g + postureSupport(model, b, o);
     const Matrix3d& r = w.scratch.rotation[at(b)];
+    if (o.gravity) {
+      const Vector3d support = postureSupport(model, b, o);
+      w.scratch.bodyForce.col(b) += model.bodies.mass(b) * g + support;
+      w.scratch.bodyTorque.col(b) += (r * postureSupportPoint(model, b, o)).cross(support);
+    }
     const Vector3d om = s.bodyAngularVelocity.col(b);
     w.scratch.bodyTorque.col(b) -= om.cross(r * (model.bodies.inertia[at(b)] * (r.transpose() * om)));
   }

@@ -89,6 +89,13 @@ Eigen::Vector3d postureSupport(const Model& model, int b, const StepOptions& o) 
   return -model.bodies.mass(b) * postureGravity(model, o);
 }
 
+Eigen::Vector3d postureSupportPoint(const Model& model, int b, const StepOptions& o) {
+  const Eigen::Vector3d g = postureGravity(model, o);
+  const double h = model.bodies.supportHeightOf(b);
+  if (!model.bodies.supported(b) || h == 0.0 || g.norm() == 0.0) return Eigen::Vector3d::Zero();
+  return -h * g.normalized();
+}
+
 double defaultTimeStep(IntegratorKind k) { return k == IntegratorKind::SymplecticEuler ? 1e-5 : 1.0 / 60.0; }
 
 void validateStepOptions(const StepOptions& o) {

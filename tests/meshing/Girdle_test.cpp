@@ -122,6 +122,12 @@ TEST_P(GirdlePresets, BonesJointsAndSegmentMasses) {
     }
     // the elbow is a hinge about the axis normal to the upper arm and the forward direction
     EXPECT_GT(m.joints.lockStiffness(joint(m, "elbow" + s)), 0.0);
+    // the arm hangs from the shoulder joint (Bodies::supportHeight), the shoulder girdle is weightless
+    const Eigen::Vector3d shoulder = m.joints.anchor.col(joint(m, "glenohumeral" + s));
+    for (int part : {humerus, forearm})
+      EXPECT_NEAR(m.bodies.supportHeightOf(part), (m.bodies.com.col(part) - shoulder).norm(), 1e-12);
+    EXPECT_EQ(m.bodies.supportHeightOf(clavicle), 0.0);
+    EXPECT_EQ(m.bodies.supportHeightOf(scapula), 0.0);
   }
   EXPECT_TRUE(m.bodies.isFixed[static_cast<std::size_t>(body(m, "cervical_spine"))]);
   EXPECT_TRUE(m.bodies.isFixed[static_cast<std::size_t>(body(m, "head"))]);
@@ -333,6 +339,41 @@ TEST_P(GirdlePresets, HandsFollowTheForearms) {
   RecordProperty("largest_fixed_share_on_a_hand", std::to_string(worst));
   EXPECT_GT(onForearm, 100);
   EXPECT_LT(worst, 0.05);
+}
+
+// the skin of a limb turns with it: turned alone about the elbow, the forearm carries every skin vertex by
+// its share w of the vertex, x' = x + w (T x - x) with T the forearm's rigid motion (linear blend skinning,
+// meshing/src/Skin.cpp), so that the hand's and the elbow's small triangles keep their shape at the view's
+// motion magnification; bound to anchor points plus a fixed offset, a vertex 3 cm off its anchors moved
+// 3 cm x the angle off its place
+TEST_P(GirdlePresets, LimbSkinTurnsWithTheLimb) {
+  const sim::Model& m = builtWithSkin(GetParam()).model;
+  const int forearm = body(m, "forearm_right");
+  const Eigen::Vector3d elbow = m.joints.anchor.col(joint(m, "elbow_right"));
+  sim::State s = sim::makeInitialState(m);
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.3, 1.0, 0.2).normalized()).toRotationMatrix();
+  s.bodyOrientation[static_cast<std::size_t>(forearm)] = Eigen::Quaterniond(r);
+  s.bodyPosition.col(forearm) = elbow + r * (m.bodies.com.col(forearm) - elbow);
+  sim::PosedGeometry rest, turned;
+  sim::poseGeometry(m, sim::makeInitialState(m), rest);
+  sim::poseGeometry(m, s, turned);
+  int carried = 0;
+  double worst = 0.0;
+  for (int v = 0; v < m.skin.vertexCount(); ++v) {
+    double w = 0.0;
+    for (int k = 0; k < sim::kSkinVertexSlots; ++k) {
+      const int a = m.skin.anchor(k, v);
+      if (a >= 0 && m.skin.anchors.body[static_cast<std::size_t>(a)] == forearm) w += m.skin.weights(k, v);
+    }
+    if (w == 0.0) continue;
+    ++carried;
+    const Eigen::Vector3d x = rest.skin.col(v);
+    const Eigen::Vector3d expected = x + w * (elbow + r * (x - elbow) - x);
+    worst = std::max(worst, (turned.skin.col(v) - expected).norm());
+  }
+  EXPECT_GT(carried, 500);
+  EXPECT_LT(worst, 1e-9) << "[m]";
 }
 
 // a deep breath lifts the shoulders visibly, by at least 10 mm more than a calm one (validate's

@@ -268,6 +268,28 @@ TEST(ModelIO, GlidingIsOptionalAndChecked) {
             "together");
 }
 
+// a body's support height (bodies[i].support_height [m]): optional, written only where set, kept through a
+// round trip, and only in (0, 2] m on a supported body
+TEST(ModelIO, SupportHeightIsOptionalAndChecked) {
+  const std::string plain = serializeModel(tinyModel());
+  EXPECT_EQ(plain.find("support_height"), std::string::npos);
+  EXPECT_EQ(parseModel(plain).bodies.supportHeight.size(), 0);
+  nlohmann::json j = nlohmann::json::parse(plain);
+  j["bodies"][1]["supported"] = true;
+  j["bodies"][1]["support_height"] = 0.25;
+  const Model hanging = parseModel(j.dump());
+  EXPECT_EQ(hanging.bodies.supportHeightOf(1), 0.25);
+  EXPECT_EQ(hanging.bodies.supportHeightOf(0), 0.0);
+  EXPECT_EQ(parseModel(serializeModel(hanging)).bodies.supportHeight, hanging.bodies.supportHeight);
+  EXPECT_EQ(rejectionOf([](nlohmann::json& m) { m["bodies"][1]["support_height"] = 0.25; }),
+            "model.json: bodies[1].support_height: needs \"supported\": true");
+  EXPECT_EQ(rejectionOf([](nlohmann::json& m) {
+              m["bodies"][1]["supported"] = true;
+              m["bodies"][1]["support_height"] = -0.1;
+            }),
+            "model.json: bodies[1].support_height: must be in (0, 2] m, got -0.1");
+}
+
 TEST(ModelIO, RejectsTruncatedJson) {
   const std::string text = serializeModel(tinyModel());
   try {

@@ -347,5 +347,66 @@ TEST(PosturalSupport, CarriesItsBodyAgainstGravityInEveryPosture) {
   EXPECT_GT((s.bodyPosition.col(1) - m.bodies.com.col(1)).norm(), 0.01);
 }
 
+// a support carried a height h above the centre of mass (Bodies::supportHeight) leaves the body weightless
+// and turns it back to its rest orientation as a pendulum of length h: torque m |g| h sin(angle) (against
+// the derivative of computeMetrics()'s gravity energy, m |g| h (1 - cos(angle))) in every posture, and a free
+// body released 0.05 rad off its rest orientation swings back through it after a quarter period
+// (pi / 2) sqrt(I / (m |g| h)), its centre of mass still
+TEST(PosturalSupport, ABodyCarriedAboveItsCentreOfMassTurnsBackAsAPendulum) {
+  Model m;
+  test::addBody(m, "neck", true, 1.0, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity());
+  const double mass = 2.0, inertia = 0.01, h = 0.3;  // [kg], [kg m^2], [m]
+  test::addBody(m, "arm", false, mass, Eigen::Vector3d(0.15, 0.05, -0.2),
+                inertia * Eigen::Matrix3d::Identity());
+  m.bodies.isSupported = {0, 1};
+  m.bodies.supportHeight = Eigen::Vector2d(0.0, h);
+  const Eigen::Vector3d axis = Eigen::Vector3d(1.0, 0.0, 0.0);
+  for (const char* name : {"upright", "supine", "left-lateral"}) {
+    SCOPED_TRACE(name);
+    StepOptions o;
+    ASSERT_TRUE(postureFromName(name, o.posture));
+    const double g = postureGravity(m, o).norm();
+    auto turned = [&](double angle) {
+      State s = makeInitialState(m);
+      s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis));
+      return s;
+    };
+    auto energy = [&](double angle) {
+      StepWork w = makeStepWork(m);
+      Metrics out;
+      computeMetrics(m, turned(angle), relaxedActivations(), o, w, out);
+      return out.gravityEnergy;
+    };
+    // the support's axis is vertical in this posture; the body turns about x, across it except on its side
+    const double across = postureGravity(m, o).normalized().cross(axis).norm();
+    const double angle = 0.2;
+    StepWork w = makeStepWork(m);
+    computeForces(m, turned(angle), relaxedActivations(), o, w);
+    EXPECT_LT(w.scratch.bodyForce.col(1).norm(), 1e-12) << "weightless";
+    EXPECT_NEAR(energy(angle), mass * g * h * (1.0 - std::cos(across * angle)), 1e-3 * mass * g * h * angle);
+    const double d = 1e-6;
+    EXPECT_NEAR(w.scratch.bodyTorque.col(1).dot(axis), -(energy(angle + d) - energy(angle - d)) / (2 * d),
+                1e-6);
+    if (across == 1.0) {
+      EXPECT_NEAR(w.scratch.bodyTorque.col(1).dot(axis), -mass * g * h * std::sin(angle), 1e-9);
+    }
+  }
+  // released upright: it swings back through its rest orientation after a quarter period
+  State s = makeInitialState(m);
+  s.bodyOrientation[1] = Eigen::Quaterniond(Eigen::AngleAxisd(0.05, axis));
+  StepWork w = makeStepWork(m);
+  const double dt = 1e-4, quarter = 0.5 * M_PI * std::sqrt(inertia / (mass * 9.81 * h));
+  double t = 0.0;
+  while (Eigen::AngleAxisd(s.bodyOrientation[1]).axis().dot(axis) *
+                 Eigen::AngleAxisd(s.bodyOrientation[1]).angle() >
+             0.0 &&
+         t < 4.0 * quarter) {
+    step(m, s, dt, relaxedActivations(), StepOptions{}, w);
+    t += dt;
+  }
+  EXPECT_NEAR(t, quarter, 0.02 * quarter);
+  EXPECT_LT((s.bodyPosition.col(1) - m.bodies.com.col(1)).norm(), 1e-9);
+}
+
 }  // namespace
 }  // namespace pneuma::sim

@@ -72,12 +72,22 @@ struct Bodies {
   /// from the rib cage: a support carries each such body's weight in every posture, f = -m g
   /// (postureGravity()), so that the breathing rib cage does not carry the arms (postureSupport(), Step.h).
   std::vector<std::uint8_t> isSupported;
+  /// [m] h_b >= 0, the height above its centre of mass, against gravity in the rest pose, at which the
+  /// support carries a supported body's weight (#B, or empty: 0 for every body; 0 where not supported). At
+  /// h = 0 the body is weightless; at h > 0 it hangs: the support's force at p = -h g/|g| (body frame) and
+  /// the weight at the centre of mass make a couple that turns the body back to its rest orientation as a
+  /// pendulum of length h would, m |g| h sin(angle), while its translation stays carried. The arms have
+  /// the height of their centre of mass below the shoulder joint, so they hang in the skin's pose from the
+  /// blades, which can turn and lift under them (postureSupportPoint(), Step.h).
+  Eigen::VectorXd supportHeight;
 
   int size() const { return static_cast<int>(name.size()); }
   /// Whether body `b` has a postural support.
   bool supported(int b) const {
     return !isSupported.empty() && isSupported[static_cast<std::size_t>(b)] != 0;
   }
+  /// [m] supportHeight of body `b` (0 when the model has none).
+  double supportHeightOf(int b) const { return supportHeight.size() == 0 ? 0.0 : supportHeight(b); }
 };
 
 /// Ball joints (Zordan et al. 2004, Section 5): rib-spine costovertebral joints and the joints

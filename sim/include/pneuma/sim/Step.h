@@ -131,9 +131,17 @@ Eigen::Vector3d postureGravity(const Model& model, const StepOptions& o);
 
 /// [N] The postural support of body `b` (Bodies::isSupported): f = -m_b postureGravity(), the body's weight
 /// carried by the neck and back muscles in the run's posture; zero for a body without one. The step adds it
-/// to the body's force, so a supported body feels no net gravity in any posture; computeMetrics() counts no
-/// gravity energy for it.
+/// to the body's force, so a supported body feels no net gravity in any posture, at the body point
+/// postureSupportPoint().
 Eigen::Vector3d postureSupport(const Model& model, int b, const StepOptions& o);
+
+/// [m] Where the postural support acts on body `b`, in its body frame relative to its centre of mass:
+/// p = -h_b g/|g| (Bodies::supportHeight, g = postureGravity()), straight above the centre of mass in the
+/// rest pose of the run's posture; zero without gravity or height. The step adds the torque (R p) x f of the
+/// force f = postureSupport() at it; computeMetrics() counts its potential -f . (R p - p), m |g| h (1 - cos
+/// of the angle the body turned from the vertical it rested on), with gravity's, whose translational part it
+/// cancels.
+Eigen::Vector3d postureSupportPoint(const Model& model, int b, const StepOptions& o);
 
 /// Checks the options (finite, non-negative scales, kappa, iteration counts).
 /// @throws Error naming the field and value.
