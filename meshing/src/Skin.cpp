@@ -963,9 +963,12 @@ void buildSkin(const AnatomyParams& a, const std::string& file, BuiltModel& out)
   const Obstacles obstacles = obstaclesOf(out);
   out.report.skinBoneClearance = pushOut(skin, obstacles);
 
-  // residuals at the landmarks after the push: distance from each target to the skin surface
+  // residuals at the surface landmarks after the push: distance from each target to the skin surface (the
+  // arms' elbows, wrists and fingertips are matched on the centreline, inside the skin: no depth)
   double residual = 0.0;
-  for (const Eigen::Vector3d& p : to) {
+  for (const Landmark& l : target) {
+    if (l.skin == l.bone) continue;
+    const Eigen::Vector3d& p = l.skin;
     double best = 1e9;
     for (int f = 0; f < skin.triangleCount(); ++f)
       best = std::min(best, pointTriangleDistance(p, skin.vertices.col(skin.triangles(0, f)),

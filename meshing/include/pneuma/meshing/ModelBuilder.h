@@ -22,7 +22,7 @@ struct BuildReport {
   double gutQualityMean = 0.0;        ///< [-] mean pressure-surface triangle quality
   int boneTriangles = 0;              ///< triangles of all remeshed bones
   int skinTetrahedra = 0;             ///< TetGen tetrahedra of the soft tissue inside the skin (0: no skin)
-  double skinLandmarkResidual = 0.0;  ///< [m] largest distance from a skin landmark target to the skin
+  double skinLandmarkResidual = 0.0;  ///< [m] largest distance from a surface landmark's target to the skin
   double skinBoneClearance = 0.0;     ///< [m] least distance from a skin vertex to a bone surface
 };
 
