@@ -24,6 +24,7 @@ struct BuildOptions {
   std::string out;
   std::string skin = meshing::kDefaultSkinFile;
   bool isPreviewSkipped = false;
+  bool hasShoulderGirdle = false;  // the preset's shoulder_girdle turned on
 };
 
 struct InfoOptions {
@@ -33,7 +34,8 @@ struct InfoOptions {
 
 void runBuild(const BuildOptions& o) {
   const auto start = std::chrono::steady_clock::now();
-  const meshing::AnatomyParams anatomy = meshing::loadAnatomy(o.anatomy);
+  meshing::AnatomyParams anatomy = meshing::loadAnatomy(o.anatomy);
+  if (o.hasShoulderGirdle) anatomy.hasShoulderGirdle = true;
   const meshing::BuiltModel built = meshing::buildModel(anatomy, o.skin);
   meshing::writeModelDirectory(built, o.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -100,6 +102,8 @@ void addModelCommand(CLI::App& app) {
        "Body surface mesh (any format assimp reads: OBJ, STL, PLY, glTF, Collada), registered to the "
        "anatomy")
       ->capture_default_str();
+  b->add_flag("--shoulder-girdle", build->hasShoulderGirdle,
+              "Add the shoulder girdle, arms and neck (the anatomy option shoulder_girdle) to the preset");
   b->add_flag("--no-preview", build->isPreviewSkipped, "Do not render preview_front.png / preview_side.png");
   b->callback([build] { guarded([&] { runBuild(*build); }); });
 

@@ -13,10 +13,7 @@ mkdir -p "$out"
 "$cli" simulate --style deep --duration 6 --out "$out/deep" --gltf "$out/deep.glb" --morphs "$out/morphs.glb"
 "$cli" play --affect fear --duration 10 --gltf "$out/fear.glb" --morphs "$out/morphs.glb"
 "$cli" play --affect relaxation --duration 12 --gltf "$out/relaxation.glb" --morphs "$out/morphs.glb"
-# the girdle model: a copy of the shipped anatomy with the option on
-cp -r "$anatomy" "$out/anatomy"
-sed -i 's/"shoulder_girdle": false/"shoulder_girdle": true/' "$out/anatomy/male.json"
-grep -q '"shoulder_girdle": true' "$out/anatomy/male.json"
-"$cli" model build --anatomy "$out/anatomy/male.json" --out "$out/girdle-model" --no-preview
+# the girdle model: the shipped anatomy with the option on
+"$cli" model build --anatomy "$anatomy/male.json" --shoulder-girdle --out "$out/girdle-model" --no-preview
 "$cli" simulate --model "$out/girdle-model" --style deep --duration 6 --out "$out/girdle-deep" \
   --gltf "$out/girdle-deep.glb"

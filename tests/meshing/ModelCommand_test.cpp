@@ -59,6 +59,23 @@ TEST(ModelCommand, BuildWithoutDisplayWritesTheModelAndSkipsPreviews) {
   fs::remove_all(out);
 }
 
+// --shoulder-girdle turns on the preset's shoulder_girdle: the model gains the clavicles, scapulae and arms,
+// the neck and the accessory muscles, and its info counts them
+TEST(ModelCommand, ShoulderGirdleFlagAddsTheGirdleToThePreset) {
+  const fs::path out = scratch("girdle");
+  const test::CliResult r = runCli({"model", "build", "--anatomy", kAnatomy + "male.json",
+                                    "--shoulder-girdle", "--out", out.string(), "--no-preview"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const sim::Model m = sim::loadModel(out.string());
+  const sim::Model plain = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
+  for (const char* bone : {"clavicle_right", "scapula_left", "humerus_right", "forearm_left", "head"})
+    EXPECT_NE(std::find(m.bodies.name.begin(), m.bodies.name.end(), bone), m.bodies.name.end()) << bone;
+  EXPECT_EQ(m.bodies.size(), plain.bodies.size() + 10);
+  EXPECT_GE(m.landmarks.find("acromion_right"), 0);
+  EXPECT_LT(plain.landmarks.find("acromion_right"), 0);
+  fs::remove_all(out);
+}
+
 TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {
   // a copy of the male preset with a negative rib length, beside its gains file
   const fs::path dir = scratch("corrupt");
