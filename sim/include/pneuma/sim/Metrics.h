@@ -46,7 +46,8 @@ struct Metrics {
   double elasticEnergy =
       0.0;  ///< [J] springs (one-sided muscles, two-sided cartilage), gut and volume-body pressure, joints
   double gravityEnergy = 0.0;  ///< [J] -m g . x summed with the posture's g (postureGravity()), relative to
-                               ///< the rest pose (0 when gravity is off)
+                               ///< the rest pose (0 when gravity is off), with the postural supports'
+                               ///< potential (postureSupportPoint(), Step.h)
   double maxJointError = 0.0;  ///< [m] largest ball-joint separation after the step
   Eigen::Matrix3Xd landmarks;  ///< [m] landmark positions, world, in Model::landmarks order (3 x #L)
 };
