@@ -52,7 +52,21 @@ constexpr double kAcromionToRib8 = 1.4;  // [-] acromion half-breadth / rib-8 la
 // each other when the view magnifies the motion 5x (tests/sim/SkinCreases_test.cpp: a calm breath at 5x, 99th
 // percentile of the fold-angle change 27 deg and 16 self-crossings, against 48 deg and 66 with 10 passes)
 constexpr int kBindingSmoothingPasses = 60;
-constexpr int kSlabs = 240;  // horizontal sections of the source mesh
+// the upper trapezius carries the skin of the shoulders' top and the upper back: its fibres run from the neck
+// and the upper thoracic spinous processes (still) to the clavicle's lateral third, the acromion and the
+// scapular spine (moving with the girdle), so a point of it moves with the girdle by its share of the way
+// from the neck to the acromion (trapeziusShare()). Bound to the girdle as a whole, the skin over the
+// shoulders' top rose with it by the acromion's full lift up to the neck's side: a deep breath's shrug added
+// 330 mL to the body's volume (the skin's enclosed volume 1.24 times the lungs' change, male; 1.21 female;
+// the tissue is incompressible: 1). Measured (tests/validation/Skin_test.cpp on the girdle models): 1.03 with
+// the values below (male and female); 1.07 with the lower edge 6 cm below the acromion instead of 12
+constexpr double kTrapeziusNeck = 0.3;  // [-] share of the way from the neck's axis to the acromion where the
+                                        // fibres leave the neck (its side: about 55 of 185 mm)
+constexpr double kTrapeziusReach =
+    0.66;  // [-] the region's lower edge below the acromion, of its half-breadth
+           // (12 cm male: about T4, where the transverse fibres end)
+constexpr double kTrapeziusBlend = 0.03;  // [m] the lower edge's blend upward into the region
+constexpr int kSlabs = 240;               // horizontal sections of the source mesh
 
 using Points = std::vector<Eigen::Vector3d>;
 
@@ -736,6 +750,21 @@ double pushOut(TriangleMesh& s, const Obstacles& o) {
 
 constexpr int kK = sim::kSkinVertexSlots - 1;  // nearest anchors per vertex; the last slot for the still body
 
+/// The share of the shoulder girdle's motion the tissue at `p` takes through the upper trapezius
+/// (kTrapezius*): on the side of acromion `a` [m] (world, rest), medial of it and above its height less
+/// kTrapeziusReach of its half-breadth, f = clamp((t - t0) / (1 - t0), 0, 1) with t the share of the way from
+/// the neck's axis n = (0, a_y, a_z) to the acromion, t = (p - n).(a - n) / |a - n|^2, and t0 =
+/// kTrapeziusNeck; blended to 1 (all of it) over kTrapeziusBlend below the region.
+double trapeziusShare(const Eigen::Vector3d& p, const Eigen::Vector3d& a) {
+  if (p.x() * a.x() <= 0.0 || std::abs(p.x()) > std::abs(a.x())) return 1.0;
+  const Eigen::Vector3d n(0.0, a.y(), a.z());
+  const double t = std::clamp((p - n).dot(a - n) / (a - n).squaredNorm(), 0.0, 1.0);
+  const double f = std::clamp((t - kTrapeziusNeck) / (1.0 - kTrapeziusNeck), 0.0, 1.0);
+  const double lower = a.z() - kTrapeziusReach * std::abs(a.x());
+  const double inside = std::clamp((p.z() - lower) / kTrapeziusBlend, 0.0, 1.0);
+  return 1.0 - inside * (1.0 - f);
+}
+
 void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o, sim::Skin& out,
           int& tetCount) {
   const sim::Model& m = built.model;
@@ -845,6 +874,34 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
     Binding& b = binding[static_cast<std::size_t>(v)];
     for (const auto& [d, a] : f) b.emplace_back(a, share / std::max(d * d, 1e-6) / sum);
     if (share < 1.0) b.emplace_back(-1, 1.0 - share);
+  }
+  // the upper trapezius: the girdle's share of the tissue between the neck and the shoulders goes to the
+  // still body (trapeziusShare())
+  for (const char* name : {"acromion_right", "acromion_left"}) {
+    const int l = m.landmarks.find(name);
+    if (l < 0 || still < 0) continue;
+    const int lb = m.landmarks.points.body[static_cast<std::size_t>(l)];
+    const Eigen::Vector3d a = m.bodies.com.col(lb) + m.landmarks.points.local.col(l);
+    for (int v = 0; v < nV; ++v) {
+      const double keep = trapeziusShare(skin.vertices.col(v), a);
+      if (keep >= 1.0) continue;
+      Binding& b = binding[static_cast<std::size_t>(v)];
+      double moved = 0.0;
+      for (auto& [anchor, w] : b) {
+        const int body =
+            anchor < 0 ? -1
+                       : o.body[static_cast<std::size_t>(anchorSource[static_cast<std::size_t>(anchor)])];
+        if (body < 0 || !m.bodies.supported(body)) continue;
+        moved += (1.0 - keep) * w;
+        w *= keep;
+      }
+      if (moved <= 0.0) continue;
+      auto stillSlot = std::find_if(b.begin(), b.end(), [](const auto& x) { return x.first < 0; });
+      if (stillSlot != b.end())
+        stillSlot->second += moved;
+      else
+        b.emplace_back(-1, moved);
+    }
   }
   // smooth the bindings over the surface (neighbouring vertices move alike: no fold of the source closes
   // through itself), keeping each vertex's kK strongest anchors and its still share
