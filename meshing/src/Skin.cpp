@@ -877,11 +877,11 @@ void bind(const TriangleMesh& skin, const BuiltModel& built, const Obstacles& o,
   }
   // the upper trapezius: the girdle's share of the tissue between the neck and the shoulders goes to the
   // still body (trapeziusShare())
+  const Eigen::Matrix3Xd landmarks = restPoints(m.landmarks.points, m);
   for (const char* name : {"acromion_right", "acromion_left"}) {
     const int l = m.landmarks.find(name);
     if (l < 0 || still < 0) continue;
-    const int lb = m.landmarks.points.body[static_cast<std::size_t>(l)];
-    const Eigen::Vector3d a = m.bodies.com.col(lb) + m.landmarks.points.local.col(l);
+    const Eigen::Vector3d a = landmarks.col(l);
     for (int v = 0; v < nV; ++v) {
       const double keep = trapeziusShare(skin.vertices.col(v), a);
       if (keep >= 1.0) continue;
