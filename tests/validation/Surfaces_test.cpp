@@ -103,10 +103,12 @@ constexpr bool kEnforceWallCrossings = false;
 // and the stiff first costal cartilage (resources/anatomy/README.md, "Rib motion"): the upper ribs now rise,
 // and at joy's deep end-inspiration the left lung's own crossings went 6 -> 14, the lungs' with the cavity 17
 // -> 38; 6 and 79 with a point in each fan of the mediastinal faces that spans the strip beside the vertebral
-// bodies (meshing/src/LungCavity.cpp, addBoundaryFanPoints). The budgets leave about 10 % for the run-to-run
-// spread of other changes.
-constexpr int kStyleCrossingBudget = 7;
-constexpr int kAffectCrossingBudget = 87;
+// bodies (meshing/src/LungCavity.cpp, addBoundaryFanPoints); 0 and 76 with the cavity's slivers turned over
+// (meshing/src/LungCavity.cpp, flipSlivers: a 10 mm floor sliver beside the spine twisted under the back
+// wall's 235 mm face at the deep breaths' end-inspiration and the right lung's mediastinal face crossed that
+// face, 3 pairs each in deep and forced-exhale; the female preset's 56 and 262 went to 10 and 58). The budget
+// leaves about 10 % for the run-to-run spread of other changes.
+constexpr int kAffectCrossingBudget = 84;
 
 // runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
 // settling: the two lungs never cross each other nor does a mediastinal face cross anything; the other
@@ -175,7 +177,9 @@ TEST(Surfaces, NoCrossingsInAnyBreathStyle) {
     const double duration = s.cycles > 0 ? 7.0 : std::max(4.0, 60.0 / s.breathsPerMinute);
     expectNoCrossings(style, std::make_unique<BreathStyleController>(s), duration, wall, sum);
   }
-  reportWallCrossings(wall, sum, kStyleCrossingBudget);
+  // the styles cross nowhere since flipSlivers (above): enforced at both phases of every style
+  testing::Test::RecordProperty("crossings", sum);
+  EXPECT_EQ(sum, 0) << "crossing pairs summed over the breath styles:" << wall.str();
 }
 
 TEST(Surfaces, NoCrossingsInAnyAffect) {
