@@ -24,7 +24,8 @@ struct BuildOptions {
   std::string out;
   std::string skin = meshing::kDefaultSkinFile;
   bool isPreviewSkipped = false;
-  bool hasShoulderGirdle = false;  // the preset's shoulder_girdle turned on
+  bool hasShoulderGirdle = false;   // --shoulder-girdle (true) or --no-shoulder-girdle (false)
+  bool isGirdleOverridden = false;  // either was given: it replaces the preset's shoulder_girdle
 };
 
 struct InfoOptions {
@@ -35,7 +36,7 @@ struct InfoOptions {
 void runBuild(const BuildOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   meshing::AnatomyParams anatomy = meshing::loadAnatomy(o.anatomy);
-  if (o.hasShoulderGirdle) anatomy.hasShoulderGirdle = true;
+  if (o.isGirdleOverridden) anatomy.hasShoulderGirdle = o.hasShoulderGirdle;
   const meshing::BuiltModel built = meshing::buildModel(anatomy, o.skin);
   meshing::writeModelDirectory(built, o.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -102,10 +103,14 @@ void addModelCommand(CLI::App& app) {
        "Body surface mesh (any format assimp reads: OBJ, STL, PLY, glTF, Collada), registered to the "
        "anatomy")
       ->capture_default_str();
-  b->add_flag("--shoulder-girdle", build->hasShoulderGirdle,
-              "Add the shoulder girdle, arms and neck (the anatomy option shoulder_girdle) to the preset");
+  CLI::Option* girdle = b->add_flag("--shoulder-girdle,!--no-shoulder-girdle", build->hasShoulderGirdle,
+                                    "Build with (or without) the shoulder girdle, arms and neck, whatever "
+                                    "the preset's shoulder_girdle says");
   b->add_flag("--no-preview", build->isPreviewSkipped, "Do not render preview_front.png / preview_side.png");
-  b->callback([build] { guarded([&] { runBuild(*build); }); });
+  b->callback([build, girdle] {
+    build->isGirdleOverridden = girdle->count() > 0;
+    guarded([&] { runBuild(*build); });
+  });
 
   auto info = std::make_shared<InfoOptions>();
   CLI::App* i = model->add_subcommand("info", "Print the summary of a model directory");

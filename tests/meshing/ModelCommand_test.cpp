@@ -76,6 +76,26 @@ TEST(ModelCommand, ShoulderGirdleFlagAddsTheGirdleToThePreset) {
   fs::remove_all(out);
 }
 
+// --no-shoulder-girdle turns the option off in a preset that has it on: the model has the plain torso's
+// bodies and no acromions
+TEST(ModelCommand, NoShoulderGirdleFlagTakesTheGirdleOutOfThePreset) {
+  const fs::path dir = scratch("nogirdle");
+  fs::create_directories(dir);
+  nlohmann::json j = nlohmann::json::parse(test::slurp(kAnatomy + "male.json"));
+  j["shoulder_girdle"] = true;
+  { std::ofstream(dir / "male.json") << j.dump(); }
+  fs::copy_file(kAnatomy + "muscle_gains.json", dir / "muscle_gains.json");
+  const fs::path out = dir / "model";
+  const test::CliResult r = runCli({"model", "build", "--anatomy", (dir / "male.json").string(),
+                                    "--no-shoulder-girdle", "--out", out.string(), "--no-preview"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const sim::Model m = sim::loadModel(out.string());
+  const sim::Model plain = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
+  EXPECT_EQ(m.bodies.name, plain.bodies.name);
+  EXPECT_LT(m.landmarks.find("acromion_right"), 0);
+  fs::remove_all(dir);
+}
+
 TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {
   // a copy of the male preset with a negative rib length, beside its gains file
   const fs::path dir = scratch("corrupt");
