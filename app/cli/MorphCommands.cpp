@@ -116,7 +116,9 @@ void runPlay(const PlayArgs& a) {
 void addBakeCommand(CLI::App& app) {
   auto args = std::make_shared<BakeArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "bake", "Bake breathing morph targets (base, breathing, chest, belly) from physics runs; write a .glb");
+      "bake",
+      "Bake breathing morph targets (base, breathing, chest, belly; shoulders with a shoulder girdle) from "
+      "physics runs; write a .glb");
   addModelOption(*cmd, args->model);
   cmd->add_option("--out", args->out, "Output .glb file (replaced when it exists)")->required();
   cmd->callback([args] { runBake(*args); });

@@ -279,14 +279,18 @@ void writeGltf(const std::string& path, const sim::Model& model, const std::stri
     skinMesh.weights.push_back(0.0);
   }
   skinMesh.primitives.push_back(skinPrimitive);
-  std::vector<tinygltf::Value> shares;
-  for (const sim::MorphTarget& t : targets.targets) shares.emplace_back(t.ribCageShare);
+  std::vector<tinygltf::Value> shares, onsets;
+  for (const sim::MorphTarget& t : targets.targets) {
+    shares.emplace_back(t.ribCageShare);
+    onsets.emplace_back(t.onsetVolume);
+  }
   tinygltf::Value::Object calibration{{"rest_volume_m3", tinygltf::Value(targets.restVolume)},
                                       {"base_volume_m3", tinygltf::Value(targets.baseVolume)},
                                       {"target_volume_m3", tinygltf::Value(targets.targetVolume)},
                                       {"volume_per_fraction_m3", tinygltf::Value(targets.volumePerFraction)},
                                       {"weight_per_volume_per_m3", tinygltf::Value(targets.weightPerVolume)},
-                                      {"rib_cage_share", tinygltf::Value(shares)}};
+                                      {"rib_cage_share", tinygltf::Value(shares)},
+                                      {"onset_volume_m3", tinygltf::Value(onsets)}};
   if (!targets.bones.empty()) {
     std::vector<tinygltf::Value> names(targets.bones.begin(), targets.bones.end()), displacements;
     for (const sim::MorphTarget& t : targets.targets)
@@ -451,6 +455,14 @@ sim::MorphTargets readGltfMorphTargets(const std::string& path) {
   m.targetVolume = number(c.Get("target_volume_m3"), "target_volume_m3");
   m.volumePerFraction = number(c.Get("volume_per_fraction_m3"), "volume_per_fraction_m3");
   m.weightPerVolume = number(c.Get("weight_per_volume_per_m3"), "weight_per_volume_per_m3");
+  // the recruited shapes' onsets (absent in files baked before them: none recruited)
+  if (c.Has("onset_volume_m3")) {
+    const tinygltf::Value& onsets = c.Get("onset_volume_m3");
+    if (!onsets.IsArray() || onsets.ArrayLen() != m.targets.size())
+      throw fail("extras.pneuma.onset_volume_m3 does not match the targets");
+    for (std::size_t k = 0; k < m.targets.size(); ++k)
+      m.targets[k].onsetVolume = number(onsets.Get(static_cast<int>(k)), "onset_volume_m3");
+  }
 
   // the bones, when baked with them
   if (c.Has("bones")) {

@@ -21,6 +21,9 @@ namespace pneuma::sim {
 namespace {
 
 constexpr int kCalibrationStride = 6;  // keep every 6th deep-run frame (10 Hz) for the calibration
+constexpr int kOnsetSteps = 20;        // onsets tried for a recruited target: the deep breath in 20 steps
+/// [-] a recruited target is baked when it takes at least this share off the deep run's skin residual
+constexpr double kRecruitedGain = 0.2;
 
 /// The skins at the smallest and largest lung volume of one run, from `skip` seconds after settling on.
 struct RunExtremes {
@@ -32,6 +35,7 @@ struct RunExtremes {
   double ribCageShare = 0.0;                                    // [-]
   std::vector<double> sampleVolume;                             // [m^3] kept frames
   std::vector<Eigen::Matrix3Xd> sampleSkin;                     // [m] kept frames (3 x #V)
+  std::vector<std::vector<Eigen::Isometry3d>> sampleBones;      // kept frames, body -> world (#B)
 };
 
 RunExtremes runStyle(const std::shared_ptr<const Model>& model, const std::string& resourceDir,
@@ -62,7 +66,11 @@ RunExtremes runStyle(const std::shared_ptr<const Model>& model, const std::strin
       if (isMin || isMax || isSample) poseGeometry(*model, s.state(), posed);
       if (isMin) run.minVolume = volume, run.minSkin = posed.skin, run.minBones = posed.body;
       if (isMax) run.maxVolume = volume, run.maxSkin = posed.skin, run.maxBones = posed.body;
-      if (isSample) run.sampleVolume.push_back(volume), run.sampleSkin.push_back(posed.skin);
+      if (isSample) {
+        run.sampleVolume.push_back(volume);
+        run.sampleSkin.push_back(posed.skin);
+        run.sampleBones.push_back(posed.body);
+      }
       ++frame;
     }
     if (progress) progress(stage, t / total);
@@ -99,6 +107,91 @@ BonePoses boneDisplacement(const BonePoses& base, const RunExtremes& r, double s
     d.rotation.col(b) = q.coeffs() - q0.coeffs();
   }
   return d;
+}
+
+/// The bones of `poses` as one vector: translations [m] then quaternion coefficients [-] on the side of
+/// `base`'s (7 #B), minus `base`'s.
+Eigen::VectorXd boneVector(const std::vector<Eigen::Isometry3d>& poses, const BonePoses& base) {
+  const Eigen::Index n = base.size();
+  Eigen::VectorXd v(7 * n);
+  for (Eigen::Index b = 0; b < n; ++b) {
+    const auto i = static_cast<std::size_t>(b);
+    v.segment<3>(3 * b) = poses[i].translation() - base.translation.col(b);
+    v.segment<4>(3 * n + 4 * b) =
+        rotationOf(poses[i], Eigen::Quaterniond(base.rotation.col(b))).coeffs() - base.rotation.col(b);
+  }
+  return v;
+}
+
+BonePoses bonePoses(const Eigen::VectorXd& v, Eigen::Index n) {
+  BonePoses d{Eigen::Matrix3Xd(3, n), Eigen::Matrix4Xd(4, n)};
+  for (Eigen::Index b = 0; b < n; ++b) {
+    d.translation.col(b) = v.segment<3>(3 * b);
+    d.rotation.col(b) = v.segment<4>(3 * n + 4 * b);
+  }
+  return d;
+}
+
+/// The deep run's shape split into a part linear in the volume and a recruited part
+/// (MorphTarget::onsetVolume): for each onset V_s on a grid between the base and the peak, the least-squares
+/// shapes D_b, D_s of
+///   x_i - base = a_i D_b + s_i D_s,  a_i = (V_i - V_b) / (V_t - V_b),  s_i = max(0, V_i - V_s) / (V_t - V_s)
+/// over the run's kept frames (skin and bones alike), keeping the onset of least skin residual.
+struct RecruitedSplit {
+  Eigen::VectorXd linearSkin, recruitedSkin;    // [m] (3 #V)
+  Eigen::VectorXd linearBones, recruitedBones;  // (7 #B), boneVector()
+  double onset = 0.0;                           // [m^3] V_s
+  double residual = 0.0, linearResidual = 0.0;  // [m^2] summed squared skin residual with and without D_s
+};
+
+RecruitedSplit splitRecruited(const RunExtremes& deep, const Eigen::Matrix3Xd& base, const BonePoses& bones) {
+  const double vb = deep.minVolume, vt = deep.maxVolume;
+  const std::size_t n = deep.sampleSkin.size();
+  std::vector<Eigen::VectorXd> skin(n), bone(n);
+  std::vector<double> a(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    skin[i] = (deep.sampleSkin[i] - base).reshaped();
+    bone[i] = boneVector(deep.sampleBones[i], bones);
+    a[i] = (deep.sampleVolume[i] - vb) / (vt - vb);
+  }
+  // the linear fit alone: D = sum a d / sum a^2
+  auto residualOf = [&](const std::vector<double>& s, const Eigen::VectorXd& db, const Eigen::VectorXd& ds) {
+    double r = 0.0;
+    for (std::size_t i = 0; i < n; ++i) r += (skin[i] - a[i] * db - s[i] * ds).squaredNorm();
+    return r;
+  };
+  RecruitedSplit best;
+  {
+    double saa = 0.0;
+    Eigen::VectorXd sad = Eigen::VectorXd::Zero(skin.front().size());
+    for (std::size_t i = 0; i < n; ++i) saa += a[i] * a[i], sad += a[i] * skin[i];
+    best.linearResidual = residualOf(std::vector<double>(n, 0.0), sad / saa, sad * 0.0);
+  }
+  best.residual = std::numeric_limits<double>::infinity();
+  for (int g = 1; g < kOnsetSteps; ++g) {
+    const double onset = vb + (vt - vb) * g / kOnsetSteps;
+    std::vector<double> s(n);
+    double saa = 0.0, sas = 0.0, sss = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      s[i] = std::max(0.0, deep.sampleVolume[i] - onset) / (vt - onset);
+      saa += a[i] * a[i], sas += a[i] * s[i], sss += s[i] * s[i];
+    }
+    const double det = saa * sss - sas * sas;
+    if (!(det > 1e-12 * saa * sss)) continue;
+    auto solve = [&](const std::vector<Eigen::VectorXd>& d, Eigen::VectorXd& db, Eigen::VectorXd& ds) {
+      Eigen::VectorXd ra = Eigen::VectorXd::Zero(d.front().size()), rs = ra;
+      for (std::size_t i = 0; i < n; ++i) ra += a[i] * d[i], rs += s[i] * d[i];
+      db = (sss * ra - sas * rs) / det;
+      ds = (saa * rs - sas * ra) / det;
+    };
+    Eigen::VectorXd db, ds;
+    solve(skin, db, ds);
+    const double r = residualOf(s, db, ds);
+    if (r >= best.residual) continue;
+    best.residual = r, best.onset = onset, best.linearSkin = db, best.recruitedSkin = ds;
+    solve(bone, best.linearBones, best.recruitedBones);
+  }
+  return best;
 }
 
 }  // namespace
@@ -142,13 +235,32 @@ MorphTargets bakeMorphTargets(std::shared_ptr<const Model> model, const std::str
   m.targets.push_back(target("breathing", deep));  // scale 1: the deep breath itself
   m.targets.push_back(target("chest", pant));
   m.targets.push_back(target("belly", supine));
+  // the shoulders of a model with a shoulder girdle (bodies with a postural support): a shape recruited above
+  // a volume (the accessory muscles lift the girdle only in deep breaths), when it explains enough of the
+  // deep run that the linear shape does not
+  bool hasGirdle = false;
+  for (int b = 0; b < model->bodies.size(); ++b) hasGirdle = hasGirdle || model->bodies.supported(b);
+  const RecruitedSplit split = hasGirdle ? splitRecruited(deep, m.base, m.boneBase) : RecruitedSplit{};
+  if (hasGirdle && std::isfinite(split.residual) &&
+      split.residual < (1.0 - kRecruitedGain) * split.linearResidual) {
+    MorphTarget& breathing = m.targets.front();
+    breathing.displacement = split.linearSkin.reshaped(3, m.base.cols());
+    breathing.boneDisplacement = bonePoses(split.linearBones, bodies);
+    MorphTarget shoulders{"shoulders", split.recruitedSkin.reshaped(3, m.base.cols()), breathing.ribCageShare,
+                          bonePoses(split.recruitedBones, bodies)};
+    shoulders.onsetVolume = split.onset;
+    m.targets.push_back(std::move(shoulders));
+  }
 
-  // volume-to-shape calibration: summed fitted weight against the volume above the base, through the origin
+  // volume-to-shape calibration: the breathing targets' summed fitted weight against the volume above the
+  // base, through the origin
   const MorphFit fit(m);
   double sxy = 0.0, sxx = 0.0;
   for (std::size_t i = 0; i < deep.sampleSkin.size(); ++i) {
     const double x = deep.sampleVolume[i] - m.baseVolume;  // [m^3]
-    sxy += x * fit.weights(deep.sampleSkin[i]).sum();
+    const Eigen::VectorXd w = fit.weights(deep.sampleSkin[i]);
+    for (std::size_t k = 0; k < m.targets.size(); ++k)
+      if (!m.targets[k].isRecruited()) sxy += x * w(static_cast<Eigen::Index>(k));
     sxx += x * x;
   }
   m.weightPerVolume = sxx > 0.0 ? sxy / sxx : 1.0 / tidal;
@@ -253,15 +365,25 @@ BoneBlendError boneBlendError(const Model& model, const Eigen::Matrix3Xd& tips,
 }
 
 Eigen::VectorXd patternWeights(const MorphTargets& targets, double fraction, double balance) {
-  const std::size_t k = targets.targets.size();
+  std::size_t k = targets.targets.size();
   Eigen::VectorXd w = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k));
   if (k == 0) return w;
   const double volume = targets.restVolume + (fraction - 0.05) * targets.volumePerFraction;  // [m^3]
   const double a = std::max(0.0, targets.weightPerVolume * (volume - targets.baseVolume));
 
-  // the shapes in order of their rib-cage share; the two enclosing the balance share the amplitude
-  std::vector<std::size_t> order(k);
-  for (std::size_t i = 0; i < k; ++i) order[i] = i;
+  // a recruited shape by its own ramp; the others in order of their rib-cage share, the two enclosing the
+  // balance sharing the amplitude
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < k; ++i) {
+    const MorphTarget& t = targets.targets[i];
+    if (t.isRecruited())
+      w(static_cast<Eigen::Index>(i)) =
+          std::max(0.0, volume - t.onsetVolume) / std::max(targets.targetVolume - t.onsetVolume, 1e-12);
+    else
+      order.push_back(i);
+  }
+  k = order.size();
+  if (k == 0) return w;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
     return targets.targets[p].ribCageShare < targets.targets[q].ribCageShare;
   });

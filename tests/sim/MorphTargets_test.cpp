@@ -75,6 +75,27 @@ TEST(PatternWeights, VolumeSetsTheAmplitudeAndBalanceTheSplit) {
   EXPECT_EQ(w(2), 0.0);
 }
 
+// a recruited target (the shoulders) takes max(0, V - V_s) / (V_t - V_s) whatever the balance, and the
+// breathing targets share the amplitude as before
+TEST(PatternWeights, RecruitedTargetRampsFromItsOnsetToTheBreathingTargetsVolume) {
+  MorphTargets m = randomTargets();
+  MorphTarget shoulders{"shoulders", Eigen::Matrix3Xd::Random(3, 50) * 0.01, 0.5, {}};
+  shoulders.onsetVolume = 3.5e-3;  // [m^3] half a litre below the breathing target's 4 L
+  m.targets.push_back(shoulders);
+  const MorphTargets plain = randomTargets();
+  for (double v : {0.1, 0.25, 0.45, 0.65, 1.0})
+    for (double b : {0.0, 0.5, 0.9}) {
+      const double volume = m.restVolume + (v - 0.05) * m.volumePerFraction;  // [m^3]
+      const Eigen::VectorXd w = patternWeights(m, v, b);
+      ASSERT_EQ(w.size(), 4);
+      EXPECT_NEAR(w(3), std::max(0.0, volume - 3.5e-3) / 0.5e-3, 1e-12) << v << " " << b;
+      EXPECT_LT((w.head(3) - patternWeights(plain, v, b)).norm(), 1e-12) << v << " " << b;
+    }
+  // at the breathing target's volume the ramp is 1
+  const double v = 0.05 + (m.targetVolume - m.restVolume) / m.volumePerFraction;
+  EXPECT_NEAR(patternWeights(m, v, 0.5)(3), 1.0, 1e-12);
+}
+
 // two bones: the second turns 10 degrees about z and moves 4 mm in the breathing target, and back 6 degrees
 // about x in the chest target; the blend follows the weights linearly in translation and, by nlerp, in angle
 TEST(BlendBones, TranslationsBlendLinearlyAndRotationsByNormalisedLerp) {
@@ -150,7 +171,10 @@ TEST(BakeMorphTargets, DefaultModelTargetsMoveTheChestOrTheBellyAsTheirBreaths) 
   REQUIRE_DEFAULT_MODEL();
   const std::shared_ptr<const Model> model = test::defaultModel();
   const MorphTargets m = bakeMorphTargets(model, PNEUMA_RESOURCE_DIR);
-  ASSERT_EQ(m.targets.size(), 3u);
+  // breathing, chest, belly, and the shoulders of a model with a shoulder girdle (supported bodies)
+  bool hasGirdle = false;
+  for (int b = 0; b < model->bodies.size(); ++b) hasGirdle = hasGirdle || model->bodies.supported(b);
+  ASSERT_EQ(m.targets.size(), hasGirdle ? 4u : 3u);
   ASSERT_EQ(m.vertexCount(), model->skin.vertexCount());
 
   // the chest (panting) and belly (supine deep) runs divide the breath as named

@@ -10,7 +10,10 @@
 ///                the end of settling, which the deep style does not breathe below,
 ///   - breathing: the skin at that breath's maximum inspiration, as a displacement from the base,
 ///   - chest:     the tidal displacement of panting (rib-cage dominant), scaled to the deep breath's volume,
-///   - belly:     the tidal displacement of a supine deep breath (abdomen dominant), scaled likewise.
+///   - belly:     the tidal displacement of a supine deep breath (abdomen dominant), scaled likewise,
+///   - shoulders: (a model with a shoulder girdle) the part of the deep breath recruited above a lung volume,
+///                the accessory muscles' shrug; the breathing target is then the part linear in the volume
+///                (MorphTarget::onsetVolume).
 /// A skin x is then approximated by the linear blend  x ~ base + sum_k w_k D_k.
 /// The bones are baked at the same extremes, so that the same weights pose the skeleton too (blendBones()).
 
@@ -38,19 +41,28 @@ struct BonePoses {
 
 /// One morph target: a displacement of every skin vertex from the base, and of every bone's pose.
 struct MorphTarget {
-  std::string name;               ///< "breathing", "chest" or "belly"
+  std::string name;               ///< "breathing", "chest", "belly" or "shoulders"
   Eigen::Matrix3Xd displacement;  ///< [m] D_k, per skin vertex (3 x #V)
   double ribCageShare = 0.0;      ///< [-] rib cage's share of the tidal volume of the run it came from
   /// the bones at this target minus the base bones: translations [m] and quaternion coefficients [-], the
   /// latter q_k - q_base with q_k the bone's rotation at weight 1 on the base's side (q_k . q_base >= 0);
   /// empty when the targets were baked without bones
   BonePoses boneDisplacement;
+  /// [m^3] V_s of a recruited shape, < 0 for a breathing one. A recruited shape is the part of the deep
+  /// breath that appears only above a lung volume: the shoulders, which the accessory muscles lift only in
+  /// deep breaths (a model with a shoulder girdle). Its weight is max(0, V - V_s) / (V_t - V_s) with V_t the
+  /// breathing target's volume (patternWeights()), and the breathing target is then the part linear in the
+  /// volume (bakeMorphTargets()).
+  double onsetVolume = -1.0;
+
+  bool isRecruited() const { return onsetVolume >= 0.0; }
 };
 
 /// The baked shapes and the volume-to-shape calibration of one model.
 struct MorphTargets {
   Eigen::Matrix3Xd base;             ///< [m] skin at the deep run's smallest lung volume (3 x #V)
-  std::vector<MorphTarget> targets;  ///< breathing, chest, belly (each scaled to the same volume change)
+  std::vector<MorphTarget> targets;  ///< breathing, chest, belly (each scaled to the same volume change),
+                                     ///< and shoulders for a model with a shoulder girdle (recruited)
   double restVolume = 0.0;    ///< [m^3] settled lung volume of the relaxed torso (pattern fraction 0.05)
   double baseVolume = 0.0;    ///< [m^3] lung volume of the base shape
   double targetVolume = 0.0;  ///< [m^3] lung volume of the breathing target (weight 1)
