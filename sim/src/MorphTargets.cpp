@@ -154,27 +154,26 @@ RecruitedSplit splitRecruited(const RunExtremes& deep, const Eigen::Matrix3Xd& b
     bone[i] = boneVector(deep.sampleBones[i], bones);
     a[i] = (deep.sampleVolume[i] - vb) / (vt - vb);
   }
-  // the linear fit alone: D = sum a d / sum a^2
   auto residualOf = [&](const std::vector<double>& s, const Eigen::VectorXd& db, const Eigen::VectorXd& ds) {
     double r = 0.0;
     for (std::size_t i = 0; i < n; ++i) r += (skin[i] - a[i] * db - s[i] * ds).squaredNorm();
     return r;
   };
+  // the linear shape alone: D = sum a d / sum a^2
   RecruitedSplit best;
-  {
-    double saa = 0.0;
-    Eigen::VectorXd sad = Eigen::VectorXd::Zero(skin.front().size());
-    for (std::size_t i = 0; i < n; ++i) saa += a[i] * a[i], sad += a[i] * skin[i];
-    best.linearResidual = residualOf(std::vector<double>(n, 0.0), sad / saa, sad * 0.0);
-  }
+  double saa = 0.0;
+  Eigen::VectorXd sad = Eigen::VectorXd::Zero(skin.front().size());
+  for (std::size_t i = 0; i < n; ++i) saa += a[i] * a[i], sad += a[i] * skin[i];
+  const std::vector<double> none(n, 0.0);
+  best.linearResidual = residualOf(none, sad / saa, Eigen::VectorXd::Zero(sad.size()));
   best.residual = std::numeric_limits<double>::infinity();
   for (int g = 1; g < kOnsetSteps; ++g) {
     const double onset = vb + (vt - vb) * g / kOnsetSteps;
     std::vector<double> s(n);
-    double saa = 0.0, sas = 0.0, sss = 0.0;
+    double sas = 0.0, sss = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       s[i] = std::max(0.0, deep.sampleVolume[i] - onset) / (vt - onset);
-      saa += a[i] * a[i], sas += a[i] * s[i], sss += s[i] * s[i];
+      sas += a[i] * s[i], sss += s[i] * s[i];
     }
     const double det = saa * sss - sas * sas;
     if (!(det > 1e-12 * saa * sss)) continue;
@@ -238,8 +237,7 @@ MorphTargets bakeMorphTargets(std::shared_ptr<const Model> model, const std::str
   // the shoulders of a model with a shoulder girdle (bodies with a postural support): a shape recruited above
   // a volume (the accessory muscles lift the girdle only in deep breaths), when it explains enough of the
   // deep run that the linear shape does not
-  bool hasGirdle = false;
-  for (int b = 0; b < model->bodies.size(); ++b) hasGirdle = hasGirdle || model->bodies.supported(b);
+  const bool hasGirdle = model->bodies.anySupported();
   const RecruitedSplit split = hasGirdle ? splitRecruited(deep, m.base, m.boneBase) : RecruitedSplit{};
   if (hasGirdle && std::isfinite(split.residual) &&
       split.residual < (1.0 - kRecruitedGain) * split.linearResidual) {

@@ -14,6 +14,7 @@
 ///  - structures of arrays: one column (or entry) per item, Eigen::Matrix3X* for 3-vectors.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -85,6 +86,10 @@ struct Bodies {
   /// Whether body `b` has a postural support.
   bool supported(int b) const {
     return !isSupported.empty() && isSupported[static_cast<std::size_t>(b)] != 0;
+  }
+  /// Whether any body has a postural support (a model with a shoulder girdle).
+  bool anySupported() const {
+    return std::find(isSupported.begin(), isSupported.end(), std::uint8_t{1}) != isSupported.end();
   }
   /// [m] supportHeight of body `b` (0 when the model has none).
   double supportHeightOf(int b) const { return supportHeight.size() == 0 ? 0.0 : supportHeight(b); }
