@@ -1,11 +1,9 @@
 #!/bin/sh
-# Writes the .glb files the glTF checks read: the baked targets, a calm and a deep physics run, two affects
-# played without physics, and a deep run of the male preset built with its shoulder girdle (clavicles,
-# scapulae and arms). Usage: export.sh PNEUMA_CLI OUT_DIR ANATOMY_DIR
+# Writes the .glb files the glTF checks read: the baked targets, a calm and a deep physics run (the deep one
+# lifts the shoulder girdle), two affects played without physics. Usage: export.sh PNEUMA_CLI OUT_DIR
 set -eu
 cli=$1
 out=$2
-anatomy=$3
 rm -rf "$out"
 mkdir -p "$out"
 "$cli" bake --out "$out/morphs.glb"
@@ -13,7 +11,3 @@ mkdir -p "$out"
 "$cli" simulate --style deep --duration 6 --out "$out/deep" --gltf "$out/deep.glb" --morphs "$out/morphs.glb"
 "$cli" play --affect fear --duration 10 --gltf "$out/fear.glb" --morphs "$out/morphs.glb"
 "$cli" play --affect relaxation --duration 12 --gltf "$out/relaxation.glb" --morphs "$out/morphs.glb"
-# the girdle model: the shipped anatomy with the option on
-"$cli" model build --anatomy "$anatomy/male.json" --shoulder-girdle --out "$out/girdle-model" --no-preview
-"$cli" simulate --model "$out/girdle-model" --style deep --duration 6 --out "$out/girdle-deep" \
-  --gltf "$out/girdle-deep.glb"

@@ -59,41 +59,44 @@ TEST(ModelCommand, BuildWithoutDisplayWritesTheModelAndSkipsPreviews) {
   fs::remove_all(out);
 }
 
-// --shoulder-girdle turns on the preset's shoulder_girdle: the model gains the clavicles, scapulae and arms,
-// the neck and the accessory muscles, and its info counts them
+// --shoulder-girdle turns on the shoulder_girdle of a preset that has it off: the model gains the clavicles,
+// scapulae and arms, the neck and the accessory muscles of the default model
 TEST(ModelCommand, ShoulderGirdleFlagAddsTheGirdleToThePreset) {
-  const fs::path out = scratch("girdle");
-  const test::CliResult r = runCli({"model", "build", "--anatomy", kAnatomy + "male.json",
-                                    "--shoulder-girdle", "--out", out.string(), "--no-preview"});
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  const sim::Model m = sim::loadModel(out.string());
-  const sim::Model plain = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
-  for (const char* bone : {"clavicle_right", "scapula_left", "humerus_right", "forearm_left", "head"})
-    EXPECT_NE(std::find(m.bodies.name.begin(), m.bodies.name.end(), bone), m.bodies.name.end()) << bone;
-  EXPECT_EQ(m.bodies.size(), plain.bodies.size() + 10);
-  EXPECT_GE(m.landmarks.find("acromion_right"), 0);
-  EXPECT_LT(plain.landmarks.find("acromion_right"), 0);
-  fs::remove_all(out);
-}
-
-// --no-shoulder-girdle turns the option off in a preset that has it on: the model has the plain torso's
-// bodies and no acromions
-TEST(ModelCommand, NoShoulderGirdleFlagTakesTheGirdleOutOfThePreset) {
-  const fs::path dir = scratch("nogirdle");
+  const fs::path dir = scratch("girdle");
   fs::create_directories(dir);
   nlohmann::json j = nlohmann::json::parse(test::slurp(kAnatomy + "male.json"));
-  j["shoulder_girdle"] = true;
+  j["shoulder_girdle"] = false;
   { std::ofstream(dir / "male.json") << j.dump(); }
   fs::copy_file(kAnatomy + "muscle_gains.json", dir / "muscle_gains.json");
   const fs::path out = dir / "model";
   const test::CliResult r = runCli({"model", "build", "--anatomy", (dir / "male.json").string(),
+                                    "--shoulder-girdle", "--out", out.string(), "--no-preview"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const sim::Model m = sim::loadModel(out.string());
+  const sim::Model girdle = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
+  EXPECT_EQ(m.bodies.name, girdle.bodies.name);
+  EXPECT_GE(m.landmarks.find("acromion_right"), 0);
+  fs::remove_all(dir);
+}
+
+// --no-shoulder-girdle turns the option off in the shipped preset, which has it on: the model loses the
+// clavicles, scapulae, arms and head, and the acromions
+TEST(ModelCommand, NoShoulderGirdleFlagTakesTheGirdleOutOfThePreset) {
+  const fs::path out = scratch("nogirdle");
+  const test::CliResult r = runCli({"model", "build", "--anatomy", kAnatomy + "male.json",
                                     "--no-shoulder-girdle", "--out", out.string(), "--no-preview"});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const sim::Model m = sim::loadModel(out.string());
-  const sim::Model plain = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
-  EXPECT_EQ(m.bodies.name, plain.bodies.name);
+  const sim::Model girdle = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
+  for (const char* bone : {"clavicle_right", "scapula_left", "humerus_right", "forearm_left", "head"}) {
+    EXPECT_NE(std::find(girdle.bodies.name.begin(), girdle.bodies.name.end(), bone),
+              girdle.bodies.name.end());
+    EXPECT_EQ(std::find(m.bodies.name.begin(), m.bodies.name.end(), bone), m.bodies.name.end()) << bone;
+  }
+  EXPECT_EQ(m.bodies.size() + 10, girdle.bodies.size());
+  EXPECT_GE(girdle.landmarks.find("acromion_right"), 0);
   EXPECT_LT(m.landmarks.find("acromion_right"), 0);
-  fs::remove_all(dir);
+  fs::remove_all(out);
 }
 
 TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {

@@ -1032,7 +1032,8 @@ TEST_F(DefaultModelWindow, RunExportsAsGltfWithBakedMorphTargets) {
   QTemporaryDir out;
   ASSERT_EQ(window.exportGltf(out.filePath("run.glb")), QString());
   const sim::MorphTargets run = viz::readGltfMorphTargets(out.filePath("run.glb").toStdString());
-  ASSERT_EQ(run.targets.size(), 3u);
+  // breathing, chest, belly, and the shoulders of the default model's shoulder girdle
+  ASSERT_EQ(run.targets.size(), window.model()->bodies.anySupported() ? 4u : 3u);
   EXPECT_EQ(run.vertexCount(), window.model()->skin.vertexCount());
   // the breathing target lifts the body: its largest displacement is centimetres, not zero and not metres
   const double largest = run.targets[0].displacement.colwise().norm().maxCoeff();  // [m]
@@ -1721,8 +1722,9 @@ TEST_F(DefaultModelWindow, GhostOfTheComparedRunIsDrawnWhereThatRunIs) {
   ASSERT_TRUE(runToEndInspiration()) << window.lastError().toStdString();
   const double same = ghostMismatch();
   // (the translucent edges of the differently coloured surfaces cross the mask's threshold at different
-  // pixels: a few per cent)
-  EXPECT_LT(same, 0.08) << "calm against calm: the ghost lies on the run";
+  // pixels: a few per cent, 8 % with the view framed on the whole body, arms and head; a paralysed
+  // hemidiaphragm gives 42 %)
+  EXPECT_LT(same, 0.1) << "calm against calm: the ghost lies on the run";
 
   window.setDisplayOptions(defaults);
   ASSERT_EQ(window.openScenario(left), QString());

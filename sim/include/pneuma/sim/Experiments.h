@@ -69,7 +69,7 @@ struct ExperimentSettings {
 /// A breath-style run.
 struct StyleRun {
   BreathStyle style;
-  double frictionScale = 1.0;  ///< [-] multiplier of every joint's mu (Eq. 3) in this run
+  double frictionScale = 1.0;  ///< [-] multiplier of the rib joints' mu (Eq. 3) in this run
   Summary summary;             ///< from settleTime on
   Trace trace;                 ///< every output frame, settling included
   double settleTime = 0.0;     ///< [s]
@@ -89,7 +89,9 @@ struct StyleRun {
 };
 
 /// Plays `style` on `model` for settings.styleDuration after settling (forcedExhaleDuration when the style
-/// is not periodic), with every joint's friction scaled by `frictionScale`.
+/// is not periodic), with the rib joints' friction (Eq. 3: the costovertebral joints, named
+/// "costovertebral_rib<level>_<side>") scaled by `frictionScale`; other joints (spine, shoulder girdle) keep
+/// theirs, so that a frictionless run differs from the calibrated one in Section 5's friction only.
 /// @throws Error on a blow-up (the message names the time and the cause).
 StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& style,
                         const ExperimentSettings& settings, double frictionScale = 1.0);
