@@ -36,6 +36,18 @@ constexpr double kGutClearance = 0.010;   // [m] least distance from skin to the
 // [m] least distance from skin to a volume body's surface (pectorals, shoulders): the skin and the thin
 // subcutaneous fat over the muscle
 constexpr double kTissueClearance = 0.004;
+// the skin over the muscles from the neck to the shoulder girdle (liftOverNeckMuscles()): the least distance
+// from skin to a muscle's line [m] (the skin and fat of the neck, and room for the shoulders' rise: at 4 mm
+// the C4-acromion line was 8.5 mm outside at a deep breath's end), how far from a vertex's normal a line may
+// pass to lift it [m], how far out along the normal it may lie [m], and the passes that spread the lifts over
+// the neighbours
+constexpr double kNeckMuscleClearance = 0.008;
+constexpr double kNeckMuscleRadius = 0.012;
+constexpr double kNeckMuscleReach = 0.03;
+constexpr int kNeckLiftPasses = 6;
+// [-] the share of a muscle's line from the neck beyond which it lifts nothing: its lateral end runs into the
+// shoulder under the deltoid volume body, which the skin already covers
+constexpr double kNeckMuscleLateralEnd = 0.8;
 constexpr double kThighCut = 0.10;       // [m] legs cut this far below the crotch
 constexpr double kPerineumDepth = 0.07;  // [m] crotch (perineum) below the pelvic floor
 constexpr double kThighCutSlack = 0.03;  // [m] a surface ending less than this below the cut is not cut again
@@ -704,6 +716,67 @@ Obstacles obstaclesOf(const BuiltModel& built) {
   return o;
 }
 
+/// Lifts the skin over the muscles from the neck to the shoulder girdle (every element from the cervical
+/// spine to a clavicle or scapula: upper trapezius, levator scapulae, rhomboid). A straight muscle from the
+/// neck to the shoulder cuts the concave neck-shoulder line of the registered mesh (the upper trapezius from
+/// C2 and C4 by up to 12 mm), where the real muscle wraps the neck and makes that line. A vertex x with
+/// normal n whose normal line x + t n passes within kNeckMuscleRadius of a muscle's line (between 5 % of the
+/// way from its neck end and kNeckMuscleLateralEnd), at -kNeckMuscleClearance < t < kNeckMuscleReach, is
+/// lifted by t + kNeckMuscleClearance along n; kNeckLiftPasses passes give each vertex the larger of its lift
+/// and 0.8 of its neighbours' mean, so that the skin takes the muscle's contour without a fold. Returns the
+/// largest lift [m].
+double liftOverNeckMuscles(TriangleMesh& s, const sim::Model& m) {
+  const auto isGirdleBone = [&](int b) {
+    if (b < 0) return false;
+    const std::string& name = m.bodies.name[static_cast<std::size_t>(b)];
+    return name.rfind("clavicle", 0) == 0 || name.rfind("scapula", 0) == 0;
+  };
+  const auto isNeck = [&](int b) {
+    return b >= 0 && m.bodies.name[static_cast<std::size_t>(b)] == "cervical_spine";
+  };
+  // each muscle's line from its neck end to its girdle end [m]
+  const Eigen::Matrix3Xd endA = restPoints(m.elements.endA, m), endB = restPoints(m.elements.endB, m);
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> lines;
+  for (int e = 0; e < m.elements.size(); ++e) {
+    const int p = m.elements.endA.body[static_cast<std::size_t>(e)],
+              q = m.elements.endB.body[static_cast<std::size_t>(e)];
+    if (isNeck(p) && isGirdleBone(q)) lines.emplace_back(endA.col(e), endB.col(e));
+    if (isNeck(q) && isGirdleBone(p)) lines.emplace_back(endB.col(e), endA.col(e));
+  }
+  if (lines.empty()) return 0.0;
+  const Eigen::Matrix3Xd normal = vertexNormals(s.vertices, s.triangles);
+  Eigen::VectorXd lift = Eigen::VectorXd::Zero(s.vertexCount());
+  for (int i = 0; i < s.vertexCount(); ++i) {
+    const Eigen::Vector3d x = s.vertices.col(i), n = normal.col(i);
+    for (const auto& [a, b] : lines) {
+      // the closest points of the normal line x + t n and the muscle's line a + u d, u in [0.05, 0.8]
+      const Eigen::Vector3d d = b - a, w = x - a;
+      const double nd = n.dot(d), dd = d.dot(d), det = dd - nd * nd;
+      if (det < 1e-12 * dd) continue;
+      const double u = std::clamp((d.dot(w) - nd * n.dot(w)) / det, 0.05, kNeckMuscleLateralEnd);
+      const Eigen::Vector3d q = a + u * d;
+      const double t = n.dot(q - x);
+      if (t <= -kNeckMuscleClearance || t >= kNeckMuscleReach || (x + t * n - q).norm() > kNeckMuscleRadius)
+        continue;
+      lift(i) = std::max(lift(i), t + kNeckMuscleClearance);
+    }
+  }
+  const auto nb = neighbours(s.vertexCount(), s.triangles);
+  for (int pass = 0; pass < kNeckLiftPasses; ++pass) {
+    Eigen::VectorXd spread = lift;
+    for (int i = 0; i < s.vertexCount(); ++i) {
+      const auto& ring = nb[static_cast<std::size_t>(i)];
+      if (ring.empty()) continue;
+      double mean = 0.0;
+      for (int j : ring) mean += lift(j);
+      spread(i) = std::max(lift(i), 0.8 * mean / static_cast<double>(ring.size()));
+    }
+    lift = spread;
+  }
+  for (int i = 0; i < s.vertexCount(); ++i) s.vertices.col(i) += lift(i) * normal.col(i);
+  return lift.maxCoeff();
+}
+
 /// Pushes skin vertices out of the obstacles; returns the least remaining clearance to a bone [m].
 double pushOut(TriangleMesh& s, const Obstacles& o) {
   const PointGrid grid(o.point, 0.02);
@@ -1015,8 +1088,9 @@ void buildSkin(const AnatomyParams& a, const std::string& file, BuiltModel& out)
   const ThinPlateSpline warp(fromAll, toAll);
   for (int i = 0; i < source.vertexCount(); ++i) source.vertices.col(i) = warp(source.vertices.col(i));
 
-  // the legs, cut at the thigh; vertices pushed out of the bones
+  // the legs, cut at the thigh; the skin lifted over the neck's muscles and pushed out of the bones
   TriangleMesh skin = cutLegs(source, targetCrotch - kThighCut, file);
+  liftOverNeckMuscles(skin, out.model);
   const Obstacles obstacles = obstaclesOf(out);
   out.report.skinBoneClearance = pushOut(skin, obstacles);
 
