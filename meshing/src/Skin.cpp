@@ -723,9 +723,8 @@ Obstacles obstaclesOf(const BuiltModel& built) {
 /// normal n whose normal line x + t n passes within kNeckMuscleRadius of a muscle's line (between 5 % of the
 /// way from its neck end and kNeckMuscleLateralEnd), at -kNeckMuscleClearance < t < kNeckMuscleReach, is
 /// lifted by t + kNeckMuscleClearance along n; kNeckLiftPasses passes give each vertex the larger of its lift
-/// and 0.8 of its neighbours' mean, so that the skin takes the muscle's contour without a fold. Returns the
-/// largest lift [m].
-double liftOverNeckMuscles(TriangleMesh& s, const sim::Model& m) {
+/// and 0.8 of its neighbours' mean, so that the skin takes the muscle's contour without a fold.
+void liftOverNeckMuscles(TriangleMesh& s, const sim::Model& m) {
   const auto isGirdleBone = [&](int b) {
     if (b < 0) return false;
     const std::string& name = m.bodies.name[static_cast<std::size_t>(b)];
@@ -743,7 +742,7 @@ double liftOverNeckMuscles(TriangleMesh& s, const sim::Model& m) {
     if (isNeck(p) && isGirdleBone(q)) lines.emplace_back(endA.col(e), endB.col(e));
     if (isNeck(q) && isGirdleBone(p)) lines.emplace_back(endB.col(e), endA.col(e));
   }
-  if (lines.empty()) return 0.0;
+  if (lines.empty()) return;
   const Eigen::Matrix3Xd normal = vertexNormals(s.vertices, s.triangles);
   Eigen::VectorXd lift = Eigen::VectorXd::Zero(s.vertexCount());
   for (int i = 0; i < s.vertexCount(); ++i) {
@@ -774,7 +773,6 @@ double liftOverNeckMuscles(TriangleMesh& s, const sim::Model& m) {
     lift = spread;
   }
   for (int i = 0; i < s.vertexCount(); ++i) s.vertices.col(i) += lift(i) * normal.col(i);
-  return lift.maxCoeff();
 }
 
 /// Pushes skin vertices out of the obstacles; returns the least remaining clearance to a bone [m].

@@ -77,7 +77,6 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
   r.xiphoid = model->landmarks.find("xiphoid");
   const int spine = spineTopBody(*model);
   if (spine >= 0) r.spineBody = model->bodies.name[static_cast<std::size_t>(spine)];
-  r.model = model;
   // the rib joints' friction (Eq. 3) scaled in a copy of the model; the shoulder girdle's joints keep theirs
   if (frictionScale != 1.0) {
     auto scaled = std::make_shared<Model>(*model);
@@ -85,8 +84,8 @@ StyleRun runBreathStyle(std::shared_ptr<const Model> model, const BreathStyle& s
       if (scaled->joints.name[static_cast<std::size_t>(j)].rfind("costovertebral", 0) == 0)
         scaled->joints.friction(j) *= frictionScale;
     model = std::move(scaled);
-    r.model = model;
   }
+  r.model = model;
   const SimulationOptions& o = settings.simulation;
   Simulation sim(std::move(model), std::make_unique<BreathStyleController>(style), o);
   const double duration = style.cycles > 0 ? settings.forcedExhaleDuration : settings.styleDuration;
