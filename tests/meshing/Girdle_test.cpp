@@ -27,7 +27,7 @@ namespace pneuma::meshing {
 namespace {
 
 /// The shipped preset `name` (its shoulder girdle is on).
-AnatomyParams withGirdle(const std::string& name) {
+AnatomyParams preset(const std::string& name) {
   return loadAnatomy(std::string(PNEUMA_RESOURCE_DIR) + "/anatomy/" + name + ".json");
 }
 
@@ -35,7 +35,7 @@ AnatomyParams withGirdle(const std::string& name) {
 const BuiltModel& built(const std::string& name) {
   static std::map<std::string, BuiltModel> cache;
   auto it = cache.find(name);
-  if (it == cache.end()) it = cache.emplace(name, buildModel(withGirdle(name), "")).first;
+  if (it == cache.end()) it = cache.emplace(name, buildModel(preset(name), "")).first;
   return it->second;
 }
 
@@ -70,7 +70,7 @@ std::vector<int> scapulothoracicSprings(const sim::Model& m) {
 class GirdlePresets : public ::testing::TestWithParam<std::string> {};
 
 // the option is on in both shipped presets
-TEST_P(GirdlePresets, IsOnInTheShippedPreset) { EXPECT_TRUE(withGirdle(GetParam()).hasShoulderGirdle); }
+TEST_P(GirdlePresets, IsOnInTheShippedPreset) { EXPECT_TRUE(preset(GetParam()).hasShoulderGirdle); }
 
 // clavicles, scapulae, humeri and forearms move on the chain sternum - sternoclavicular - acromioclavicular
 // - glenohumeral - elbow, each held by a postural support; the arm segments weigh de Leva's (1996) shares of
@@ -78,7 +78,7 @@ TEST_P(GirdlePresets, IsOnInTheShippedPreset) { EXPECT_TRUE(withGirdle(GetParam(
 TEST_P(GirdlePresets, BonesJointsAndSegmentMasses) {
   const BuiltModel& b = built(GetParam());
   const sim::Model& m = b.model;
-  const AnatomyParams a = withGirdle(GetParam());
+  const AnatomyParams a = preset(GetParam());
   for (const char* side : {"_right", "_left"}) {
     SCOPED_TRACE(side);
     const std::string s = side;
@@ -127,7 +127,7 @@ TEST_P(GirdlePresets, BonesJointsAndSegmentMasses) {
 // forearm flexed forward at the elbow
 TEST_P(GirdlePresets, ArmsHangInTheAPose) {
   const sim::Model& m = built(GetParam()).model;
-  const AnatomyParams a = withGirdle(GetParam());
+  const AnatomyParams a = preset(GetParam());
   for (const char* side : {"_right", "_left"}) {
     const Eigen::Vector3d shoulder = m.joints.anchor.col(joint(m, std::string("glenohumeral") + side));
     const Eigen::Vector3d elbow = m.joints.anchor.col(joint(m, std::string("elbow") + side));
@@ -238,7 +238,7 @@ TEST_P(GirdlePresets, ShoulderBladesSlideOnTheRibs) {
 const BuiltModel& builtWithSkin(const std::string& name) {
   static std::map<std::string, BuiltModel> cache;
   auto it = cache.find(name);
-  if (it == cache.end()) it = cache.emplace(name, buildModel(withGirdle(name))).first;
+  if (it == cache.end()) it = cache.emplace(name, buildModel(preset(name))).first;
   return it->second;
 }
 

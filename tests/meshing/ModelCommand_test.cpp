@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "CliRunner.h"
@@ -24,6 +25,17 @@ fs::path scratch(const std::string& name) {
       fs::path(testing::TempDir()) / ("pneuma_model_cmd_" + std::to_string(getpid()) + "_" + name);
   fs::remove_all(p);
   return p;
+}
+
+/// A copy of the male preset in a new folder `dir`, beside its gains file, changed by `edit`; returns its
+/// path.
+fs::path writePresetCopy(const fs::path& dir, const std::function<void(nlohmann::json&)>& edit) {
+  fs::create_directories(dir);
+  nlohmann::json j = nlohmann::json::parse(test::slurp(kAnatomy + "male.json"));
+  edit(j);
+  { std::ofstream(dir / "male.json") << j.dump(); }
+  fs::copy_file(kAnatomy + "muscle_gains.json", dir / "muscle_gains.json");
+  return dir / "male.json";
 }
 
 TEST(ModelCommand, InfoJsonDescribesTheDefaultModel) {
@@ -63,14 +75,10 @@ TEST(ModelCommand, BuildWithoutDisplayWritesTheModelAndSkipsPreviews) {
 // scapulae and arms, the neck and the accessory muscles of the default model
 TEST(ModelCommand, ShoulderGirdleFlagAddsTheGirdleToThePreset) {
   const fs::path dir = scratch("girdle");
-  fs::create_directories(dir);
-  nlohmann::json j = nlohmann::json::parse(test::slurp(kAnatomy + "male.json"));
-  j["shoulder_girdle"] = false;
-  { std::ofstream(dir / "male.json") << j.dump(); }
-  fs::copy_file(kAnatomy + "muscle_gains.json", dir / "muscle_gains.json");
+  const fs::path anatomy = writePresetCopy(dir, [](nlohmann::json& j) { j["shoulder_girdle"] = false; });
   const fs::path out = dir / "model";
-  const test::CliResult r = runCli({"model", "build", "--anatomy", (dir / "male.json").string(),
-                                    "--shoulder-girdle", "--out", out.string(), "--no-preview"});
+  const test::CliResult r = runCli({"model", "build", "--anatomy", anatomy.string(), "--shoulder-girdle",
+                                    "--out", out.string(), "--no-preview"});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const sim::Model m = sim::loadModel(out.string());
   const sim::Model girdle = sim::loadModel(PNEUMA_DEFAULT_MODEL_DIR);
@@ -100,16 +108,13 @@ TEST(ModelCommand, NoShoulderGirdleFlagTakesTheGirdleOutOfThePreset) {
 }
 
 TEST(ModelCommand, CorruptAnatomyFailsNamingTheFieldAndWritesNothing) {
-  // a copy of the male preset with a negative rib length, beside its gains file
+  // a copy of the male preset with a negative rib length
   const fs::path dir = scratch("corrupt");
-  fs::create_directories(dir);
-  nlohmann::json j = nlohmann::json::parse(test::slurp(kAnatomy + "male.json"));
-  j["ribs"][2]["arc_length_mm"] = -10;
-  { std::ofstream(dir / "male.json") << j.dump(); }
-  fs::copy_file(kAnatomy + "muscle_gains.json", dir / "muscle_gains.json");
+  const fs::path anatomy =
+      writePresetCopy(dir, [](nlohmann::json& j) { j["ribs"][2]["arc_length_mm"] = -10; });
   const fs::path out = dir / "model";
-  const test::CliResult r = runCli(
-      {"model", "build", "--anatomy", (dir / "male.json").string(), "--out", out.string(), "--no-preview"});
+  const test::CliResult r =
+      runCli({"model", "build", "--anatomy", anatomy.string(), "--out", out.string(), "--no-preview"});
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("ribs[2].arc_length_mm: must be in [30, 600], got -10"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
