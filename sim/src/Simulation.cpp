@@ -13,8 +13,9 @@
 namespace pneuma::sim {
 
 namespace {
-constexpr long long kCheckpointVersion = 4;  // 2 adds simulation.posture, 3 the volume bodies, 4 the pattern
-                                             // drive's internal intercostal lag
+// 2 adds simulation.posture, 3 the volume bodies, 4 the pattern drive's internal intercostal lag, 5 the
+// cycles' inspiratory balance
+constexpr long long kCheckpointVersion = 5;
 }  // namespace
 
 void validateSimulationOptions(const SimulationOptions& o) {

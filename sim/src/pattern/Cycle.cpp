@@ -57,6 +57,7 @@ void validateCycle(const CycleSpec& c) {
   requireRange("irregularity.rate", c.rateIrregularity, 0.0, 0.5);
   requireRange("irregularity.depth", c.depthIrregularity, 0.0, 0.5);
   requireRange("balance", c.balance, 0.0, 1.0);
+  if (c.inspiratoryBalance) requireRange("inspiratory_balance", *c.inspiratoryBalance, 0.0, 1.0);
 
   // keyframes: which kinds need them
   const auto& k = c.keyframes;
@@ -165,6 +166,11 @@ double Cycle::shape(double u) const {
   const double s = (2 * t3 - 3 * t2 + 1) * m_s[a] + (t3 - 2 * t2 + t) * h * m_slope[a] +
                    (-2 * t3 + 3 * t2) * m_s[i] + (t3 - t2) * h * m_slope[i];
   return std::clamp(s, 0.0, 1.0);
+}
+
+double Cycle::balance(double tau, const BreathVariation& variation) const {
+  const double peakTime = m_u[static_cast<std::size_t>(m_peak)] * m_moving * variation.durationScale;  // [s]
+  return m_spec.inspiratoryBalance && tau < peakTime ? *m_spec.inspiratoryBalance : m_spec.balance;
 }
 
 double Cycle::volume(double tau, const BreathVariation& variation) const {

@@ -155,7 +155,9 @@ void LayerStack::setStartVolume(double v) {
   m_hasVolume = true;
 }
 
-double LayerStack::balance() const { return m_layers.empty() ? 0.5 : m_layers.back().cycle.spec().balance; }
+double LayerStack::balance() const {
+  return m_layers.empty() ? 0.5 : m_layers.back().cycle.balance(m_time - m_breathStart, m_variation);
+}
 
 std::string LayerStack::currentLayerName() const {
   return m_layers.empty() ? std::string() : m_layers.back().name;
@@ -166,9 +168,10 @@ namespace {
 void writeCycle(CheckpointWriter& out, const std::string& key, const CycleSpec& c) {
   out.write(key + ".kind", static_cast<int>(c.kind));
   out.write(key + ".isRelative", c.isRelative);
-  Eigen::Matrix<double, 9, 1> v;
+  // an unset inspiratory balance is written as -1
+  Eigen::Matrix<double, 10, 1> v;
   v << c.rate, c.depthMin, c.depthMax, c.ieRatio, c.postInspiratoryPause, c.postExpiratoryPause,
-      c.rateIrregularity, c.depthIrregularity, c.balance;
+      c.rateIrregularity, c.depthIrregularity, c.balance, c.inspiratoryBalance.value_or(-1.0);
   out.write(key + ".values", v);
   Eigen::Matrix2Xd k(2, static_cast<Eigen::Index>(c.keyframes.size()));
   for (std::size_t i = 0; i < c.keyframes.size(); ++i)
@@ -182,7 +185,7 @@ CycleSpec readCycle(CheckpointReader& in, const std::string& key) {
   if (kind < 0 || kind > static_cast<int>(CycleKind::Spline)) in.fail(key + ".kind", "unknown cycle kind");
   c.kind = static_cast<CycleKind>(kind);
   c.isRelative = in.readBool(key + ".isRelative");
-  Eigen::Matrix<double, 9, 1> v;
+  Eigen::Matrix<double, 10, 1> v;
   in.read(key + ".values", v);
   c.rate = v(0);
   c.depthMin = v(1);
@@ -193,6 +196,7 @@ CycleSpec readCycle(CheckpointReader& in, const std::string& key) {
   c.rateIrregularity = v(6);
   c.depthIrregularity = v(7);
   c.balance = v(8);
+  if (v(9) >= 0.0) c.inspiratoryBalance = v(9);
   Eigen::Matrix2Xd k;
   in.read(key + ".keyframes", k);
   for (Eigen::Index i = 0; i < k.cols(); ++i) c.keyframes.push_back({k(0, i), k(1, i)});

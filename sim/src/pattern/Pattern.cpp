@@ -27,7 +27,7 @@ CycleKind parseKind(const Node& n) {
 
 CycleSpec parseCycle(const Node& n) {
   n.allowKeys({"kind", "time", "rate_bpm", "depth", "ie_ratio", "post_inspiratory_pause_s",
-               "post_expiratory_pause_s", "irregularity", "balance", "keyframes"});
+               "post_expiratory_pause_s", "irregularity", "balance", "inspiratory_balance", "keyframes"});
   CycleSpec c;
   c.kind = parseKind(n.at("kind"));
 
@@ -60,6 +60,7 @@ CycleSpec parseCycle(const Node& n) {
     c.depthIrregularity = irr.numberOr("depth", 0.0);
   }
   c.balance = n.numberOr("balance", c.balance);
+  if (n.has("inspiratory_balance")) c.inspiratoryBalance = n.at("inspiratory_balance").number();
 
   // keyframes as [time, volume] pairs
   if (n.has("keyframes")) {

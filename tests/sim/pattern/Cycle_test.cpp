@@ -132,6 +132,26 @@ TEST(Cycle, VariationScalesDurationAndDepth) {
   EXPECT_NEAR(hi, c.depthMin + 0.5 * (c.depthMax - c.depthMin), 1e-9);
 }
 
+// the inspiratory balance holds from the breath's start to the shape's peak (the first keyframe with the
+// largest value, moved by the duration variation), the balance from there on, the post-inspiratory pause
+// included
+TEST(Cycle, InspiratoryBalanceHoldsUntilThePeak) {
+  CycleSpec c = spline({{0, 0.0}, {0.8, 1.0}, {1.2, 0.5}, {1.3, 1.0}, {2.6, 0.0}}, false);
+  c.balance = 0.15;
+  c.postInspiratoryPause = 0.5;
+  EXPECT_DOUBLE_EQ(Cycle(c).balance(0.79), 0.15);  // unset: the balance throughout
+  c.inspiratoryBalance = 0.9;
+  const Cycle cycle(c);
+  EXPECT_DOUBLE_EQ(cycle.balance(0.0), 0.9);
+  EXPECT_DOUBLE_EQ(cycle.balance(0.79), 0.9);
+  EXPECT_DOUBLE_EQ(cycle.balance(0.81), 0.15);
+  EXPECT_DOUBLE_EQ(cycle.balance(1.25), 0.15);  // in the pause
+  EXPECT_DOUBLE_EQ(cycle.balance(1.8), 0.15);   // rising again after the peak: still expiration
+  const BreathVariation slower{1.5, 1.0};
+  EXPECT_DOUBLE_EQ(cycle.balance(1.15, slower), 0.9);  // the peak at 1.2 s
+  EXPECT_DOUBLE_EQ(cycle.balance(1.25, slower), 0.15);
+}
+
 TEST(Cycle, InvalidSpecsNameTheField) {
   CycleSpec c;
   c.depthMin = 0.4;
@@ -156,6 +176,10 @@ TEST(Cycle, InvalidSpecsNameTheField) {
   c = CycleSpec();
   c.balance = 1.5;
   EXPECT_EQ(validationError(c).rfind("balance:", 0), 0u) << validationError(c);
+
+  c = CycleSpec();
+  c.inspiratoryBalance = std::nan("");
+  EXPECT_EQ(validationError(c).rfind("inspiratory_balance:", 0), 0u) << validationError(c);
 
   EXPECT_EQ(validationError(CycleSpec()), "");
 }

@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <cstring>
+#include <sstream>
 #include <vector>
 
+#include "pneuma/sim/Checkpoint.h"
 #include "pneuma/sim/Error.h"
 
 using namespace pneuma::sim;
@@ -158,4 +160,30 @@ TEST(LayerStack, RejectsBadPushesAndTimeTravel) {
   }
   s.sample(2.0);
   EXPECT_THROW(s.sample(1.0), Error);
+}
+
+// the playing layer's balance follows its breath: the inspiratory balance while it rises, the balance after
+// its peak; a stack read back from a checkpoint plays on with the same balances and volumes
+TEST(LayerStack, BalanceFollowsTheBreathAndSurvivesACheckpoint) {
+  Layer l = layer("laugh", 15.0, 0.55, kInfinite, 0.15);  // 4 s breaths, peak at 1.6 s (I:E 1:1.5)
+  l.cycle.inspiratoryBalance = 0.9;
+  LayerStack s(3);
+  s.push({l}, SwitchMode::Immediate, 0.0);
+  s.sample(0.0);
+  s.sample(1.0);
+  EXPECT_DOUBLE_EQ(s.balance(), 0.9);
+  std::stringstream file;
+  CheckpointWriter out(file);
+  s.saveState(out, "stack");
+  LayerStack read(0);
+  CheckpointReader in(file, "stack.ckpt");
+  read.loadState(in, "stack");
+  EXPECT_DOUBLE_EQ(read.balance(), 0.9);
+  for (double t : {1.5, 2.0, 4.9}) {
+    EXPECT_EQ(read.sample(t), s.sample(t)) << t;
+    EXPECT_EQ(read.balance(), s.balance()) << t;
+  }
+  EXPECT_DOUBLE_EQ(s.balance(), 0.9);  // 0.9 s into the second breath
+  s.sample(5.8);                       // 1.8 s into it, past the peak
+  EXPECT_DOUBLE_EQ(s.balance(), 0.15);
 }

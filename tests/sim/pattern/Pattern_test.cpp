@@ -74,6 +74,8 @@ TEST(PatternFile, MalformedFilesNameTheField) {
        "test.json: layers[0].cycle.depth[1]: must be in [0, 1]"},
       {R"({"kind": "spline", "rate_bpm": 15, "depth": [0.05, 0.25], "ie_ratio": 1, "keyframes": [[0, 0], [1, 0]]})",
        "test.json: layers[0].cycle.ie_ratio: not allowed with keyframes"},
+      {R"({"kind": "linear", "rate_bpm": 15, "depth": [0.05, 0.25], "inspiratory_balance": -0.2})",
+       "test.json: layers[0].cycle.inspiratory_balance: must be in [0, 1]"},
   };
   for (const Case& c : cases) {
     const std::string msg = parseError(patternWith(c.cycle));

@@ -11,6 +11,7 @@
 /// Beyond the paper: the inspiration:expiration ratio, post-inspiratory and post-expiratory pauses and
 /// a per-breath random variation of the breath duration and depth (irregularity).
 
+#include <optional>
 #include <vector>
 
 namespace pneuma::sim::pattern {
@@ -47,6 +48,8 @@ struct CycleSpec {
       0.0;  ///< [-] half-width of the uniform relative variation of depthMax - depthMin, [0, 0.5]
   double balance =
       0.5;  ///< [-] thoraco-abdominal balance: 0 all abdomen (diaphragm), 1 all chest (intercostals)
+  std::optional<double>
+      inspiratoryBalance;  ///< [-] balance from the breath's start to its peak, in [0, 1]; unset: `balance`
   std::vector<Keyframe>
       keyframes;  ///< explicit shape; required for `keyframe`, optional for `spline`, none for `linear`
 };
@@ -74,6 +77,10 @@ class Cycle {
 
   /// Volume fraction v in [0, 1] at time tau [s] after the start of a breath, tau clamped to [0, duration].
   double volume(double tau, const BreathVariation& variation = {}) const;
+
+  /// [-] thoraco-abdominal balance at time tau [s] after the start of a breath: `inspiratoryBalance` before
+  /// the shape's peak (when set), `balance` from the peak on.
+  double balance(double tau, const BreathVariation& variation = {}) const;
 
   /// Normalised shape s(u) in [0, 1] of the moving part, u in [0, 1] (pauses excluded).
   double shape(double u) const;
