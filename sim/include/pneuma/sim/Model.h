@@ -225,8 +225,8 @@ constexpr int kLungVertexSlots = 6;  ///< cavity vertices one lung vertex may co
 /// convex combination of up to six cavity vertices, x_v = sum_k w_k c_{i_k}, with c the posed cavity vertices
 /// (Cavity). A vertex on a cavity wall takes the three corners of the cavity triangle it lies on, so the
 /// lung's costal and diaphragmatic faces move with the walls exactly; a vertex on the mediastinal face takes
-/// the two cavity points straight above and below it (three corners each), so that face follows the ribs
-/// above and the diaphragm below.
+/// the two cavity points at the ends of a chord through it in the face's plane (three corners each), the
+/// chord that meets a wall soonest, so that the face follows the walls nearest to each of its points.
 struct LungSurface {
   Eigen::Matrix<int, 6, Eigen::Dynamic>
       cavityVertex;  ///< cavity vertex indices, -1 marks an unused slot (6 x #V)
