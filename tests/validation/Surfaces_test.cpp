@@ -4,7 +4,8 @@
 // checked with the triangle-triangle crossing test of SurfaceCrossings.h: each surface against itself, and
 // the pairs that must not cross (each lung with the gut, with the cavity and with the other lung). Short
 // runs: two seconds of settling and one breath or a few seconds of each style. Skips when the default model
-// is absent.
+// is absent. ctest runs the rest and breath-style checks on the female preset's model as well
+// (FemalePreset.Surfaces).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -111,9 +112,11 @@ constexpr bool kEnforceWallCrossings = false;
 // inspiratory_balance: its 59 pairs, where the dome alone drew 1.25 L, went to 13); 0 and 19 with the
 // mediastinal faces' points bound along the chord that meets a wall soonest (meshing/src/LungCavity.cpp,
 // kChordDirections: the 4 pairs each of anger, excitement, pain and startle at end-expiration, a face point
-// beside the dome's posterior notch, are gone). The budget leaves about 10 % for the run-to-run spread of
-// other changes.
-constexpr int kAffectCrossingBudget = 21;
+// beside the dome's posterior notch, are gone); 0 and 18 with the fan points at 0.6 times the face points'
+// spacing (meshing/src/LungCavity.cpp, kFanEdge; the female preset's styles 8 -> 0, so ctest
+// FemalePreset.Surfaces checks them too). The budget leaves about 10 % for the run-to-run spread of other
+// changes.
+constexpr int kAffectCrossingBudget = 20;
 
 // runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
 // settling: the two lungs never cross each other nor does a mediastinal face cross anything; the other
