@@ -347,7 +347,7 @@ Activations PatternController::activations(double t, const Metrics& latest) {
     m_tracking.targetMax = std::max(m_tracking.targetMax, m_target);
   }
 
-  // smooth balance changes between layers
+  // smooth balance changes (between layers, and at the peak of a cycle with an inspiratory balance)
   m_balance += (m_stack.balance() - m_balance) * (1.0 - std::exp(-dt / m_options.balanceTimeConstant));
 
   // feed-forward plus PI feedback, in volume-fraction units

@@ -98,9 +98,11 @@ struct PatternControllerOptions {
   /// frame-to-frame jump above 45 % of peak flow on any affect (AffectFlow test; docs/patterns.md,
   /// "Feedback"); the integral carries the slow lag.
   double kp = 0.5;
-  double ki = 50.0;                  ///< [1/s] integral gain
-  double integralLimit = 0.2;        ///< [-] clamp of the integral term I, in fraction units
-  double balanceTimeConstant = 0.3;  ///< [s] first-order smoothing of balance changes between layers
+  double ki = 50.0;            ///< [1/s] integral gain
+  double integralLimit = 0.2;  ///< [-] clamp of the integral term I, in fraction units
+  /// [s] first-order smoothing of balance changes: between layers, and at the peak of a cycle with an
+  /// inspiratory balance (CycleSpec::inspiratoryBalance)
+  double balanceTimeConstant = 0.3;
   /// [s] first-order lag between the drive and the internal intercostals' activation, added to their lever's
   /// lag in the feed-forward. They move the chest within one step (their calibrated lag is 0), and with the
   /// rib necks' costotransverse lock of 300 N m/rad (resources/anatomy/README.md) the chest answers them in
