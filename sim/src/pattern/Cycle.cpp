@@ -168,20 +168,23 @@ double Cycle::shape(double u) const {
   return std::clamp(s, 0.0, 1.0);
 }
 
+double Cycle::peakTime(const BreathVariation& variation) const {
+  return m_u[static_cast<std::size_t>(m_peak)] * (m_moving * variation.durationScale);
+}
+
 double Cycle::balance(double tau, const BreathVariation& variation) const {
-  const double peakTime = m_u[static_cast<std::size_t>(m_peak)] * m_moving * variation.durationScale;  // [s]
-  return m_spec.inspiratoryBalance && tau < peakTime ? *m_spec.inspiratoryBalance : m_spec.balance;
+  return m_spec.inspiratoryBalance && tau < peakTime(variation) ? *m_spec.inspiratoryBalance : m_spec.balance;
 }
 
 double Cycle::volume(double tau, const BreathVariation& variation) const {
   // map breath time to shape time, holding during the pauses
   const double moving = m_moving * variation.durationScale;
-  const double peakTime = m_u[static_cast<std::size_t>(m_peak)] * moving;
+  const double peak = peakTime(variation);
   const double pauseIn = m_spec.postInspiratoryPause;
   double u;
-  if (tau <= peakTime)
+  if (tau <= peak)
     u = tau / moving;
-  else if (tau <= peakTime + pauseIn)
+  else if (tau <= peak + pauseIn)
     u = m_u[static_cast<std::size_t>(m_peak)];
   else
     u = (tau - pauseIn) / moving;

@@ -86,6 +86,9 @@ class Cycle {
   double shape(double u) const;
 
  private:
+  // [s] time of the shape's peak after the start of a breath (pauses excluded before it)
+  double peakTime(const BreathVariation& variation) const;
+
   CycleSpec m_spec;
   std::vector<double> m_u;      // [-] keyframe times normalised to [0, 1]
   std::vector<double> m_s;      // [-] keyframe shape values
