@@ -117,9 +117,11 @@ constexpr bool kEnforceWallCrossings = false;
 // FemalePreset.Surfaces checks them too); 0 and 16 with relaxation's and sadness's balance at 0.45
 // (resources/presets/affect/, docs/patterns.md: at 0.2 and 0.35 the dome alone drew their inspirations and
 // the rib cage was drawn in; relaxation's 2 pairs, and the female preset's 6 pairs of the gut with itself in
-// the two, are gone: her affects 45 -> 39). The budget leaves about 10 % for the run-to-run spread of other
-// changes.
-constexpr int kAffectCrossingBudget = 18;
+// the two, are gone: her affects 45 -> 39); 0 and 4 with the dome's rim held on the ribs as the rest of the
+// zone of apposition is (meshing/src/MuscleNetwork.cpp, addApposition(): at joy's laugh the untied rim rode
+// up past the first ring on its insertions on the rising lower ribs; the female preset's 39 -> 14). The
+// budget leaves about 10 % for the run-to-run spread of other changes.
+constexpr int kAffectCrossingBudget = 5;
 
 // runs `controller` for settle + duration and checks the frames of smallest and largest lung volume after
 // settling: the two lungs never cross each other nor does a mediastinal face cross anything; the other
