@@ -153,9 +153,12 @@ void addDiaphragm(const Skeleton& sk, const GutSurface& gut, ElementSink& sink) 
 /// there by the pleural fluid, so that the abdominal pressure of an inspiration pushes on the lower ribs
 /// rather than bulging the dome out between them (Loring & Mead 1982, J Appl Physiol 53:756; De Troyer &
 /// Wilson 2016, J Appl Physiol 121:391). The pleural fluid holds the dome against the ribs but lets it slide
-/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. The dome
-/// rings inside the rim whose rise above the costal margin's mean level (GutSurface::domeRingRise) is at most
-/// the zone's height `a.abdomen.appositionHeight` lie in the zone. Each of their nodes gets a
+/// along them: the apposed dome shortens and descends like a piston while the ribs rise past it. The zone
+/// begins at the rim, where the costal fibres leave the costal margin, and takes in the dome rings whose rise
+/// above the costal margin's mean level (GutSurface::domeRingRise) is at most the zone's height
+/// `a.abdomen.appositionHeight`. Unheld, the rim followed its insertions on the rising lower ribs past the
+/// first ring at the biggest inspirations (a yawn, a sigh, a laugh: the tip of rib 8 rises 27 mm in the
+/// female preset's yawn) and the dome folded on itself between them. Each of their moving nodes gets a
 /// two-sided spring (Cartilage group) toward the nearest point of the inner face of ribs 6-12, or of the
 /// front of the vertebral bodies T10-L1 beside the crura (where the dome lies on the spine; without it the
 /// dome's rings over the spine fold backward on themselves while the model settles), within
@@ -183,9 +186,11 @@ void addApposition(const AnatomyParams& a, const Skeleton& sk, const GutSurface&
   for (const Eigen::Vector3d& c : spineFront)
     for (double x : {-kVertebralFrontHalfWidth, 0.0, kVertebralFrontHalfWidth})
       face.push_back(Endpoint::onBody(sk.lumbar, c + Eigen::Vector3d(x, 0, 0)));
-  for (std::size_t ring = 1; ring < gut.domeRing.size(); ++ring) {
+  for (std::size_t ring = 0; ring < gut.domeRing.size(); ++ring) {
     if (gut.domeRingRise[ring] > a.abdomen.appositionHeight) break;
     for (int node : gut.domeRing[ring]) {
+      // the rim's crural arc is fixed to the spine
+      if (gut.region[static_cast<std::size_t>(node)] == sim::NodeRegion::Fixed) continue;
       const Eigen::Vector3d p = gut.rest.col(node);
       const Endpoint& rib = nearest(face, p);
       const double reach = (rib.world - p).norm();

@@ -198,7 +198,7 @@ AffectInhale firstInhale(const std::string& affect, double window) {
   return in;
 }
 
-// joy's laugh starts with a deep, quick inspiration (1.25 L in 0.7 s) before its abdominal convulsions (de
+// joy's laugh starts with a deep, quick inspiration (1.1 L in 0.7 s) before its abdominal convulsions (de
 // Melo et al. 2010): a deep inspiration recruits the rib cage as well as the diaphragm, so from the end of
 // settling to the peak the rib cage gives at least 30 % of the volume (upright, Konno & Mead 1967, J Appl
 // Physiol 22:407: most of the inspiratory capacity is rib-cage displacement; the deep style gives 38 %) and
