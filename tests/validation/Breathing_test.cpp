@@ -230,6 +230,19 @@ TEST(Breathing, SlowDeepAffectsMoveTheRibCageOut) {
   }
 }
 
+// Neutral breathing (every affect's layer after its event) is quiet breathing, 0.5 L at 15 b/m: its rib cage
+// gives as much of it as in the calm style, within the 55-85 % of seated and standing adults
+// (physiology.calm.rib_cage_share: Sharp et al. 1975, J Appl Physiol 39:608; J Appl Physiol 1968, 24:159).
+// With its balance at 0.4 it gave 45 % on the default model and 34 % on the female preset; at 0.52 71 % and
+// 59 % (resources/presets/affect/neutral.json, docs/patterns.md).
+TEST(Breathing, NeutralAffectBreathesWithTheRibCageAsCalmBreathingDoes) {
+  REQUIRE_DEFAULT_MODEL();
+  const AffectInhale in = firstInhale("neutral", 1.8);
+  ASSERT_GT(in.volume, 0.4e-3) << "neutral's first inspiration";
+  EXPECT_GE(in.ribCageShare, 0.55);
+  EXPECT_LE(in.ribCageShare, 0.85);
+}
+
 // Figure 4: "Gut deformation after a heavy impact ... volume error less than 0.5 percent"
 TEST(Breathing, HeavyImpactKeepsGutVolumeErrorBelowHalfPercent) {
   REQUIRE_DEFAULT_MODEL();
