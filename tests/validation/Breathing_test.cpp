@@ -201,7 +201,7 @@ AffectInhale firstInhale(const std::string& affect, double window) {
 // joy's laugh starts with a deep, quick inspiration (1.1 L in 0.7 s) before its abdominal convulsions (de
 // Melo et al. 2010): a deep inspiration recruits the rib cage as well as the diaphragm, so from the end of
 // settling to the peak the rib cage gives at least 30 % of the volume (upright, Konno & Mead 1967, J Appl
-// Physiol 22:407: most of the inspiratory capacity is rib-cage displacement; the deep style gives 38 %) and
+// Physiol 22:407: most of the inspiratory capacity is rib-cage displacement; the deep style gives 41 %) and
 // the dome descends within the deep breath's 20-35 mm per litre (physiology.deep.dome_per_litre). With the
 // convulsions' balance (0.15) for the inhale as well, it was 4 % and 47 mm/L: a diaphragm-only piston
 // (resources/presets/affect/joy.json, inspiratory_balance).
