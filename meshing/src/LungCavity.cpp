@@ -133,33 +133,6 @@ TriangleMesh ellipsoid(const Eigen::Vector3d& c, const Eigen::Vector3d& r) {
   return sweepTube(st, 24, false);
 }
 
-/// z [m] of the first cavity surface point straight above (`up`) or below `p`, with its triangle and
-/// barycentric weights; false when the vertical line misses.
-bool verticalHit(const TriangleMesh& cavity, const Eigen::Vector3d& p, bool up, int& face, Eigen::Vector3d& w,
-                 double& z) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int f = 0; f < cavity.triangleCount(); ++f) {
-    const Eigen::Vector3d a = cavity.vertices.col(cavity.triangles(0, f));
-    const Eigen::Vector3d b = cavity.vertices.col(cavity.triangles(1, f));
-    const Eigen::Vector3d c = cavity.vertices.col(cavity.triangles(2, f));
-    // barycentric coordinates of p's projection in the xy plane
-    const double det = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
-    if (std::abs(det) < 1e-14) continue;
-    const double wb = ((p.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (p.y() - a.y())) / det;
-    const double wc = ((b.x() - a.x()) * (p.y() - a.y()) - (p.x() - a.x()) * (b.y() - a.y())) / det;
-    const double wa = 1.0 - wb - wc;
-    if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
-    const double zh = wa * a.z() + wb * b.z() + wc * c.z();
-    const double d = up ? zh - p.z() : p.z() - zh;
-    if (d < 0.0 || d >= best) continue;
-    best = d;
-    face = f;
-    w = {wa, wb, wc};
-    z = zh;
-  }
-  return std::isfinite(best);
-}
-
 /// The first point of the cavity surface hit by the ray p + t d, t > 0: its triangle, barycentric weights and
 /// t [m per unit d]; false when the ray misses (Moller & Trumbore 1997).
 bool rayHit(const TriangleMesh& cavity, const Eigen::Vector3d& p, const Eigen::Vector3d& d, int& face,
@@ -482,10 +455,10 @@ LungMeshes carveLungs(const TriangleMesh& cavity, double shift) {
   Eigen::Vector3d c(midX + kHeartCentreX * size.x(), lo.y() + kHeartCentreY * size.y(), hi.z());
   int face = -1;
   Eigen::Vector3d w;
-  double floorZ = lo.z();
-  if (!verticalHit(cavity, c, false, face, w, floorZ))
+  double depth = 0.0;  // [m] from the cavity's top down to its floor under the heart's centre
+  if (!rayHit(cavity, c, -Eigen::Vector3d::UnitZ(), face, w, depth))
     throw sim::Error("lungs: no cavity floor under the heart");
-  c.z() = floorZ + (1.0 - kHeartSink) * r.z();
+  c.z() += -depth + (1.0 - kHeartSink) * r.z();
   const TriangleMesh carved = subtract(subtract(cavity, block, kGrid, "lungs (central mediastinum)"),
                                        ellipsoid(c, r), kGrid, "lungs (heart)");
   // each component to the side of its centroid; the right lung lies at x > 0 (world RAS)
